@@ -1,0 +1,409 @@
+//! The run configuration, read from RON (`assets/*.ron`).
+//!
+//! Every hyper-parameter of the method lives here with a doc line, none as a literal in
+//! code. Defaults are the paper's Tables I and II and `DESIGN.md`; a field left out of a
+//! file keeps its default, an unknown field or a wrong type is an error that names the
+//! file, the line and column, and the field's path.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::env::{CartPoleParams, EnvConfig};
+use crate::sapnet::SapNetParams;
+
+/// Everything one run needs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Config {
+    /// The target task and its physics.
+    pub env: EnvConfig,
+    /// DQN hyper-parameters (Table I, ChainerRL's defaults where the paper is silent).
+    pub dqn: DqnConfig,
+    /// SAP-Net parameters (Table II).
+    pub sapnet: SapNetParams,
+    /// The source-policy library.
+    pub sources: SourcesConfig,
+    /// What an experiment runs and how often.
+    pub protocol: ProtocolConfig,
+    /// The run seed: everything random derives from it.
+    pub seed: u64,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Self {
+            env: EnvConfig::CartPole(CartPoleParams::default()),
+            dqn: DqnConfig::default(),
+            sapnet: SapNetParams::default(),
+            sources: SourcesConfig::default(),
+            protocol: ProtocolConfig::default(),
+            seed: 0,
+        }
+    }
+}
+
+/// How ε of ε-greedy evolves over the steps of a policy.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Exploration {
+    /// The paper: ε constant (Table I: 0.03).
+    Constant { epsilon: f64 },
+    /// ε falls linearly from `start` to `end` over `steps` steps, then stays at `end`.
+    Linear { start: f64, end: f64, steps: u64 },
+}
+
+/// DQN hyper-parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DqnConfig {
+    /// γ, the discount rate (Table I: 0.99).
+    pub gamma: f64,
+    /// Adam's learning rate (ChainerRL's default 1e-3).
+    pub learning_rate: f64,
+    /// Adam's ε (Table I: 1e-3).
+    pub adam_epsilon: f64,
+    /// Adam's β₁ and β₂.
+    pub adam_betas: (f64, f64),
+    /// Minibatch size of one update (ChainerRL: 32).
+    pub batch_size: usize,
+    /// Transitions the replay buffer holds (Table I: 1e6).
+    pub replay_capacity: usize,
+    /// Steps stored before updates begin (Table I: 50 CartPole, 100 MountainCar).
+    pub replay_start_size: usize,
+    /// Environment steps between rounds of updates (ChainerRL: 1).
+    pub update_interval: u64,
+    /// Gradient updates per round (ChainerRL: 1).
+    pub gradient_steps: u32,
+    /// Steps between hard copies of the online network into the target network
+    /// (ChainerRL's default 10,000; decides whether the paper's setting learns at all).
+    pub target_update_interval: u64,
+    /// Huber loss threshold (ChainerRL `clip_delta=True`: 1).
+    pub huber_delta: f64,
+    /// Clip the gradients' global norm to this value (SB3: 10; ChainerRL: none).
+    pub max_grad_norm: Option<f64>,
+    /// Decay of the statistic loss, the moving average the SAP-Net judgment reads
+    /// (ChainerRL's `average_loss`: 0.99).
+    pub loss_decay: f64,
+    pub exploration: Exploration,
+    /// Treat a time-limit truncation as terminal (old Gym and ChainerRL did); Gymnasium
+    /// semantics (`false`) keep bootstrapping through it.
+    pub truncation_as_terminal: bool,
+}
+
+impl Default for DqnConfig {
+    fn default() -> Self {
+        Self {
+            gamma: 0.99,
+            learning_rate: 1e-3,
+            adam_epsilon: 1e-3,
+            adam_betas: (0.9, 0.999),
+            batch_size: 32,
+            replay_capacity: 1_000_000,
+            replay_start_size: 50,
+            update_interval: 1,
+            gradient_steps: 1,
+            target_update_interval: 10_000,
+            huber_delta: 1.0,
+            max_grad_norm: None,
+            loss_decay: 0.99,
+            exploration: Exploration::Constant { epsilon: 0.03 },
+            truncation_as_terminal: false,
+        }
+    }
+}
+
+/// The library of source policies (paper III-B).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SourcesConfig {
+    /// N, the number of source policies (paper: 10).
+    pub count: usize,
+    /// Inclusive range of the number of hidden layers, drawn uniformly (paper: 1–3).
+    pub hidden_layers: (usize, usize),
+    /// Inclusive range of units per hidden layer, drawn uniformly (around 100).
+    pub units: (usize, usize),
+    /// Episodes each source policy trains on the source task.
+    pub training_episodes: u32,
+    /// The source task, when it differs from the target task (`None`: the same).
+    pub env: Option<EnvConfig>,
+}
+
+impl Default for SourcesConfig {
+    fn default() -> Self {
+        Self {
+            count: 10,
+            hidden_layers: (1, 3),
+            units: (50, 150),
+            training_episodes: 300,
+            env: None,
+        }
+    }
+}
+
+/// A learner an experiment compares.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Method {
+    /// Transfer learning with SAP-Net over the source library (Algorithm 3).
+    SapNet,
+    /// DQN from scratch with these hidden layers (the paper's baselines: `[100]`,
+    /// `[100, 100]`, `[100, 100, 100]`).
+    Dqn { hidden: Vec<usize> },
+}
+
+/// What an experiment runs and how often (paper III-B).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ProtocolConfig {
+    /// Training episodes per run (Table I: 5000 CartPole, 10000 MountainCar).
+    pub episodes: u32,
+    /// Independent runs per method, averaged (paper: 5).
+    pub runs: u32,
+    /// Greedy test episodes after training (Table I "Number of test": 5).
+    pub test_episodes: u32,
+    /// Window of the moving average of episode returns in plots (paper: 10).
+    pub moving_average: usize,
+    pub methods: Vec<Method>,
+}
+
+impl Default for ProtocolConfig {
+    fn default() -> Self {
+        Self {
+            episodes: 5000,
+            runs: 5,
+            test_episodes: 5,
+            moving_average: 10,
+            methods: vec![
+                Method::SapNet,
+                Method::Dqn { hidden: vec![100] },
+                Method::Dqn {
+                    hidden: vec![100, 100],
+                },
+                Method::Dqn {
+                    hidden: vec![100, 100, 100],
+                },
+            ],
+        }
+    }
+}
+
+/// A config that could not be read: where, and what was expected.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("reading config {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{0}")]
+    Parse(Box<ParseError>),
+    #[error("config {}: {message}", origin)]
+    Invalid { origin: String, message: String },
+}
+
+/// A located syntax or type error in a RON file.
+#[derive(Debug)]
+pub struct ParseError {
+    /// The file name, or a label for text that did not come from a file.
+    pub origin: String,
+    pub line: usize,
+    pub column: usize,
+    /// Dotted path of the field being read, e.g. `dqn.gamma` (empty at the top level).
+    pub field: String,
+    pub message: String,
+}
+
+impl fmt::Display for ParseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "config {}: line {}, column {}",
+            self.origin, self.line, self.column
+        )?;
+        if !self.field.is_empty() && self.field != "." {
+            write!(f, ", field `{}`", self.field)?;
+        }
+        write!(f, ": {}", self.message)
+    }
+}
+
+/// The RON options every file of this project is read with: a newtype variant's struct may
+/// drop its extra parentheses (`CartPole(gravity: 9.8)` rather than `CartPole((…))`).
+pub fn ron_options() -> ron::Options {
+    ron::Options::default().with_default_extension(ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES)
+}
+
+/// Reads any RON document, with located errors. `origin` names the text in messages.
+pub fn parse_ron<T: serde::de::DeserializeOwned>(text: &str, origin: &str) -> Result<T, ConfigError> {
+    let options = ron_options();
+    let mut de = ron::Deserializer::from_str_with_options(text, &options).map_err(|e| {
+        ConfigError::Parse(Box::new(ParseError {
+            origin: origin.to_string(),
+            line: e.span.start.line,
+            column: e.span.start.col,
+            field: String::new(),
+            message: e.code.to_string(),
+        }))
+    })?;
+    let located = |de: &ron::Deserializer, field: String, code: ron::Error| {
+        let spanned = de.span_error(code);
+        ConfigError::Parse(Box::new(ParseError {
+            origin: origin.to_string(),
+            line: spanned.span.start.line,
+            column: spanned.span.start.col,
+            field,
+            message: spanned.code.to_string(),
+        }))
+    };
+    let value = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let field = e.path().to_string();
+        located(&de, field, e.into_inner())
+    })?;
+    de.end().map_err(|e| located(&de, String::new(), e))?;
+    Ok(value)
+}
+
+impl Config {
+    /// Reads and validates a config file.
+    pub fn from_file(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_ron(&text, &path.display().to_string())
+    }
+
+    /// Reads and validates a config from RON text; `origin` names it in errors.
+    pub fn from_ron(text: &str, origin: &str) -> Result<Self, ConfigError> {
+        let config: Config = parse_ron(text, origin)?;
+        config.validate().map_err(|message| ConfigError::Invalid {
+            origin: origin.to_string(),
+            message,
+        })?;
+        Ok(config)
+    }
+
+    /// Checks the values serde cannot: ranges and relations between fields.
+    pub fn validate(&self) -> Result<(), String> {
+        let d = &self.dqn;
+        check(d.gamma >= 0.0 && d.gamma <= 1.0, "dqn.gamma", "a number in [0, 1]", d.gamma)?;
+        check(d.learning_rate > 0.0, "dqn.learning_rate", "a number > 0", d.learning_rate)?;
+        check(d.adam_epsilon > 0.0, "dqn.adam_epsilon", "a number > 0", d.adam_epsilon)?;
+        check(d.batch_size > 0, "dqn.batch_size", "at least 1", d.batch_size)?;
+        check(
+            d.replay_capacity >= d.batch_size,
+            "dqn.replay_capacity",
+            "at least dqn.batch_size",
+            d.replay_capacity,
+        )?;
+        check(d.update_interval > 0, "dqn.update_interval", "at least 1", d.update_interval)?;
+        check(
+            d.target_update_interval > 0,
+            "dqn.target_update_interval",
+            "at least 1",
+            d.target_update_interval,
+        )?;
+        check(d.huber_delta > 0.0, "dqn.huber_delta", "a number > 0", d.huber_delta)?;
+        check(
+            d.loss_decay >= 0.0 && d.loss_decay < 1.0,
+            "dqn.loss_decay",
+            "a number in [0, 1)",
+            d.loss_decay,
+        )?;
+        if let Some(norm) = d.max_grad_norm {
+            check(norm > 0.0, "dqn.max_grad_norm", "a number > 0", norm)?;
+        }
+        match d.exploration {
+            Exploration::Constant { epsilon } => check(
+                (0.0..=1.0).contains(&epsilon),
+                "dqn.exploration.epsilon",
+                "a number in [0, 1]",
+                epsilon,
+            )?,
+            Exploration::Linear { start, end, .. } => {
+                check((0.0..=1.0).contains(&start), "dqn.exploration.start", "a number in [0, 1]", start)?;
+                check((0.0..=1.0).contains(&end), "dqn.exploration.end", "a number in [0, 1]", end)?;
+            }
+        }
+        let s = &self.sapnet;
+        check(s.threshold > 0.0 && s.threshold.is_finite(), "sapnet.threshold", "a finite number > 0", s.threshold)?;
+        check(s.temperature > 0.0 && s.temperature.is_finite(), "sapnet.temperature", "a finite number > 0", s.temperature)?;
+        check(s.coefficient.is_finite(), "sapnet.coefficient", "a finite number", s.coefficient)?;
+        check(s.delta.is_finite(), "sapnet.delta", "a finite number", s.delta)?;
+        let src = &self.sources;
+        check(src.count > 0, "sources.count", "at least 1", src.count)?;
+        check(
+            src.hidden_layers.0 >= 1 && src.hidden_layers.0 <= src.hidden_layers.1,
+            "sources.hidden_layers",
+            "(min, max) with 1 <= min <= max",
+            format!("{:?}", src.hidden_layers),
+        )?;
+        check(
+            src.units.0 >= 1 && src.units.0 <= src.units.1,
+            "sources.units",
+            "(min, max) with 1 <= min <= max",
+            format!("{:?}", src.units),
+        )?;
+        let p = &self.protocol;
+        check(p.runs > 0, "protocol.runs", "at least 1", p.runs)?;
+        check(p.moving_average > 0, "protocol.moving_average", "at least 1", p.moving_average)?;
+        check(!p.methods.is_empty(), "protocol.methods", "at least one method", "[]")?;
+        for (i, method) in p.methods.iter().enumerate() {
+            if let Method::Dqn { hidden } = method {
+                check(
+                    !hidden.is_empty() && hidden.iter().all(|&u| u > 0),
+                    &format!("protocol.methods[{i}].hidden"),
+                    "a non-empty list of layer sizes > 0",
+                    format!("{hidden:?}"),
+                )?;
+            }
+        }
+        Ok(())
+    }
+}
+
+fn check(ok: bool, field: &str, expected: &str, got: impl fmt::Display) -> Result<(), String> {
+    if ok {
+        Ok(())
+    } else {
+        Err(format!("field `{field}`: expected {expected}, got {got}"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_papers_tables() {
+        let c = Config::default();
+        assert_eq!(c.dqn.gamma, 0.99);
+        assert_eq!(c.dqn.adam_epsilon, 1e-3);
+        assert_eq!(c.dqn.replay_capacity, 1_000_000);
+        assert_eq!(c.dqn.replay_start_size, 50);
+        assert_eq!(c.dqn.target_update_interval, 10_000);
+        assert_eq!(c.dqn.exploration, Exploration::Constant { epsilon: 0.03 });
+        assert_eq!(c.sapnet.delta, -0.5);
+        assert_eq!(c.sapnet.threshold, 1.0);
+        assert_eq!(c.sapnet.coefficient, 1.0);
+        assert_eq!(c.sapnet.prototypes[0].omega, 0.1);
+        assert_eq!(c.protocol.episodes, 5000);
+        assert_eq!(c.protocol.runs, 5);
+        assert_eq!(c.protocol.test_episodes, 5);
+        assert_eq!(c.sources.count, 10);
+    }
+
+    #[test]
+    fn an_empty_document_is_the_default() {
+        assert_eq!(Config::from_ron("()", "test").unwrap(), Config::default());
+    }
+
+    #[test]
+    fn newtype_variants_need_no_double_parentheses() {
+        let c = Config::from_ron("(env: MountainCar(max_episode_steps: 300))", "test").unwrap();
+        match c.env {
+            EnvConfig::MountainCar(p) => assert_eq!(p.max_episode_steps, 300),
+            other => panic!("wrong env {other:?}"),
+        }
+    }
+}

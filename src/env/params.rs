@@ -1,0 +1,162 @@
+//! Physical parameters of the environments, as read from a config.
+//!
+//! Defaults are Gymnasium's constants; a field left out of a config keeps its default.
+
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// Which environment a config runs, with its physics.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum EnvConfig {
+    CartPole(CartPoleParams),
+    MountainCar(MountainCarParams),
+    Acrobot(AcrobotParams),
+}
+
+impl EnvConfig {
+    /// Short name used for the policy library's folder (`saved_policies/<task>/`).
+    pub fn task_name(&self) -> &'static str {
+        match self {
+            EnvConfig::CartPole(_) => "cartpole",
+            EnvConfig::MountainCar(_) => "mountain_car",
+            EnvConfig::Acrobot(_) => "acrobot",
+        }
+    }
+
+    pub fn max_episode_steps(&self) -> u32 {
+        match self {
+            EnvConfig::CartPole(p) => p.max_episode_steps,
+            EnvConfig::MountainCar(p) => p.max_episode_steps,
+            EnvConfig::Acrobot(p) => p.max_episode_steps,
+        }
+    }
+}
+
+/// CartPole's integrator (Gymnasium's `kinematics_integrator`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Integrator {
+    /// Position from the old velocity (Gymnasium's default `"euler"`).
+    Euler,
+    /// Position from the new velocity (`"semi-implicit euler"`).
+    SemiImplicitEuler,
+}
+
+/// CartPole (Barto, Sutton & Anderson). `max_episode_steps` 500 is v1, 200 is v0.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CartPoleParams {
+    /// Time limit (sets `truncated`): 500 for CartPole-v1, 200 for CartPole-v0.
+    pub max_episode_steps: u32,
+    /// m/s².
+    pub gravity: f64,
+    /// kg.
+    pub masscart: f64,
+    /// kg.
+    pub masspole: f64,
+    /// Half the pole's length, m.
+    pub length: f64,
+    /// Magnitude of the push, N.
+    pub force_mag: f64,
+    /// Seconds between state updates.
+    pub tau: f64,
+    pub integrator: Integrator,
+    /// Pole angle beyond which the episode terminates, rad (12°).
+    pub theta_threshold_radians: f64,
+    /// Cart position beyond which the episode terminates, m.
+    pub x_threshold: f64,
+}
+
+impl Default for CartPoleParams {
+    fn default() -> Self {
+        Self {
+            max_episode_steps: 500,
+            gravity: 9.8,
+            masscart: 1.0,
+            masspole: 0.1,
+            length: 0.5,
+            force_mag: 10.0,
+            tau: 0.02,
+            integrator: Integrator::Euler,
+            // Same operation order as Gymnasium: 12 * 2 * math.pi / 360.
+            theta_threshold_radians: 12.0 * 2.0 * PI / 360.0,
+            x_threshold: 2.4,
+        }
+    }
+}
+
+/// MountainCar-v0 (Moore), discrete actions.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MountainCarParams {
+    /// Time limit (sets `truncated`): 200 for MountainCar-v0.
+    pub max_episode_steps: u32,
+    pub min_position: f64,
+    pub max_position: f64,
+    pub max_speed: f64,
+    pub goal_position: f64,
+    pub goal_velocity: f64,
+    /// Engine force per unit of action.
+    pub force: f64,
+    pub gravity: f64,
+}
+
+impl Default for MountainCarParams {
+    fn default() -> Self {
+        Self {
+            max_episode_steps: 200,
+            min_position: -1.2,
+            max_position: 0.6,
+            max_speed: 0.07,
+            goal_position: 0.5,
+            goal_velocity: 0.0,
+            force: 0.001,
+            gravity: 0.0025,
+        }
+    }
+}
+
+/// Acrobot-v1 (Sutton), "book" dynamics, RK4 integration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AcrobotParams {
+    /// Time limit (sets `truncated`): 500 for Acrobot-v1.
+    pub max_episode_steps: u32,
+    /// Seconds per step.
+    pub dt: f64,
+    pub link_length_1: f64,
+    pub link_length_2: f64,
+    pub link_mass_1: f64,
+    pub link_mass_2: f64,
+    /// Position of the centre of mass of link 1.
+    pub link_com_pos_1: f64,
+    /// Position of the centre of mass of link 2.
+    pub link_com_pos_2: f64,
+    /// Moment of inertia of both links.
+    pub link_moi: f64,
+    pub max_vel_1: f64,
+    pub max_vel_2: f64,
+    /// Torque applied by actions 0, 1, 2.
+    pub available_torque: [f64; 3],
+    /// Uniform noise added to the torque (Gymnasium's default 0: none).
+    pub torque_noise_max: f64,
+}
+
+impl Default for AcrobotParams {
+    fn default() -> Self {
+        Self {
+            max_episode_steps: 500,
+            dt: 0.2,
+            link_length_1: 1.0,
+            link_length_2: 1.0,
+            link_mass_1: 1.0,
+            link_mass_2: 1.0,
+            link_com_pos_1: 0.5,
+            link_com_pos_2: 0.5,
+            link_moi: 1.0,
+            max_vel_1: 4.0 * PI,
+            max_vel_2: 9.0 * PI,
+            available_torque: [-1.0, 0.0, 1.0],
+            torque_noise_max: 0.0,
+        }
+    }
+}

@@ -1,0 +1,12 @@
+//! sapnet: policy reuse in reinforcement learning with a spreading activation model
+//! (SAP-Net), after "Autonomous Reusing Policy Selection using Spreading Activation Model
+//! in Deep Reinforcement Learning".
+//!
+//! - [`sapnet`]: the paper's section II — categories, the policy graph, selection,
+//!   activation and spreading. Pure maths.
+//! - [`env`]: native CartPole, MountainCar and Acrobot, exact to Gymnasium.
+//! - [`config`]: the RON run configuration, with the paper's values as defaults.
+
+pub mod config;
+pub mod env;
+pub mod sapnet;

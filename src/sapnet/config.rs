@@ -1,0 +1,79 @@
+//! SAP-Net's parameters (paper Table II) as read from a config.
+
+use serde::{Deserialize, Serialize};
+
+/// A way of putting policies into categories (paper II-C). Two policies share a category
+/// under a prototype when the prototype gives them the same key.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Prototype {
+    /// Number of hidden layers: the paper's only prototype.
+    HiddenLayers,
+    /// Units per hidden layer (mean over layers) bucketed by `width`.
+    UnitsBucket { width: usize },
+    /// The task the policy was trained on.
+    SourceTask,
+    /// The hidden layers' activation function.
+    Activation,
+}
+
+/// A prototype and its weight ω_c in the prototype matrix P_c (eq. 5).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WeightedPrototype {
+    pub prototype: Prototype,
+    /// ω_c: the entry P_c[i][j] for policies i ≠ j in the same category (Table II: 0.1).
+    pub omega: f64,
+}
+
+/// Which pairs of policies are joined before the prototypes adjust the weights (eq. 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum BaseGraph {
+    /// Joined when they share a category under at least one prototype.
+    SharedCategory,
+    /// Every pair joined.
+    Complete,
+}
+
+/// Which walks the spreading recursion may take (Algorithm 2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Paths {
+    /// The paper: only the threshold T_ω bounds a walk, which may step back.
+    Literal,
+    /// No policy twice on one walk.
+    Simple,
+}
+
+/// SAP-Net parameters. Defaults are the paper's Table II.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SapNetParams {
+    /// The prototypes in use, each with its ω_c.
+    pub prototypes: Vec<WeightedPrototype>,
+    /// δ, adjustment weight of the prototype matrices (eq. 5; Table II: −0.5).
+    pub delta: f64,
+    /// T_ω, the spreading threshold on the summed path weight (eq. 10; Table II: 1.0).
+    pub threshold: f64,
+    /// 𝒜, the activated coefficient (eq. 8; Table II: 1.0).
+    pub coefficient: f64,
+    /// τ, the softmax temperature of selection (eq. 6; the paper: 1).
+    pub temperature: f64,
+    pub base_graph: BaseGraph,
+    pub paths: Paths,
+}
+
+impl Default for SapNetParams {
+    fn default() -> Self {
+        Self {
+            prototypes: vec![WeightedPrototype {
+                prototype: Prototype::HiddenLayers,
+                omega: 0.1,
+            }],
+            delta: -0.5,
+            threshold: 1.0,
+            coefficient: 1.0,
+            temperature: 1.0,
+            base_graph: BaseGraph::SharedCategory,
+            paths: Paths::Literal,
+        }
+    }
+}
