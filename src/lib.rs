@@ -10,3 +10,5 @@
 pub mod config;
 pub mod env;
 pub mod sapnet;
+pub mod app;
+pub mod cli;

@@ -1,0 +1,71 @@
+//! Command-line interface.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand};
+
+/// SAP-Net: reuse a library of DQN policies by spreading activation over a policy graph.
+///
+/// With no subcommand, runs the experiment of `--config` (default: the embedded CartPole
+/// configuration, the paper's settings).
+#[derive(Debug, Parser)]
+#[command(name = "sapnet", version, about, long_about = None)]
+pub struct Cli {
+    #[command(flatten)]
+    pub run: RunArgs,
+
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// Options of a training run.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// RON config file (see assets/). Without it, the embedded CartPole config (paper values).
+    #[arg(long, short, value_name = "FILE", global = true)]
+    pub config: Option<PathBuf>,
+
+    /// Run without the terminal UI: progress on stderr, results in --out.
+    #[arg(long)]
+    pub headless: bool,
+
+    /// Run seed, overriding the config's `seed`: the same seed and config give the same
+    /// numbers on the same machine.
+    #[arg(long, value_name = "N", global = true)]
+    pub seed: Option<u64>,
+
+    /// Directory for results (CSV, JSON, plots).
+    #[arg(long, value_name = "DIR", default_value = "out")]
+    pub out: PathBuf,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run episodes with uniformly random actions and print their lengths and returns
+    /// (a quick check of an environment and its physics).
+    Env(EnvArgs),
+    /// Step SAP-Net's activation and spreading by hand on a small graph.
+    Teach(TeachArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct EnvArgs {
+    /// Number of episodes.
+    #[arg(long, value_name = "N", default_value_t = 10)]
+    pub episodes: u32,
+}
+
+#[derive(Debug, Args)]
+pub struct TeachArgs {
+    /// Print the trace instead of opening the interactive view.
+    #[arg(long)]
+    pub headless: bool,
+
+    /// Activate this policy (0-based index); repeat to activate several in order.
+    #[arg(long = "activate", value_name = "I")]
+    pub activate: Vec<usize>,
+
+    /// With --headless: print one JSON object {activations, probabilities, trace}.
+    #[arg(long)]
+    pub json: bool,
+}
