@@ -230,11 +230,15 @@ impl fmt::Display for ParseError {
 /// The RON options every file of this project is read with: a newtype variant's struct may
 /// drop its extra parentheses (`CartPole(gravity: 9.8)` rather than `CartPole((…))`).
 pub fn ron_options() -> ron::Options {
-    ron::Options::default().with_default_extension(ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES)
+    ron::Options::default()
+        .with_default_extension(ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES)
 }
 
 /// Reads any RON document, with located errors. `origin` names the text in messages.
-pub fn parse_ron<T: serde::de::DeserializeOwned>(text: &str, origin: &str) -> Result<T, ConfigError> {
+pub fn parse_ron<T: serde::de::DeserializeOwned>(
+    text: &str,
+    origin: &str,
+) -> Result<T, ConfigError> {
     let options = ron_options();
     let mut de = ron::Deserializer::from_str_with_options(text, &options).map_err(|e| {
         ConfigError::Parse(Box::new(ParseError {
@@ -286,24 +290,54 @@ impl Config {
     /// Checks the values serde cannot: ranges and relations between fields.
     pub fn validate(&self) -> Result<(), String> {
         let d = &self.dqn;
-        check(d.gamma >= 0.0 && d.gamma <= 1.0, "dqn.gamma", "a number in [0, 1]", d.gamma)?;
-        check(d.learning_rate > 0.0, "dqn.learning_rate", "a number > 0", d.learning_rate)?;
-        check(d.adam_epsilon > 0.0, "dqn.adam_epsilon", "a number > 0", d.adam_epsilon)?;
-        check(d.batch_size > 0, "dqn.batch_size", "at least 1", d.batch_size)?;
+        check(
+            d.gamma >= 0.0 && d.gamma <= 1.0,
+            "dqn.gamma",
+            "a number in [0, 1]",
+            d.gamma,
+        )?;
+        check(
+            d.learning_rate > 0.0,
+            "dqn.learning_rate",
+            "a number > 0",
+            d.learning_rate,
+        )?;
+        check(
+            d.adam_epsilon > 0.0,
+            "dqn.adam_epsilon",
+            "a number > 0",
+            d.adam_epsilon,
+        )?;
+        check(
+            d.batch_size > 0,
+            "dqn.batch_size",
+            "at least 1",
+            d.batch_size,
+        )?;
         check(
             d.replay_capacity >= d.batch_size,
             "dqn.replay_capacity",
             "at least dqn.batch_size",
             d.replay_capacity,
         )?;
-        check(d.update_interval > 0, "dqn.update_interval", "at least 1", d.update_interval)?;
+        check(
+            d.update_interval > 0,
+            "dqn.update_interval",
+            "at least 1",
+            d.update_interval,
+        )?;
         check(
             d.target_update_interval > 0,
             "dqn.target_update_interval",
             "at least 1",
             d.target_update_interval,
         )?;
-        check(d.huber_delta > 0.0, "dqn.huber_delta", "a number > 0", d.huber_delta)?;
+        check(
+            d.huber_delta > 0.0,
+            "dqn.huber_delta",
+            "a number > 0",
+            d.huber_delta,
+        )?;
         check(
             d.loss_decay >= 0.0 && d.loss_decay < 1.0,
             "dqn.loss_decay",
@@ -321,15 +355,45 @@ impl Config {
                 epsilon,
             )?,
             Exploration::Linear { start, end, .. } => {
-                check((0.0..=1.0).contains(&start), "dqn.exploration.start", "a number in [0, 1]", start)?;
-                check((0.0..=1.0).contains(&end), "dqn.exploration.end", "a number in [0, 1]", end)?;
+                check(
+                    (0.0..=1.0).contains(&start),
+                    "dqn.exploration.start",
+                    "a number in [0, 1]",
+                    start,
+                )?;
+                check(
+                    (0.0..=1.0).contains(&end),
+                    "dqn.exploration.end",
+                    "a number in [0, 1]",
+                    end,
+                )?;
             }
         }
         let s = &self.sapnet;
-        check(s.threshold > 0.0 && s.threshold.is_finite(), "sapnet.threshold", "a finite number > 0", s.threshold)?;
-        check(s.temperature > 0.0 && s.temperature.is_finite(), "sapnet.temperature", "a finite number > 0", s.temperature)?;
-        check(s.coefficient.is_finite(), "sapnet.coefficient", "a finite number", s.coefficient)?;
-        check(s.delta.is_finite(), "sapnet.delta", "a finite number", s.delta)?;
+        check(
+            s.threshold > 0.0 && s.threshold.is_finite(),
+            "sapnet.threshold",
+            "a finite number > 0",
+            s.threshold,
+        )?;
+        check(
+            s.temperature > 0.0 && s.temperature.is_finite(),
+            "sapnet.temperature",
+            "a finite number > 0",
+            s.temperature,
+        )?;
+        check(
+            s.coefficient.is_finite(),
+            "sapnet.coefficient",
+            "a finite number",
+            s.coefficient,
+        )?;
+        check(
+            s.delta.is_finite(),
+            "sapnet.delta",
+            "a finite number",
+            s.delta,
+        )?;
         let src = &self.sources;
         check(src.count > 0, "sources.count", "at least 1", src.count)?;
         check(
@@ -346,8 +410,18 @@ impl Config {
         )?;
         let p = &self.protocol;
         check(p.runs > 0, "protocol.runs", "at least 1", p.runs)?;
-        check(p.moving_average > 0, "protocol.moving_average", "at least 1", p.moving_average)?;
-        check(!p.methods.is_empty(), "protocol.methods", "at least one method", "[]")?;
+        check(
+            p.moving_average > 0,
+            "protocol.moving_average",
+            "at least 1",
+            p.moving_average,
+        )?;
+        check(
+            !p.methods.is_empty(),
+            "protocol.methods",
+            "at least one method",
+            "[]",
+        )?;
         for (i, method) in p.methods.iter().enumerate() {
             if let Method::Dqn { hidden } = method {
                 check(

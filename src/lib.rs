@@ -7,8 +7,10 @@
 //! - [`env`]: native CartPole, MountainCar and Acrobot, exact to Gymnasium.
 //! - [`config`]: the RON run configuration, with the paper's values as defaults.
 
+pub mod app;
+pub mod assets;
+pub mod cli;
 pub mod config;
 pub mod env;
+pub mod random_episodes;
 pub mod sapnet;
-pub mod app;
-pub mod cli;

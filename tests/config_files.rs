@@ -1,0 +1,97 @@
+//! The shipped configs load, and a malformed config gives a located error.
+
+use std::path::Path;
+
+use sapnet::config::{Config, ConfigError};
+use sapnet::env::EnvConfig;
+
+fn asset(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets")
+        .join(name)
+}
+
+#[test]
+fn every_shipped_run_config_loads() {
+    for name in ["cartpole.ron", "mountain_car.ron", "acrobot.ron"] {
+        Config::from_file(&asset(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+}
+
+#[test]
+fn the_cartpole_config_spells_out_the_defaults() {
+    // assets/cartpole.ron writes every field; it must say exactly what the code defaults
+    // to, so that reading the file tells the truth about a run without it.
+    let config = Config::from_file(&asset("cartpole.ron")).unwrap();
+    assert_eq!(config, Config::default());
+}
+
+#[test]
+fn the_mountain_car_config_uses_table_one() {
+    let config = Config::from_file(&asset("mountain_car.ron")).unwrap();
+    assert!(matches!(config.env, EnvConfig::MountainCar(_)));
+    assert_eq!(config.dqn.replay_start_size, 100);
+    assert_eq!(config.protocol.episodes, 10_000);
+}
+
+fn parse_error(text: &str) -> String {
+    match Config::from_ron(text, "bad.ron") {
+        Err(err @ ConfigError::Parse(_)) => err.to_string(),
+        Err(other) => panic!("expected a parse error, got {other}"),
+        Ok(_) => panic!("expected an error for {text:?}"),
+    }
+}
+
+#[test]
+fn an_unknown_field_is_named_with_its_line_and_column() {
+    let text = "(\n    dqn: (\n        gamma: 0.99,\n        gamm: 0.5,\n    ),\n)\n";
+    let message = parse_error(text);
+    assert!(
+        message.starts_with("config bad.ron: line 4, column "),
+        "{message}"
+    );
+    assert!(message.contains("gamm"), "{message}");
+    assert!(message.contains("field `dqn"), "{message}");
+}
+
+#[test]
+fn a_wrong_type_names_the_field_path() {
+    let text = "(\n    dqn: (\n        batch_size: \"thirty-two\",\n    ),\n)\n";
+    let message = parse_error(text);
+    assert!(message.contains("line 3"), "{message}");
+    assert!(message.contains("field `dqn.batch_size`"), "{message}");
+}
+
+#[test]
+fn a_wrong_type_deep_in_the_physics_is_located() {
+    let text = "(env: CartPole(\n  gravity: 9.8,\n  masspole: true,\n))";
+    let message = parse_error(text);
+    assert!(message.contains("line 3"), "{message}");
+    assert!(message.contains("masspole"), "{message}");
+}
+
+#[test]
+fn an_unknown_environment_is_rejected() {
+    let message = parse_error("(env: LunarLander())");
+    assert!(message.contains("LunarLander"), "{message}");
+}
+
+#[test]
+fn a_syntax_error_is_located() {
+    let message = parse_error("(\n  seed: 1,\n  dqn: (gamma: 0.9\n");
+    assert!(message.starts_with("config bad.ron: line "), "{message}");
+}
+
+#[test]
+fn an_out_of_range_value_names_the_field() {
+    let err = Config::from_ron("(dqn: (gamma: 1.5))", "bad.ron").unwrap_err();
+    let message = err.to_string();
+    assert!(message.contains("dqn.gamma"), "{message}");
+    assert!(message.contains("[0, 1]"), "{message}");
+}
+
+#[test]
+fn a_missing_file_names_the_path() {
+    let err = Config::from_file(Path::new("no/such/config.ron")).unwrap_err();
+    assert!(err.to_string().contains("no/such/config.ron"), "{err}");
+}
