@@ -67,6 +67,9 @@ pub trait Environment: Send {
     /// # Panics
     /// If `action` is out of range: that is a bug in the caller, not bad input.
     fn step(&mut self, action: usize) -> Step;
+    /// The observation of the current state (Gymnasium's `_get_ob`), e.g. after
+    /// [`set_state`](Environment::set_state).
+    fn observation(&self) -> Observation;
     /// The internal `f64` state.
     fn state(&self) -> &[f64];
     /// Overwrites the internal state (as Gymnasium's `env.unwrapped.state = …`), for tests

@@ -1,0 +1,425 @@
+//! Acrobot, after Gymnasium 1.x `gymnasium/envs/classic_control/acrobot.py`
+//! (`AcrobotEnv.step`, `_dsdt` with `book_or_nips = "book"`, `rk4`, `wrap`, `bound`,
+//! `reset`), with `TimeLimit`'s truncation built in.
+
+use std::f64::consts::PI;
+use std::hint::black_box;
+
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+use super::{AcrobotParams, Environment, Observation, StateError, Step};
+
+/// Half-width of the uniform distribution of every state variable at reset (Gymnasium's
+/// default reset bounds, ±0.1).
+const RESET_BOUND: f64 = 0.1;
+
+/// Gymnasium's `_dsdt` hard-codes gravity rather than making it a class constant.
+const GRAVITY: f64 = 9.8;
+
+/// Two links joined by an actuated joint, hanging from a fixed one; swing the tip above the
+/// bar. Actions 0, 1, 2 apply the torques `available_torque[action]` (−1, 0, +1).
+///
+/// State `[theta1, theta2, dtheta1, dtheta2]`; the observation is
+/// `[cos θ1, sin θ1, cos θ2, sin θ2, dθ1, dθ2]`, computed in `f64` and cast to `f32`.
+/// Reward −1 per step and 0 on the terminating step. Until the first reset the state is all
+/// zeros and the generator is seeded with 0.
+#[derive(Debug, Clone)]
+pub struct Acrobot {
+    params: AcrobotParams,
+    /// Parts of `_dsdt` that depend only on the parameters, each computed exactly as its
+    /// sub-expression in Gymnasium so that the result is the same to the bit.
+    derived: Derived,
+    state: [f64; 4],
+    rng: StdRng,
+    elapsed: u32,
+}
+
+/// Sub-expressions of Gymnasium's `_dsdt` that do not depend on the state.
+#[derive(Debug, Clone)]
+struct Derived {
+    /// `m1 * lc1**2`
+    m1_lc1_sq: f64,
+    /// `l1**2 + lc2**2`
+    l1_sq_plus_lc2_sq: f64,
+    /// `2 * l1 * lc2`
+    two_l1_lc2: f64,
+    /// `l1 * lc2`
+    l1_lc2: f64,
+    /// `lc2**2`
+    lc2_sq: f64,
+    /// `m2 * lc2 * g`
+    m2_lc2_g: f64,
+    /// `-m2 * l1 * lc2`
+    neg_m2_l1_lc2: f64,
+    /// `2 * m2 * l1 * lc2`
+    two_m2_l1_lc2: f64,
+    /// `(m1 * lc1 + m2 * l1) * g`
+    phi1_gravity: f64,
+    /// `m2 * l1 * lc2`
+    m2_l1_lc2: f64,
+    /// `m2 * lc2**2 + I2`
+    m2_lc2_sq_plus_i2: f64,
+}
+
+impl Derived {
+    fn new(p: &AcrobotParams) -> Self {
+        let (m1, m2) = (p.link_mass_1, p.link_mass_2);
+        let (l1, lc1, lc2) = (p.link_length_1, p.link_com_pos_1, p.link_com_pos_2);
+        let i2 = p.link_moi;
+        let lc2_sq = py_square(lc2);
+        Self {
+            m1_lc1_sq: m1 * py_square(lc1),
+            l1_sq_plus_lc2_sq: py_square(l1) + lc2_sq,
+            two_l1_lc2: 2.0 * l1 * lc2,
+            l1_lc2: l1 * lc2,
+            lc2_sq,
+            m2_lc2_g: m2 * lc2 * GRAVITY,
+            neg_m2_l1_lc2: -m2 * l1 * lc2,
+            two_m2_l1_lc2: 2.0 * m2 * l1 * lc2,
+            phi1_gravity: (m1 * lc1 + m2 * l1) * GRAVITY,
+            m2_l1_lc2: m2 * l1 * lc2,
+            m2_lc2_sq_plus_i2: m2 * lc2_sq + i2,
+        }
+    }
+}
+
+/// `x**2` as Python and NumPy evaluate it: a call to the C library's `pow`.
+///
+/// glibc's `pow` is accurate to 0.52 ulp, not correctly rounded, so `pow(x, 2.0)` differs
+/// from `x * x` for about one input in a thousand. LLVM rewrites `pow(x, 2.0)` into
+/// `x * x`; hiding the exponent keeps the call.
+#[inline]
+fn py_square(x: f64) -> f64 {
+    x.powf(black_box(2.0))
+}
+
+/// Gymnasium's `wrap`: shifts `x` by whole turns until it lies in `[lo, hi]`.
+#[inline]
+fn wrap(mut x: f64, lo: f64, hi: f64) -> f64 {
+    let diff = hi - lo;
+    while x > hi {
+        x -= diff;
+    }
+    while x < lo {
+        x += diff;
+    }
+    x
+}
+
+/// Gymnasium's `bound`: Python's `min(max(x, lo), hi)`, whose ties (±0) and NaN keep `x`.
+#[inline]
+fn bound(x: f64, lo: f64, hi: f64) -> f64 {
+    let x = if lo > x { lo } else { x };
+    if hi < x {
+        hi
+    } else {
+        x
+    }
+}
+
+impl Acrobot {
+    pub fn new(params: AcrobotParams) -> Self {
+        Self {
+            derived: Derived::new(&params),
+            params,
+            state: [0.0; 4],
+            rng: StdRng::seed_from_u64(0),
+            elapsed: 0,
+        }
+    }
+
+    /// Gymnasium's `_dsdt` ("book" dynamics): the time derivative of `s` under torque `a`.
+    #[inline]
+    fn dsdt(&self, s: [f64; 4], a: f64) -> [f64; 4] {
+        let d = &self.derived;
+        let i1 = self.params.link_moi;
+        let i2 = self.params.link_moi;
+        let m2 = self.params.link_mass_2;
+        let [theta1, theta2, dtheta1, dtheta2] = s;
+        let cos_theta2 = theta2.cos();
+        let sin_theta2 = theta2.sin();
+
+        let d1 = d.m1_lc1_sq + m2 * (d.l1_sq_plus_lc2_sq + d.two_l1_lc2 * cos_theta2) + i1 + i2;
+        let d2 = m2 * (d.lc2_sq + d.l1_lc2 * cos_theta2) + i2;
+        let phi2 = d.m2_lc2_g * (theta1 + theta2 - PI / 2.0).cos();
+        let phi1 = d.neg_m2_l1_lc2 * py_square(dtheta2) * sin_theta2
+            - d.two_m2_l1_lc2 * dtheta2 * dtheta1 * sin_theta2
+            + d.phi1_gravity * (theta1 - PI / 2.0).cos()
+            + phi2;
+        let ddtheta2 = (a + d2 / d1 * phi1 - d.m2_l1_lc2 * py_square(dtheta1) * sin_theta2 - phi2)
+            / (d.m2_lc2_sq_plus_i2 - py_square(d2) / d1);
+        let ddtheta1 = -(d2 * ddtheta2 + phi1) / d1;
+        [dtheta1, dtheta2, ddtheta1, ddtheta2]
+    }
+
+    /// Gymnasium's `rk4` over the single interval `[0, dt]`. The torque rides along as a
+    /// fifth state variable with derivative 0 there, so it is passed unchanged here.
+    #[inline]
+    fn rk4(&self, y0: [f64; 4], torque: f64) -> [f64; 4] {
+        let dt = self.params.dt;
+        let dt2 = dt / 2.0;
+        let shifted = |k: [f64; 4], h: f64| std::array::from_fn(|i| y0[i] + h * k[i]);
+        let k1 = self.dsdt(y0, torque);
+        let k2 = self.dsdt(shifted(k1, dt2), torque);
+        let k3 = self.dsdt(shifted(k2, dt2), torque);
+        let k4 = self.dsdt(shifted(k3, dt), torque);
+        let sixth = dt / 6.0;
+        std::array::from_fn(|i| y0[i] + sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
+    }
+}
+
+impl Environment for Acrobot {
+    fn id(&self) -> &'static str {
+        "Acrobot-v1"
+    }
+
+    fn observation_size(&self) -> usize {
+        6
+    }
+
+    fn action_count(&self) -> usize {
+        3
+    }
+
+    /// Draws every state variable from U(−0.1, 0.1) and rounds it to `f32`, as Gymnasium's
+    /// `reset` does (`.astype(np.float32)`); the state is then held in `f64`.
+    ///
+    /// Gymnasium computes this first observation's sines and cosines in `float32` (NumPy's
+    /// own routines); here they are computed in `f64` and rounded, which differs by one ulp
+    /// in about one reset in a thousand. Every later observation is computed as Gymnasium
+    /// does.
+    fn reset(&mut self, seed: Option<u64>) -> Observation {
+        if let Some(seed) = seed {
+            self.rng = StdRng::seed_from_u64(seed);
+        }
+        for v in &mut self.state {
+            *v = f64::from(self.rng.random_range(-RESET_BOUND..RESET_BOUND) as f32);
+        }
+        self.elapsed = 0;
+        self.observation()
+    }
+
+    /// Gymnasium's `AcrobotEnv.step`, operation for operation, so the state matches its
+    /// `float64` state bit for bit. The torque noise is drawn from the environment's
+    /// generator only when `torque_noise_max > 0`, as in Gymnasium.
+    ///
+    /// # Panics
+    /// If `action` is not 0, 1 or 2.
+    #[inline]
+    fn step(&mut self, action: usize) -> Step {
+        assert!(action < 3, "Acrobot: action {action} is not 0, 1 or 2");
+        let p = &self.params;
+        let mut torque = p.available_torque[action];
+        if p.torque_noise_max > 0.0 {
+            torque += self
+                .rng
+                .random_range(-p.torque_noise_max..p.torque_noise_max);
+        }
+        let ns = self.rk4(self.state, torque);
+        let p = &self.params;
+        self.state = [
+            wrap(ns[0], -PI, PI),
+            wrap(ns[1], -PI, PI),
+            bound(ns[2], -p.max_vel_1, p.max_vel_1),
+            bound(ns[3], -p.max_vel_2, p.max_vel_2),
+        ];
+
+        let [theta1, theta2, ..] = self.state;
+        let terminated = -theta1.cos() - (theta2 + theta1).cos() > 1.0;
+        self.elapsed += 1;
+        Step {
+            obs: self.observation(),
+            reward: if terminated { 0.0 } else { -1.0 },
+            terminated,
+            truncated: self.elapsed >= p.max_episode_steps,
+        }
+    }
+
+    /// Gymnasium's `_get_ob`.
+    #[inline]
+    fn observation(&self) -> Observation {
+        let [theta1, theta2, dtheta1, dtheta2] = self.state;
+        Observation::from_slice(&[
+            theta1.cos() as f32,
+            theta1.sin() as f32,
+            theta2.cos() as f32,
+            theta2.sin() as f32,
+            dtheta1 as f32,
+            dtheta2 as f32,
+        ])
+    }
+
+    fn state(&self) -> &[f64] {
+        &self.state
+    }
+
+    fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
+        self.state = state.try_into().map_err(|_| StateError::WrongLength {
+            env: "Acrobot",
+            expected: 4,
+            got: state.len(),
+        })?;
+        Ok(())
+    }
+
+    fn elapsed_steps(&self) -> u32 {
+        self.elapsed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn env() -> Acrobot {
+        let mut env = Acrobot::new(AcrobotParams::default());
+        env.reset(Some(11));
+        env
+    }
+
+    #[test]
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    fn square_is_glibc_pow_not_the_product() {
+        // An input where glibc's pow(x, 2) and x * x round differently (found with Python:
+        // `x**2 != x*x`).
+        let x = f64::from_bits(0xc010_db07_b8dd_0d73);
+        assert_eq!(py_square(x).to_bits(), 0x4031_c1c5_d522_784f);
+        assert_eq!((x * x).to_bits(), 0x4031_c1c5_d522_7850);
+    }
+
+    #[test]
+    fn wrap_shifts_by_whole_turns() {
+        assert_eq!(wrap(0.5, -PI, PI), 0.5);
+        assert_eq!(wrap(PI, -PI, PI), PI);
+        assert_eq!(wrap(-PI, -PI, PI), -PI);
+        assert_eq!(wrap(3.5, -PI, PI), 3.5 - 2.0 * PI);
+        assert_eq!(wrap(-3.5, -PI, PI), -3.5 + 2.0 * PI);
+        assert_eq!(wrap(10.0, -PI, PI), 10.0 - 2.0 * PI - 2.0 * PI);
+    }
+
+    #[test]
+    fn bound_clips_and_keeps_ties() {
+        assert_eq!(bound(20.0, -4.0, 4.0), 4.0);
+        assert_eq!(bound(-20.0, -4.0, 4.0), -4.0);
+        assert_eq!(bound(1.5, -4.0, 4.0), 1.5);
+        assert!(bound(-0.0, 0.0, 1.0).is_sign_negative());
+    }
+
+    #[test]
+    fn theta1_wraps_across_pi_in_both_directions() {
+        let mut env = env();
+        env.set_state(&[3.1, 0.0, 3.0, 0.0]).unwrap();
+        env.step(1);
+        let theta1 = env.state()[0];
+        assert!((-PI..0.0).contains(&theta1), "theta1 = {theta1}");
+
+        env.set_state(&[-3.1, 0.0, -3.0, 0.0]).unwrap();
+        env.step(1);
+        let theta1 = env.state()[0];
+        assert!((0.0..=PI).contains(&theta1), "theta1 = {theta1}");
+    }
+
+    #[test]
+    fn velocities_are_bounded() {
+        let p = AcrobotParams::default();
+        let mut env = env();
+        for sign in [1.0, -1.0] {
+            env.set_state(&[0.0, 0.0, sign * 2.0 * p.max_vel_1, sign * 2.0 * p.max_vel_2])
+                .unwrap();
+            env.step(1);
+            let [.., dtheta1, dtheta2] = env.state() else {
+                unreachable!()
+            };
+            // The dynamics may turn a velocity round; whichever way it ends, it is clipped.
+            assert_eq!((dtheta1.abs(), dtheta2.abs()), (p.max_vel_1, p.max_vel_2));
+        }
+    }
+
+    #[test]
+    fn tip_above_the_bar_terminates_with_reward_zero() {
+        let mut env = env();
+        // Both links pointing up: the tip is 2 above the pivot.
+        env.set_state(&[PI - 0.01, 0.0, 0.0, 0.0]).unwrap();
+        let step = env.step(1);
+        assert!(step.terminated);
+        assert_eq!(step.reward, 0.0);
+
+        env.set_state(&[0.0; 4]).unwrap();
+        let step = env.step(1);
+        assert!(!step.terminated);
+        assert_eq!(step.reward, -1.0);
+    }
+
+    #[test]
+    fn observation_is_trigonometry_of_the_state() {
+        let mut env = env();
+        env.set_state(&[0.3, -0.2, 0.1, -0.4]).unwrap();
+        let obs = env.step(2).obs;
+        let [t1, t2, d1, d2] = env.state().try_into().unwrap();
+        let expected = [t1.cos(), t1.sin(), t2.cos(), t2.sin(), d1, d2].map(|v| v as f32);
+        assert_eq!(*obs, expected);
+    }
+
+    #[test]
+    fn truncates_at_the_time_limit_even_when_terminated() {
+        let mut env = Acrobot::new(AcrobotParams {
+            max_episode_steps: 2,
+            ..AcrobotParams::default()
+        });
+        env.reset(Some(0));
+        assert!(!env.step(1).truncated);
+        env.set_state(&[PI - 0.01, 0.0, 0.0, 0.0]).unwrap();
+        let step = env.step(1);
+        assert!(step.terminated && step.truncated);
+    }
+
+    #[test]
+    fn same_seed_same_reset_and_resets_in_range_in_f32() {
+        let mut a = Acrobot::new(AcrobotParams::default());
+        let mut b = Acrobot::new(AcrobotParams::default());
+        assert_eq!(a.reset(Some(5)), b.reset(Some(5)));
+        assert_eq!(a.state(), b.state());
+        assert_eq!(a.reset(None), b.reset(None));
+        for _ in 0..1000 {
+            a.reset(None);
+            for &v in a.state() {
+                assert!((-0.1..=0.1).contains(&v));
+                assert_eq!(f64::from(v as f32), v);
+            }
+        }
+    }
+
+    #[test]
+    fn torque_noise_is_drawn_only_when_enabled() {
+        let mut quiet = env();
+        let mut reference = env();
+        quiet.step(0);
+        assert_eq!(quiet.reset(None), reference.reset(None));
+
+        let noisy_params = AcrobotParams {
+            torque_noise_max: 0.5,
+            ..AcrobotParams::default()
+        };
+        let mut noisy = Acrobot::new(noisy_params.clone());
+        let mut reference = Acrobot::new(noisy_params);
+        noisy.reset(Some(1));
+        reference.reset(Some(1));
+        noisy.step(1);
+        assert_ne!(noisy.reset(None), reference.reset(None));
+    }
+
+    #[test]
+    fn set_state_checks_length() {
+        assert!(matches!(
+            env().set_state(&[0.0; 6]),
+            Err(StateError::WrongLength { got: 6, .. })
+        ));
+    }
+
+    #[test]
+    #[should_panic(expected = "action 3")]
+    fn out_of_range_action_panics() {
+        env().step(3);
+    }
+}

@@ -1,0 +1,266 @@
+//! CartPole, after Gymnasium 1.x `gymnasium/envs/classic_control/cartpole.py`
+//! (`CartPoleEnv.step` and `CartPoleEnv.reset`), with `TimeLimit`'s truncation built in.
+
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+use super::{CartPoleParams, Environment, Integrator, Observation, StateError, Step};
+
+/// Half-width of the uniform distribution of every state variable at reset (Gymnasium's
+/// default reset bounds, ±0.05).
+const RESET_BOUND: f64 = 0.05;
+
+/// A pole hinged on a cart; push the cart left (action 0) or right (action 1) to keep the
+/// pole upright.
+///
+/// State `[x, x_dot, theta, theta_dot]`; the observation is the state cast to `f32`.
+/// Reward 1 on every step, the terminating one included. Until the first reset the state is
+/// all zeros and the generator is seeded with 0.
+#[derive(Debug, Clone)]
+pub struct CartPole {
+    params: CartPoleParams,
+    /// Gymnasium's `total_mass`, computed once as it does in `__init__`.
+    total_mass: f64,
+    /// Gymnasium's `polemass_length`.
+    polemass_length: f64,
+    state: [f64; 4],
+    rng: StdRng,
+    elapsed: u32,
+    /// Gymnasium's `steps_beyond_terminated is not None`: steps taken after the pole fell
+    /// earn 0.
+    fell: bool,
+}
+
+impl CartPole {
+    pub fn new(params: CartPoleParams) -> Self {
+        Self {
+            total_mass: params.masspole + params.masscart,
+            polemass_length: params.masspole * params.length,
+            params,
+            state: [0.0; 4],
+            rng: StdRng::seed_from_u64(0),
+            elapsed: 0,
+            fell: false,
+        }
+    }
+}
+
+impl Environment for CartPole {
+    fn id(&self) -> &'static str {
+        if self.params.max_episode_steps == 200 {
+            "CartPole-v0"
+        } else {
+            "CartPole-v1"
+        }
+    }
+
+    fn observation_size(&self) -> usize {
+        4
+    }
+
+    fn action_count(&self) -> usize {
+        2
+    }
+
+    fn reset(&mut self, seed: Option<u64>) -> Observation {
+        if let Some(seed) = seed {
+            self.rng = StdRng::seed_from_u64(seed);
+        }
+        for v in &mut self.state {
+            *v = self.rng.random_range(-RESET_BOUND..RESET_BOUND);
+        }
+        self.elapsed = 0;
+        self.fell = false;
+        self.observation()
+    }
+
+    /// Gymnasium's `CartPoleEnv.step`, operation for operation, so the state matches its
+    /// `float64` state bit for bit.
+    ///
+    /// # Panics
+    /// If `action` is not 0 or 1.
+    #[inline]
+    fn step(&mut self, action: usize) -> Step {
+        assert!(action < 2, "CartPole: action {action} is not 0 or 1");
+        let p = &self.params;
+        let [mut x, mut x_dot, mut theta, mut theta_dot] = self.state;
+        let force = if action == 1 {
+            p.force_mag
+        } else {
+            -p.force_mag
+        };
+        let costheta = theta.cos();
+        let sintheta = theta.sin();
+
+        let temp =
+            (force + self.polemass_length * (theta_dot * theta_dot) * sintheta) / self.total_mass;
+        let thetaacc = (p.gravity * sintheta - costheta * temp)
+            / (p.length * (4.0 / 3.0 - p.masspole * (costheta * costheta) / self.total_mass));
+        let xacc = temp - self.polemass_length * thetaacc * costheta / self.total_mass;
+
+        match p.integrator {
+            Integrator::Euler => {
+                x += p.tau * x_dot;
+                x_dot += p.tau * xacc;
+                theta += p.tau * theta_dot;
+                theta_dot += p.tau * thetaacc;
+            }
+            Integrator::SemiImplicitEuler => {
+                x_dot += p.tau * xacc;
+                x += p.tau * x_dot;
+                theta_dot += p.tau * thetaacc;
+                theta += p.tau * theta_dot;
+            }
+        }
+        self.state = [x, x_dot, theta, theta_dot];
+
+        let terminated = x < -p.x_threshold
+            || x > p.x_threshold
+            || theta < -p.theta_threshold_radians
+            || theta > p.theta_threshold_radians;
+        let reward = if self.fell { 0.0 } else { 1.0 };
+        self.fell |= terminated;
+        self.elapsed += 1;
+        Step {
+            obs: self.observation(),
+            reward,
+            terminated,
+            truncated: self.elapsed >= p.max_episode_steps,
+        }
+    }
+
+    #[inline]
+    fn observation(&self) -> Observation {
+        Observation::from_slice(&self.state.map(|v| v as f32))
+    }
+
+    fn state(&self) -> &[f64] {
+        &self.state
+    }
+
+    fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
+        self.state = state.try_into().map_err(|_| StateError::WrongLength {
+            env: "CartPole",
+            expected: 4,
+            got: state.len(),
+        })?;
+        Ok(())
+    }
+
+    fn elapsed_steps(&self) -> u32 {
+        self.elapsed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn env() -> CartPole {
+        let mut env = CartPole::new(CartPoleParams::default());
+        env.reset(Some(7));
+        env
+    }
+
+    #[test]
+    fn cart_beyond_x_threshold_terminates_with_reward_one() {
+        for (x, x_dot, action) in [(2.39, 1.0, 1), (-2.39, -1.0, 0)] {
+            let mut env = env();
+            env.set_state(&[x, x_dot, 0.0, 0.0]).unwrap();
+            let step = env.step(action);
+            assert!(env.state()[0].abs() > 2.4);
+            assert!(step.terminated, "x = {} should terminate", env.state()[0]);
+            assert!(!step.truncated);
+            assert_eq!(step.reward, 1.0);
+        }
+    }
+
+    #[test]
+    fn pole_beyond_twelve_degrees_terminates_with_reward_one() {
+        let limit = 12f64.to_radians();
+        for sign in [1.0, -1.0] {
+            let mut env = env();
+            env.set_state(&[0.0, 0.0, sign * (limit - 1e-4), sign * 0.5])
+                .unwrap();
+            let step = env.step(0);
+            assert!(env.state()[2].abs() > limit);
+            assert!(step.terminated);
+            assert_eq!(step.reward, 1.0);
+        }
+    }
+
+    #[test]
+    fn inside_thresholds_does_not_terminate() {
+        let mut env = env();
+        env.set_state(&[2.3, 0.0, 0.2, 0.0]).unwrap();
+        let step = env.step(1);
+        assert!(!step.terminated && !step.truncated);
+        assert_eq!(step.reward, 1.0);
+    }
+
+    #[test]
+    fn steps_after_the_fall_earn_nothing_until_reset() {
+        let mut env = env();
+        env.set_state(&[0.0, 0.0, 0.3, 0.0]).unwrap();
+        assert_eq!(env.step(0).reward, 1.0);
+        assert_eq!(env.step(0).reward, 0.0);
+        env.reset(None);
+        assert_eq!(env.step(0).reward, 1.0);
+    }
+
+    #[test]
+    fn truncates_at_the_time_limit_even_when_terminated() {
+        let mut env = CartPole::new(CartPoleParams {
+            max_episode_steps: 3,
+            ..CartPoleParams::default()
+        });
+        env.reset(Some(1));
+        env.set_state(&[0.0; 4]).unwrap();
+        assert!(!env.step(0).truncated);
+        assert!(!env.step(1).truncated);
+        env.set_state(&[3.0, 0.0, 0.0, 0.0]).unwrap();
+        let step = env.step(0);
+        assert!(step.terminated && step.truncated);
+        assert_eq!(env.elapsed_steps(), 3);
+    }
+
+    #[test]
+    fn same_seed_same_reset_and_resets_in_range() {
+        let mut a = CartPole::new(CartPoleParams::default());
+        let mut b = CartPole::new(CartPoleParams::default());
+        assert_eq!(a.reset(Some(42)), b.reset(Some(42)));
+        assert_eq!(a.reset(None), b.reset(None));
+        assert_ne!(a.reset(Some(1)), a.reset(Some(2)));
+        for _ in 0..1000 {
+            let obs = a.reset(None);
+            assert!(a.state().iter().all(|v| (-0.05..0.05).contains(v)));
+            assert!(obs.iter().zip(a.state()).all(|(&o, &s)| o == s as f32));
+        }
+    }
+
+    #[test]
+    fn unseeded_fresh_env_is_deterministic() {
+        let mut a = CartPole::new(CartPoleParams::default());
+        let mut b = CartPole::new(CartPoleParams::default());
+        assert_eq!(a.reset(None), b.reset(Some(0)));
+    }
+
+    #[test]
+    fn set_state_checks_length() {
+        let mut env = env();
+        assert_eq!(
+            env.set_state(&[0.0; 3]),
+            Err(StateError::WrongLength {
+                env: "CartPole",
+                expected: 4,
+                got: 3
+            })
+        );
+    }
+
+    #[test]
+    #[should_panic(expected = "action 2")]
+    fn out_of_range_action_panics() {
+        env().step(2);
+    }
+}
