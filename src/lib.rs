@@ -6,9 +6,11 @@
 //!   activation and spreading. Pure maths.
 //! - [`env`]: native CartPole, MountainCar and Acrobot, exact to Gymnasium.
 //! - [`config`]: the RON run configuration, with the paper's values as defaults.
+//! - [`teach`]: stepping activation and spreading by hand on a small graph.
 
 pub mod config;
 pub mod env;
 pub mod sapnet;
+pub mod teach;
 pub mod app;
 pub mod cli;
