@@ -266,8 +266,11 @@ impl<'g> Spreader<'g> {
     /// Makes the next `spread` call, updating `activations`; `None` once the recursion has
     /// returned to `activate`.
     ///
+    /// Pass the activations the spreader was started with, as they were left by the
+    /// previous step.
+    ///
     /// # Panics
-    /// If `activations` is not the slice the spreader was started with (or one as long).
+    /// If `activations` has fewer entries than the graph has policies.
     pub fn step(&mut self, activations: &mut [f64]) -> Option<TraceStep> {
         let Call {
             from,
