@@ -23,7 +23,7 @@ pub enum Prototype {
 #[serde(deny_unknown_fields)]
 pub struct WeightedPrototype {
     pub prototype: Prototype,
-    /// ω_c: the entry P_c[i][j] for policies i ≠ j in the same category (Table II: 0.1).
+    /// ω_c: the entry `P_c[i][j]` for policies i ≠ j in the same category (Table II: 0.1).
     pub omega: f64,
 }
 

@@ -118,19 +118,16 @@ impl TeachConfig {
     pub fn lesson(&self) -> Result<Lesson, String> {
         let n = self.count()?;
         let params = self.params();
+        params.validate().map_err(|e| e.to_string())?;
         let graph = if self.descriptions.is_empty() {
             Graph::from_edges(n, self.edges.iter().copied()).map_err(in_field("edges"))?
         } else if !self.edges.is_empty() {
             return Err("give the graph by `edges` or by `descriptions`, not both".into());
         } else {
-            params.validate().map_err(|e| e.to_string())?;
             Graph::from_categories(&self.descriptions, &params).map_err(in_field("descriptions"))?
         };
         let initial = self.initial.clone().unwrap_or_else(|| vec![0.0; n]);
-        let net = SapNet::with_activations(graph, params, initial).map_err(|e| match e {
-            SapNetError::BadParameter { .. } => e.to_string(),
-            _ => in_field("initial")(e),
-        })?;
+        let net = SapNet::with_activations(graph, params, initial).map_err(in_field("initial"))?;
         let names = if self.names.is_empty() {
             (0..n).map(|i| format!("π{i}")).collect()
         } else {
