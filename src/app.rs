@@ -4,14 +4,15 @@ use std::io::Write;
 
 use anyhow::{Context, Result};
 
-use crate::cli::{Cli, Command, EnvArgs};
+use crate::cli::{Cli, Command, EnvArgs, TeachArgs};
 use crate::config::Config;
 use crate::{assets, env, random_episodes};
 
 pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Some(Command::Env(args)) => run_env(&cli, args),
-        Some(Command::Teach(_)) | None => anyhow::bail!("not wired yet"),
+        Some(Command::Teach(args)) => run_teach(&cli, args),
+        None => anyhow::bail!("not wired yet"),
     }
 }
 
@@ -35,4 +36,14 @@ fn run_env(cli: &Cli, args: &EnvArgs) -> Result<()> {
     random_episodes::print(&mut out, env.id(), &episodes)
         .and_then(|()| out.flush())
         .context("writing to stdout")
+}
+
+fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
+    if !args.headless {
+        anyhow::bail!(
+            "the interactive teach view comes with the TUI; for now use \
+             `sapnet teach --headless --activate I`"
+        );
+    }
+    crate::teach::headless::run(cli.run.config.as_deref(), args, &mut std::io::stdout().lock())
 }

@@ -6,6 +6,7 @@
 //!   activation and spreading. Pure maths.
 //! - [`env`]: native CartPole, MountainCar and Acrobot, exact to Gymnasium.
 //! - [`config`]: the RON run configuration, with the paper's values as defaults.
+//! - [`teach`]: stepping activation and spreading by hand on a small graph.
 
 pub mod app;
 pub mod assets;
@@ -14,3 +15,4 @@ pub mod config;
 pub mod env;
 pub mod random_episodes;
 pub mod sapnet;
+pub mod teach;

@@ -2,6 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::error::SapNetError;
+
 /// A way of putting policies into categories (paper II-C). Two policies share a category
 /// under a prototype when the prototype gives them the same key.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -21,7 +23,7 @@ pub enum Prototype {
 #[serde(deny_unknown_fields)]
 pub struct WeightedPrototype {
     pub prototype: Prototype,
-    /// ω_c: the entry P_c[i][j] for policies i ≠ j in the same category (Table II: 0.1).
+    /// ω_c: the entry `P_c[i][j]` for policies i ≠ j in the same category (Table II: 0.1).
     pub omega: f64,
 }
 
@@ -75,5 +77,42 @@ impl Default for SapNetParams {
             base_graph: BaseGraph::SharedCategory,
             paths: Paths::Literal,
         }
+    }
+}
+
+impl SapNetParams {
+    /// Checks what the types cannot: T_ω and τ finite and > 0 (a walk must be able to
+    /// stop, a softmax must be defined), 𝒜, δ and every ω_c finite, bucket widths ≥ 1.
+    pub fn validate(&self) -> Result<(), SapNetError> {
+        let bad = |name: &str, value: f64, expected| SapNetError::BadParameter {
+            name: name.to_string(),
+            value,
+            expected,
+        };
+        let positive = |name: &str, value: f64| {
+            if value > 0.0 && value.is_finite() {
+                Ok(())
+            } else {
+                Err(bad(name, value, "a finite number > 0"))
+            }
+        };
+        let finite = |name: &str, value: f64| {
+            if value.is_finite() {
+                Ok(())
+            } else {
+                Err(bad(name, value, "a finite number"))
+            }
+        };
+        positive("threshold", self.threshold)?;
+        positive("temperature", self.temperature)?;
+        finite("coefficient", self.coefficient)?;
+        finite("delta", self.delta)?;
+        for (c, weighted) in self.prototypes.iter().enumerate() {
+            finite(&format!("prototypes[{c}].omega"), weighted.omega)?;
+            if let Prototype::UnitsBucket { width: 0 } = weighted.prototype {
+                return Err(bad(&format!("prototypes[{c}].width"), 0.0, "at least 1"));
+            }
+        }
+        Ok(())
     }
 }

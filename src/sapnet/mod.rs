@@ -1,6 +1,191 @@
 //! SAP-Net (paper section II): categories, the policy graph, selection, activation and
 //! spreading. Pure maths over plain vectors: no candle, no I/O, no threads.
+//!
+//! - [`prototype`]: categories of policies and prototype matrices (II-C, eq. 5).
+//! - [`graph`]: the SAP-Net 𝔾 and its weights M (II-D, eq. 2–5).
+//! - [`selection`]: the softmax over activations (II-E, eq. 6).
+//! - [`judgment`]: positive and negative transitions (II-F, eq. 7).
+//! - [`spreading`]: activation and spreading (II-F, II-G, eq. 8–11, Algorithms 1–2).
+//!
+//! [`SapNet`] bundles them as Algorithm 3 uses them.
 
 mod config;
+mod error;
+pub mod graph;
+pub mod judgment;
+mod policy;
+pub mod prototype;
+pub mod selection;
+pub mod spreading;
+
+use rand::Rng;
 
 pub use config::{BaseGraph, Paths, Prototype, SapNetParams, WeightedPrototype};
+pub use error::SapNetError;
+pub use graph::Graph;
+pub use judgment::judge;
+pub use policy::PolicyDescription;
+pub use spreading::{Call, NoTrace, Spreader, Spreading, TraceSink, TraceStep};
+
+/// A SAP-Net with its activations 𝔸: what the transfer loop selects from and activates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SapNet {
+    graph: Graph,
+    params: SapNetParams,
+    activations: Vec<f64>,
+}
+
+impl SapNet {
+    /// A SAP-Net over `graph` with every activation 0.
+    pub fn new(graph: Graph, params: SapNetParams) -> Result<Self, SapNetError> {
+        let activations = vec![0.0; graph.len()];
+        Self::with_activations(graph, params, activations)
+    }
+
+    /// A SAP-Net whose graph is built from the policies' categories (eq. 3–5).
+    pub fn from_policies(
+        policies: &[PolicyDescription],
+        params: SapNetParams,
+    ) -> Result<Self, SapNetError> {
+        let graph = Graph::from_categories(policies, &params)?;
+        Self::new(graph, params)
+    }
+
+    /// A SAP-Net over `graph` starting from the given activations.
+    pub fn with_activations(
+        graph: Graph,
+        params: SapNetParams,
+        activations: Vec<f64>,
+    ) -> Result<Self, SapNetError> {
+        params.validate()?;
+        check_activations(graph.len(), &activations)?;
+        Ok(Self {
+            graph,
+            params,
+            activations,
+        })
+    }
+
+    pub fn graph(&self) -> &Graph {
+        &self.graph
+    }
+
+    pub fn params(&self) -> &SapNetParams {
+        &self.params
+    }
+
+    /// 𝔸, one activation per policy.
+    pub fn activations(&self) -> &[f64] {
+        &self.activations
+    }
+
+    /// N, the number of policies.
+    pub fn len(&self) -> usize {
+        self.graph.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.graph.is_empty()
+    }
+
+    /// T_ω and the walks spreading may take.
+    pub fn spreading(&self) -> Spreading {
+        Spreading {
+            threshold: self.params.threshold,
+            paths: self.params.paths,
+        }
+    }
+
+    /// 𝒜 on a positive transition, 0 on a negative one (Algorithm 3).
+    pub fn coefficient(&self, positive: bool) -> f64 {
+        if positive {
+            self.params.coefficient
+        } else {
+            0.0
+        }
+    }
+
+    /// The selection probabilities of eq. 6.
+    pub fn probabilities(&self) -> Vec<f64> {
+        selection::probabilities(&self.activations, self.params.temperature)
+    }
+
+    /// Draws the policy that acts next with the probabilities of eq. 6.
+    pub fn select(&self, rng: &mut impl Rng) -> usize {
+        selection::select(&self.activations, self.params.temperature, rng)
+    }
+
+    /// The chosen policy after training: the highest activation, the lowest index on a tie.
+    ///
+    /// # Panics
+    /// If there are no policies.
+    pub fn chosen(&self) -> usize {
+        let mut best = 0;
+        for (i, &a) in self.activations.iter().enumerate() {
+            if a > self.activations[best] {
+                best = i;
+            }
+        }
+        best
+    }
+
+    /// Eq. 7: whether a step that moved the acting policy's statistic loss from
+    /// `e_before` to `e_after` was a positive transition.
+    pub fn judge(e_before: f64, e_after: f64) -> bool {
+        judgment::judge(e_before, e_after)
+    }
+
+    /// Activates policy `i` after a positive or negative transition and spreads
+    /// (eq. 8–11). A negative transition activates with 0, which deposits 0 everywhere,
+    /// so nothing is walked.
+    ///
+    /// # Panics
+    /// If `i` is not a policy.
+    pub fn activate(&mut self, i: usize, positive: bool) {
+        assert!(i < self.len(), "policy {i} of {}", self.len());
+        if positive {
+            self.activate_traced(i, true, &mut NoTrace);
+        }
+    }
+
+    /// As [`activate`](Self::activate), reporting every `spread` call to `sink`; a
+    /// negative transition walks the graph too, so the trace shows its zero deposits.
+    ///
+    /// # Panics
+    /// If `i` is not a policy.
+    pub fn activate_traced<S: TraceSink>(&mut self, i: usize, positive: bool, sink: &mut S) {
+        let coefficient = self.coefficient(positive);
+        let spreading = self.spreading();
+        spreading::activate(
+            &self.graph,
+            spreading,
+            i,
+            coefficient,
+            &mut self.activations,
+            sink,
+        );
+    }
+
+    /// Replaces the activations, e.g. with a state a front end stepped back to.
+    pub fn set_activations(&mut self, activations: Vec<f64>) -> Result<(), SapNetError> {
+        check_activations(self.len(), &activations)?;
+        self.activations = activations;
+        Ok(())
+    }
+}
+
+fn check_activations(n: usize, activations: &[f64]) -> Result<(), SapNetError> {
+    if activations.len() != n {
+        return Err(SapNetError::ActivationCount {
+            n,
+            got: activations.len(),
+        });
+    }
+    match activations.iter().position(|a| !a.is_finite()) {
+        Some(i) => Err(SapNetError::BadActivation {
+            i,
+            value: activations[i],
+        }),
+        None => Ok(()),
+    }
+}

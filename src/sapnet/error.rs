@@ -1,0 +1,30 @@
+//! What can be wrong with a SAP-Net before it runs.
+
+/// A graph or parameter SAP-Net refuses. Every variant names the pair, policy or parameter
+/// at fault, so a config error can point at the line to fix.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SapNetError {
+    #[error(
+        "edge ({i}, {j}) weighs {weight}: every edge weight must be a finite number > 0, \
+         or spreading would never end"
+    )]
+    BadWeight { i: usize, j: usize, weight: f64 },
+    #[error("edge ({i}, {j}) names a policy that does not exist: there are {n} policies, numbered from 0")]
+    EdgeOutOfRange { i: usize, j: usize, n: usize },
+    #[error("edge ({i}, {i}) joins a policy to itself")]
+    SelfLoop { i: usize },
+    #[error("edge ({i}, {j}) is listed twice")]
+    DuplicateEdge { i: usize, j: usize },
+    #[error("parameter `{name}` is {value}: expected {expected}")]
+    BadParameter {
+        name: String,
+        value: f64,
+        expected: &'static str,
+    },
+    #[error("{got} initial activations given for {n} policies")]
+    ActivationCount { n: usize, got: usize },
+    #[error("initial activation of policy {i} is {value}: expected a finite number")]
+    BadActivation { i: usize, value: f64 },
+    #[error("policy {i} does not exist: there are {n} policies, numbered from 0")]
+    NoSuchPolicy { i: usize, n: usize },
+}

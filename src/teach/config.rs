@@ -1,0 +1,229 @@
+//! The teach file: a small SAP-Net to step through by hand.
+//!
+//! The graph is given either by its `edges` (the weights of M directly, as in the paper's
+//! Fig. 2) or by policy `descriptions` with `prototypes`, `delta` and `base_graph`, which
+//! build M from categories (eq. 3–5). Everything else defaults to Table II. See
+//! `assets/teach_fig2.ron` and `assets/teach_table2.ron`.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::config::{parse_ron, ConfigError};
+use crate::sapnet::{
+    BaseGraph, Graph, Paths, PolicyDescription, SapNet, SapNetError, SapNetParams,
+    WeightedPrototype,
+};
+
+/// The paper's Fig. 2, used when no teach file is given.
+pub const FIG2: &str = include_str!("../../assets/teach_fig2.ron");
+
+/// A teach file as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TeachConfig {
+    /// N, the number of policies. May be left out (or 0) when `names` or `descriptions`
+    /// count them.
+    pub policies: usize,
+    /// Names shown for the policies; default π0, π1, …
+    pub names: Vec<String>,
+    /// The graph as undirected edges `(i, j, M_ij)`, 0-based. Leave empty to build the
+    /// graph from `descriptions`.
+    pub edges: Vec<(usize, usize, f64)>,
+    /// The policies' features; when given, M is built from their categories (eq. 3–5)
+    /// and `edges` must be empty.
+    pub descriptions: Vec<PolicyDescription>,
+    /// The prototypes in use with their ω_c (with `descriptions`).
+    pub prototypes: Vec<WeightedPrototype>,
+    /// δ of eq. 5 (with `descriptions`).
+    pub delta: f64,
+    /// Which pairs eq. 3 joins (with `descriptions`).
+    pub base_graph: BaseGraph,
+    /// T_ω of eq. 10.
+    pub threshold: f64,
+    /// 𝒜 of eq. 8.
+    pub coefficient: f64,
+    /// τ of eq. 6.
+    pub temperature: f64,
+    pub paths: Paths,
+    /// Activations before the first activation; default all 0.
+    pub initial: Option<Vec<f64>>,
+}
+
+impl Default for TeachConfig {
+    fn default() -> Self {
+        let p = SapNetParams::default();
+        Self {
+            policies: 0,
+            names: Vec::new(),
+            edges: Vec::new(),
+            descriptions: Vec::new(),
+            prototypes: p.prototypes,
+            delta: p.delta,
+            base_graph: p.base_graph,
+            threshold: p.threshold,
+            coefficient: p.coefficient,
+            temperature: p.temperature,
+            paths: p.paths,
+            initial: None,
+        }
+    }
+}
+
+/// A teach file made ready: the SAP-Net and what to call its policies.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lesson {
+    pub names: Vec<String>,
+    pub net: SapNet,
+}
+
+impl TeachConfig {
+    /// Reads a teach file, or the embedded Fig. 2 without one.
+    pub fn load(path: Option<&Path>) -> Result<Lesson, ConfigError> {
+        match path {
+            Some(path) => {
+                let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                })?;
+                Self::lesson_from_ron(&text, &path.display().to_string())
+            }
+            None => Self::lesson_from_ron(FIG2, "teach_fig2.ron (embedded)"),
+        }
+    }
+
+    /// Reads and builds a teach file from RON text; `origin` names it in errors.
+    pub fn lesson_from_ron(text: &str, origin: &str) -> Result<Lesson, ConfigError> {
+        let config: TeachConfig = parse_ron(text, origin)?;
+        config.lesson().map_err(|message| ConfigError::Invalid {
+            origin: origin.to_string(),
+            message,
+        })
+    }
+
+    /// The SAP-Net parameters this file sets.
+    pub fn params(&self) -> SapNetParams {
+        SapNetParams {
+            prototypes: self.prototypes.clone(),
+            delta: self.delta,
+            threshold: self.threshold,
+            coefficient: self.coefficient,
+            temperature: self.temperature,
+            base_graph: self.base_graph,
+            paths: self.paths,
+        }
+    }
+
+    /// Checks the file and builds its SAP-Net. The message names the field at fault.
+    pub fn lesson(&self) -> Result<Lesson, String> {
+        let n = self.count()?;
+        let params = self.params();
+        params.validate().map_err(|e| e.to_string())?;
+        let graph = if self.descriptions.is_empty() {
+            Graph::from_edges(n, self.edges.iter().copied()).map_err(in_field("edges"))?
+        } else if !self.edges.is_empty() {
+            return Err("give the graph by `edges` or by `descriptions`, not both".into());
+        } else {
+            Graph::from_categories(&self.descriptions, &params).map_err(in_field("descriptions"))?
+        };
+        let initial = self.initial.clone().unwrap_or_else(|| vec![0.0; n]);
+        let net = SapNet::with_activations(graph, params, initial).map_err(in_field("initial"))?;
+        let names = if self.names.is_empty() {
+            (0..n).map(|i| format!("π{i}")).collect()
+        } else {
+            self.names.clone()
+        };
+        Ok(Lesson { names, net })
+    }
+
+    /// N, from whichever of `policies`, `names` and `descriptions` are given; they must agree.
+    fn count(&self) -> Result<usize, String> {
+        let given = [
+            ("policies", self.policies),
+            ("names", self.names.len()),
+            ("descriptions", self.descriptions.len()),
+        ];
+        let mut n = None;
+        for (field, count) in given.into_iter().filter(|&(_, c)| c > 0) {
+            match n {
+                None => n = Some((field, count)),
+                Some((first, m)) if m != count => {
+                    return Err(format!(
+                        "field `{field}` gives {count} policies but `{first}` gives {m}"
+                    ))
+                }
+                Some(_) => {}
+            }
+        }
+        n.map(|(_, count)| count)
+            .ok_or_else(|| "no policies: give `policies`, `names` or `descriptions`".into())
+    }
+}
+
+fn in_field(field: &'static str) -> impl Fn(SapNetError) -> String {
+    move |e| format!("field `{field}`: {e}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lesson(text: &str) -> Result<Lesson, String> {
+        TeachConfig::lesson_from_ron(text, "test.ron").map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn the_embedded_fig2_is_eq4_with_weights_0_4() {
+        let l = TeachConfig::load(None).unwrap();
+        assert_eq!(l.names, ["π0", "π1", "π2", "π3"]);
+        let edges: Vec<_> = l.net.graph().edges().collect();
+        assert_eq!(edges, [(0, 1, 0.4), (0, 2, 0.4), (1, 2, 0.4), (1, 3, 0.4)]);
+        assert_eq!(l.net.params().threshold, 1.0);
+        assert_eq!(l.net.activations(), [0.0; 4]);
+    }
+
+    #[test]
+    fn the_table2_asset_has_three_hidden_layer_categories_at_0_95() {
+        let text = include_str!("../../assets/teach_table2.ron");
+        let l = lesson(text).unwrap();
+        assert_eq!(l.net.len(), 10);
+        assert!(l.net.graph().edges().all(|(_, _, w)| w == 0.95));
+        // Categories of 3, 4 and 3 policies are cliques: 3 + 6 + 3 edges.
+        assert_eq!(l.net.graph().edges().count(), 12);
+    }
+
+    #[test]
+    fn a_bad_edge_is_named_with_its_file_and_field() {
+        let e = lesson("(policies: 3, edges: [(0, 1, 0.4), (1, 2, -0.1)])").unwrap_err();
+        assert!(e.contains("test.ron"), "{e}");
+        assert!(e.contains("field `edges`: edge (1, 2) weighs -0.1"), "{e}");
+        let e = lesson("(policies: 3, edges: [(0, 3, 0.4)])").unwrap_err();
+        assert!(e.contains("edge (0, 3)"), "{e}");
+    }
+
+    #[test]
+    fn a_typo_is_located() {
+        let e = lesson("(policies: 3,\n edgs: [])").unwrap_err();
+        assert!(e.contains("line 2"), "{e}");
+        assert!(e.contains("edgs"), "{e}");
+    }
+
+    #[test]
+    fn counts_must_agree() {
+        let e = lesson(r#"(policies: 3, names: ["a", "b"])"#).unwrap_err();
+        assert!(
+            e.contains("`names` gives 2 policies but `policies` gives 3"),
+            "{e}"
+        );
+        let e = lesson("(policies: 2, initial: Some([1.0]))").unwrap_err();
+        assert!(e.contains("field `initial`"), "{e}");
+        let e = lesson("(threshold: 1.0)").unwrap_err();
+        assert!(e.contains("no policies"), "{e}");
+    }
+
+    #[test]
+    fn a_bad_threshold_names_the_parameter() {
+        let e = lesson("(policies: 2, threshold: 0.0)").unwrap_err();
+        assert!(e.contains("parameter `threshold` is 0"), "{e}");
+    }
+}

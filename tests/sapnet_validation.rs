@@ -1,0 +1,161 @@
+//! A SAP-Net that could spread forever, or divide by zero, is refused and the culprit named.
+
+use sapnet::sapnet::{
+    BaseGraph, Graph, PolicyDescription, Prototype, SapNet, SapNetError, SapNetParams,
+    WeightedPrototype,
+};
+
+#[test]
+fn a_weight_that_is_not_positive_and_finite_names_its_pair() {
+    for weight in [0.0, -0.4, f64::NAN, f64::INFINITY] {
+        let err = Graph::from_edges(3, [(0, 1, 0.4), (2, 1, weight)]).unwrap_err();
+        assert!(
+            matches!(err, SapNetError::BadWeight { i: 2, j: 1, .. }),
+            "{weight}: {err:?}"
+        );
+        let message = err.to_string();
+        assert!(message.starts_with("edge (2, 1) weighs"), "{message}");
+        assert!(message.contains("> 0"), "{message}");
+    }
+}
+
+#[test]
+fn eq5_pushing_a_weight_to_zero_names_the_pair() {
+    let policies: Vec<_> = [1, 2, 1]
+        .iter()
+        .map(|&l| PolicyDescription::new(vec![100; l], "CartPole-v1"))
+        .collect();
+    // δ·ω_c = −10·0.1 = −1: the same-category pair (0, 2) would weigh 1 − 1 = 0.
+    let params = SapNetParams {
+        delta: -10.0,
+        ..SapNetParams::default()
+    };
+    let err = Graph::from_categories(&policies, &params).unwrap_err();
+    assert_eq!(
+        err,
+        SapNetError::BadWeight {
+            i: 0,
+            j: 2,
+            weight: 0.0
+        }
+    );
+}
+
+#[test]
+fn a_complete_base_graph_keeps_unrelated_pairs_at_weight_1() {
+    let policies: Vec<_> = [1, 2, 1]
+        .iter()
+        .map(|&l| PolicyDescription::new(vec![100; l], "CartPole-v1"))
+        .collect();
+    let params = SapNetParams {
+        base_graph: BaseGraph::Complete,
+        ..SapNetParams::default()
+    };
+    let g = Graph::from_categories(&policies, &params).unwrap();
+    assert_eq!(
+        g.edges().collect::<Vec<_>>(),
+        [(0, 1, 1.0), (0, 2, 0.95), (1, 2, 1.0)]
+    );
+}
+
+#[test]
+fn two_shared_prototypes_add_up_in_eq5() {
+    let policies = [
+        PolicyDescription::new(vec![100], "CartPole-v1"),
+        PolicyDescription::new(vec![110], "CartPole-v1"),
+    ];
+    let params = SapNetParams {
+        prototypes: vec![
+            WeightedPrototype {
+                prototype: Prototype::HiddenLayers,
+                omega: 0.1,
+            },
+            WeightedPrototype {
+                prototype: Prototype::SourceTask,
+                omega: 0.3,
+            },
+        ],
+        ..SapNetParams::default()
+    };
+    let g = Graph::from_categories(&policies, &params).unwrap();
+    // 1 − 0.5·(0.1 + 0.3) = 0.8
+    assert!((g.weight(0, 1).unwrap() - 0.8).abs() < 1e-15);
+}
+
+#[test]
+fn a_threshold_that_is_not_positive_and_finite_names_the_parameter() {
+    for threshold in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let params = SapNetParams {
+            threshold,
+            ..SapNetParams::default()
+        };
+        let err = SapNet::new(Graph::from_edges(2, [(0, 1, 0.5)]).unwrap(), params).unwrap_err();
+        assert!(
+            matches!(&err, SapNetError::BadParameter { name, .. } if name == "threshold"),
+            "{threshold}: {err:?}"
+        );
+        assert!(
+            err.to_string().starts_with("parameter `threshold` is"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
+fn other_parameters_are_named_too() {
+    let graph = || Graph::from_edges(2, [(0, 1, 0.5)]).unwrap();
+    let cases: [(SapNetParams, &str); 4] = [
+        (
+            SapNetParams {
+                temperature: 0.0,
+                ..SapNetParams::default()
+            },
+            "temperature",
+        ),
+        (
+            SapNetParams {
+                coefficient: f64::NAN,
+                ..SapNetParams::default()
+            },
+            "coefficient",
+        ),
+        (
+            SapNetParams {
+                delta: f64::NEG_INFINITY,
+                ..SapNetParams::default()
+            },
+            "delta",
+        ),
+        (
+            SapNetParams {
+                prototypes: vec![WeightedPrototype {
+                    prototype: Prototype::UnitsBucket { width: 0 },
+                    omega: 0.1,
+                }],
+                ..SapNetParams::default()
+            },
+            "prototypes[0].width",
+        ),
+    ];
+    for (params, field) in cases {
+        let err = SapNet::new(graph(), params).unwrap_err();
+        assert!(
+            matches!(&err, SapNetError::BadParameter { name, .. } if name == field),
+            "{field}: {err:?}"
+        );
+    }
+}
+
+#[test]
+fn initial_activations_must_fit_the_graph() {
+    let graph = || Graph::from_edges(2, [(0, 1, 0.5)]).unwrap();
+    let p = SapNetParams::default;
+    assert_eq!(
+        SapNet::with_activations(graph(), p(), vec![0.0]).unwrap_err(),
+        SapNetError::ActivationCount { n: 2, got: 1 }
+    );
+    assert!(matches!(
+        SapNet::with_activations(graph(), p(), vec![0.0, f64::NAN]).unwrap_err(),
+        SapNetError::BadActivation { i: 1, .. }
+    ));
+}

@@ -1,0 +1,140 @@
+//! `sapnet teach --headless` as a user runs it.
+
+use std::process::{Command, Output};
+
+fn sapnet(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("running sapnet")
+}
+
+#[test]
+fn json_is_one_object_with_the_fig2_values() {
+    let out = sapnet(&["teach", "--headless", "--json", "--activate", "1"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("stdout is one JSON value");
+    let object = json.as_object().unwrap();
+    let mut keys: Vec<_> = object.keys().map(String::as_str).collect();
+    keys.sort_unstable();
+    assert_eq!(keys, ["activations", "probabilities", "trace"]);
+
+    let numbers = |key: &str| -> Vec<f64> {
+        json[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let a = numbers("activations");
+    // See tests/sapnet_spreading.rs for the arithmetic.
+    for (got, want) in a.iter().zip([0.9375, 1.0 + 20.0 / 48.0, 0.9375, 5.0 / 6.0]) {
+        assert!((got - want).abs() < 1e-12, "{a:?}");
+    }
+    assert!((numbers("probabilities").iter().sum::<f64>() - 1.0).abs() < 1e-9);
+
+    let trace = json["trace"].as_array().unwrap();
+    assert_eq!(trace.len(), 21);
+    let first = &trace[0];
+    assert_eq!(first["from"], 1);
+    assert_eq!(first["to"], 0);
+    assert_eq!(first["h"], 1);
+    assert_eq!(first["omega"], 0.4);
+    assert_eq!(first["stopped"], false);
+    assert!((first["eta"].as_f64().unwrap() - 1.0 / 3.0).abs() < 1e-15);
+    assert!((first["delta"].as_f64().unwrap() - 5.0 / 6.0).abs() < 1e-15);
+}
+
+#[test]
+fn the_table_shows_every_call_and_the_final_state() {
+    let out = sapnet(&["teach", "--headless", "--activate", "1", "--activate", "3"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("activate π1"), "{text}");
+    assert!(text.contains("activate π3"), "{text}");
+    assert!(text.contains("stopped"), "{text}");
+    assert!(text.contains("probability"), "{text}");
+}
+
+#[test]
+fn a_teach_file_can_be_given() {
+    let out = sapnet(&[
+        "teach",
+        "--headless",
+        "--json",
+        "--config",
+        "assets/teach_table2.ron",
+        "--activate",
+        "0",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let a: Vec<f64> = json["activations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    // π0 has two same-category neighbours: each gets (1/2)/0.95.
+    assert_eq!(a[..3], [1.0, 0.5 / 0.95, 0.5 / 0.95]);
+    assert!(a[3..].iter().all(|&x| x == 0.0));
+}
+
+#[test]
+fn a_bad_index_exits_with_code_2_and_names_it() {
+    let out = sapnet(&[
+        "teach",
+        "--headless",
+        "--json",
+        "--activate",
+        "1",
+        "--activate",
+        "7",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("--activate 7"), "{err}");
+    assert!(err.contains("4 policies"), "{err}");
+}
+
+#[test]
+fn a_broken_teach_file_is_located() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.ron");
+    std::fs::write(&path, "(policies: 2,\n edges: [(0, 1, 0.0)])").unwrap();
+    let out = sapnet(&[
+        "teach",
+        "--headless",
+        "--config",
+        path.to_str().unwrap(),
+        "--activate",
+        "0",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("bad.ron"), "{err}");
+    assert!(err.contains("edge (0, 1) weighs 0"), "{err}");
+}
+
+#[test]
+fn the_interactive_view_is_not_there_yet() {
+    let out = sapnet(&["teach", "--activate", "1"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--headless"));
+}
