@@ -8,5 +8,6 @@
 //! - [`config`]: the RON run configuration, with the paper's values as defaults.
 
 pub mod config;
+pub mod dqn;
 pub mod env;
 pub mod sapnet;
