@@ -10,4 +10,5 @@
 pub mod config;
 pub mod dqn;
 pub mod env;
+pub mod policy_store;
 pub mod sapnet;
