@@ -134,10 +134,9 @@ impl DqnAgent {
         })?;
 
         let obs = Tensor::from_slice(batch.obs(), (n, obs_size), &Device::Cpu)?;
-        let q = self.online.forward(&obs)?;
-        let loss_tensor =
-            td_huber_loss(&q, batch.actions(), &self.targets, self.config.huber_delta)?;
-        let loss = f64::from(loss_tensor.to_scalar::<f32>()?);
+        let (q, layer_inputs) = self.online.forward_train(&obs)?;
+        let (actions, targets, delta) = (batch.actions(), &self.targets, self.config.huber_delta);
+        let (loss, grad_q) = with_f32(&q, |q| td_huber_loss(q, actions, targets, delta))??;
         if !loss.is_finite() {
             return Err(DqnError::NonFiniteLoss {
                 step: self.steps,
@@ -145,8 +144,9 @@ impl DqnAgent {
                 loss,
             });
         }
-        self.optimizer
-            .step(self.online.parameters(), &loss_tensor.backward()?)?;
+        let grad_q = Tensor::from_vec(grad_q, q.shape(), &Device::Cpu)?;
+        let grads = self.online.backward(&layer_inputs, grad_q)?;
+        self.optimizer.step(self.online.parameters(), &grads)?;
 
         self.updates += 1;
         self.last_loss = Some(loss);

@@ -6,6 +6,8 @@ pub enum DqnError {
     NonFiniteLoss { step: u64, update: u64, loss: f64 },
     #[error("observation has {got} values, the Q-network takes {expected}")]
     ObservationSize { expected: usize, got: usize },
+    #[error("action {action} is out of range for {action_count} actions")]
+    ActionOutOfRange { action: usize, action_count: usize },
     #[error("invalid Q-network architecture: {0}")]
     Architecture(String),
     #[error("tensor operation failed: {0}")]

@@ -1,11 +1,7 @@
 //! The DQN loss: Huber on the TD error of the taken actions, mean over the batch
 //! (ChainerRL's `clip_delta=True` with `batch_accumulator="mean"`).
 
-use std::sync::Arc;
-
-use candle_core::{bail, CpuStorage, CustomOp1, Layout, Result, Shape, Tensor};
-
-use super::host::with_f32;
+use super::DqnError;
 
 /// Huber loss of one error `x`: `x²/2` while `|x| ≤ δ`, then `δ(|x| − δ/2)`.
 pub fn huber(x: f64, delta: f64) -> f64 {
@@ -17,87 +13,50 @@ pub fn huber(x: f64, delta: f64) -> f64 {
     }
 }
 
-/// `mean_b huber(q[b, actions[b]] − targets[b])` as a scalar tensor that backpropagates
-/// into `q` (`[batch, action_count]`).
+/// The loss `mean_b huber(q[b, a_b] − y_b)` and its gradient with respect to `q`, for
+/// Q-values `q` (`[batch, action_count]`, row-major), the actions `a` taken and the TD
+/// targets `y`. The gradient is `clamp(q[b, a_b] − y_b, −δ, δ) / batch` at the taken
+/// actions and zero elsewhere.
 ///
-/// One fused op rather than gather, subtract, abs, compare, select and mean: each candle op
-/// allocates and adds a node to the backward graph, and at DQN's sizes that overhead costs
-/// more than the arithmetic.
+/// Computed on plain slices: a chain of candle ops (gather, subtract, abs, compare, select,
+/// mean, and their backward) allocates a tensor per step for 32 numbers.
 ///
 /// # Panics
 /// If `actions` and `targets` do not have one entry per row of `q`.
-pub fn td_huber_loss(q: &Tensor, actions: &[u32], targets: &[f32], delta: f64) -> Result<Tensor> {
-    let (batch, _) = q.dims2()?;
+pub fn td_huber_loss(
+    q: &[f32],
+    actions: &[u32],
+    targets: &[f32],
+    delta: f64,
+) -> Result<(f64, Vec<f32>), DqnError> {
+    let batch = targets.len();
     assert_eq!(actions.len(), batch, "one action per row");
-    assert_eq!(targets.len(), batch, "one target per row");
-    q.apply_op1_arc(Arc::new(Box::new(TdHuber {
-        actions: actions.to_vec(),
-        targets: targets.to_vec(),
-        delta: delta as f32,
-    })))
-}
-
-struct TdHuber {
-    actions: Vec<u32>,
-    targets: Vec<f32>,
-    delta: f32,
-}
-
-impl TdHuber {
-    /// `q[b, a_b] − y_b` for every row.
-    fn errors<'a>(&'a self, q: &'a [f32]) -> impl Iterator<Item = f32> + 'a {
-        let actions_per_row = q.len() / self.targets.len();
-        self.actions
-            .iter()
-            .zip(&self.targets)
-            .enumerate()
-            .map(move |(b, (&a, &y))| q[b * actions_per_row + a as usize] - y)
-    }
-}
-
-impl CustomOp1 for TdHuber {
-    fn name(&self) -> &'static str {
-        "td-huber-loss"
-    }
-
-    fn cpu_fwd(&self, storage: &CpuStorage, layout: &Layout) -> Result<(CpuStorage, Shape)> {
-        let Some((start, end)) = layout.contiguous_offsets() else {
-            bail!("td-huber-loss needs contiguous Q-values")
-        };
-        let q = &storage.as_slice::<f32>()?[start..end];
-        if let Some(&a) = self
-            .actions
-            .iter()
-            .find(|&&a| a as usize >= layout.dims()[1])
-        {
-            bail!("action {a} out of range for {} actions", layout.dims()[1])
+    assert!(
+        batch > 0 && q.len() % batch == 0,
+        "one row of Q-values per target"
+    );
+    let action_count = q.len() / batch;
+    let mut grad = vec![0.0f32; q.len()];
+    let mut sum = 0.0f64;
+    for (b, (&a, &y)) in actions.iter().zip(targets).enumerate() {
+        let a = a as usize;
+        if a >= action_count {
+            return Err(DqnError::ActionOutOfRange {
+                action: a,
+                action_count,
+            });
         }
-        let delta = f64::from(self.delta);
-        let sum: f64 = self.errors(q).map(|x| huber(f64::from(x), delta)).sum();
-        let mean = (sum / self.targets.len() as f64) as f32;
-        Ok((CpuStorage::F32(vec![mean]), Shape::from(())))
+        let error = f64::from(q[b * action_count + a]) - f64::from(y);
+        sum += huber(error, delta);
+        grad[b * action_count + a] = (error.clamp(-delta, delta) / batch as f64) as f32;
     }
-
-    /// d loss / d q[b, a_b] = clamp(q[b, a_b] − y_b, −δ, δ) / batch; zero for other actions.
-    fn bwd(&self, q: &Tensor, _loss: &Tensor, grad_loss: &Tensor) -> Result<Option<Tensor>> {
-        let (batch, actions_per_row) = q.dims2()?;
-        let scale = grad_loss.to_scalar::<f32>()? / batch as f32;
-        let grad = with_f32(q, |q| {
-            let mut grad = vec![0.0f32; q.len()];
-            for (b, x) in self.errors(q).enumerate() {
-                let a = self.actions[b] as usize;
-                grad[b * actions_per_row + a] = x.clamp(-self.delta, self.delta) * scale;
-            }
-            grad
-        })?;
-        Ok(Some(Tensor::from_vec(grad, q.shape(), q.device())?))
-    }
+    Ok((sum / batch as f64, grad))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use candle_core::{Device, Var};
+    use candle_core::{Device, Tensor, Var};
 
     #[test]
     fn huber_by_hand() {
@@ -113,54 +72,50 @@ mod tests {
     #[test]
     fn td_loss_by_hand() {
         // Errors: 0.5 − 0 = 0.5 (row 0, action 1) and 2 − (−1) = 3 (row 1, action 0).
-        let q = Tensor::new(&[[9.0f32, 0.5], [2.0, 9.0]], &Device::Cpu).unwrap();
-        let loss = td_huber_loss(&q, &[1, 0], &[0.0, -1.0], 1.0).unwrap();
-        assert_eq!(loss.to_scalar::<f32>().unwrap(), (0.125 + 2.5) / 2.0);
+        let q = [9.0, 0.5, 2.0, 9.0];
+        let (loss, grad) = td_huber_loss(&q, &[1, 0], &[0.0, -1.0], 1.0).unwrap();
+        assert_eq!(loss, (0.125 + 2.5) / 2.0);
+        assert_eq!(grad, [0.0, 0.25, 0.5, 0.0]);
     }
 
     #[test]
     fn matches_candle_huber_and_its_gradient() {
-        let q = Var::new(
-            &[[0.3f32, -1.2, 4.0], [2.5, 0.1, -0.7], [0.0, 0.2, 0.4]],
-            &Device::Cpu,
-        )
-        .unwrap();
+        let values = [[0.3f32, -1.2, 4.0], [2.5, 0.1, -0.7], [0.0, 0.2, 0.4]];
+        let q = Var::new(&values, &Device::Cpu).unwrap();
         let actions = [2u32, 0, 1];
         let targets = [1.0f32, 0.0, 0.5];
-        let ours = td_huber_loss(q.as_tensor(), &actions, &targets, 1.0).unwrap();
+        let flat: Vec<f32> = values.iter().flatten().copied().collect();
+        let (loss, grad) = td_huber_loss(&flat, &actions, &targets, 1.0).unwrap();
+
         let index = Tensor::new(&[[2u32], [0], [1]], &Device::Cpu).unwrap();
         let taken = q.as_tensor().gather(&index, 1).unwrap().squeeze(1).unwrap();
         let y = Tensor::new(&targets, &Device::Cpu).unwrap();
         let reference = candle_nn::loss::huber(&taken, &y, 1.0).unwrap();
-        let (a, b) = (
-            ours.to_scalar::<f32>().unwrap(),
-            reference.to_scalar::<f32>().unwrap(),
-        );
-        assert!((a - b).abs() < 1e-6, "{a} vs {b}");
-        let g_ours = ours
+        let want = f64::from(reference.to_scalar::<f32>().unwrap());
+        assert!((loss - want).abs() < 1e-6, "{loss} vs {want}");
+        let want = reference
             .backward()
             .unwrap()
             .get(q.as_tensor())
             .unwrap()
-            .to_vec2::<f32>();
-        let g_ref = reference
-            .backward()
-            .unwrap()
-            .get(q.as_tensor())
-            .unwrap()
-            .to_vec2::<f32>();
-        let (g_ours, g_ref) = (g_ours.unwrap(), g_ref.unwrap());
-        for (x, y) in g_ours.iter().flatten().zip(g_ref.iter().flatten()) {
-            assert!((x - y).abs() < 1e-6, "{g_ours:?} vs {g_ref:?}");
+            .flatten_all();
+        for (x, y) in grad.iter().zip(want.unwrap().to_vec1::<f32>().unwrap()) {
+            assert!((x - y).abs() < 1e-6, "{grad:?}");
         }
-        // The clipped error: 4 − 1 = 3 → δ/3, 2.5 → δ/3, −0.3 → −0.1.
-        assert_eq!(g_ours[0][2], 1.0 / 3.0);
-        assert!((g_ours[2][1] + 0.1).abs() < 1e-6);
+        // The clipped errors: 4 − 1 = 3 → δ/3; −0.3 → −0.1.
+        assert_eq!(grad[2], 1.0 / 3.0);
+        assert!((grad[7] + 0.1).abs() < 1e-6);
     }
 
     #[test]
     fn refuses_an_out_of_range_action() {
-        let q = Tensor::zeros((1, 2), candle_core::DType::F32, &Device::Cpu).unwrap();
-        assert!(td_huber_loss(&q, &[2], &[0.0], 1.0).is_err());
+        let err = td_huber_loss(&[0.0, 0.0], &[2], &[0.0], 1.0).unwrap_err();
+        assert!(matches!(
+            err,
+            DqnError::ActionOutOfRange {
+                action: 2,
+                action_count: 2
+            }
+        ));
     }
 }

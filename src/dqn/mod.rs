@@ -8,6 +8,7 @@
 //! train from one shared buffer, so [`DqnAgent::observe`] borrows it.
 
 mod agent;
+mod backprop;
 mod error;
 mod exploration;
 mod host;

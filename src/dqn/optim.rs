@@ -15,7 +15,6 @@
 
 use std::cell::RefCell;
 
-use candle_core::backprop::GradStore;
 use candle_core::{bail, CpuStorage, InplaceOp2, Layout, Result, Tensor, Var};
 
 use super::host::with_f32;
@@ -54,17 +53,18 @@ impl Adam {
         }
     }
 
-    /// One step on `parameters` (the same list, in the same order, as at construction).
-    /// A parameter without a gradient is left alone, as Chainer does.
-    pub fn step(&mut self, parameters: &[Var], grads: &GradStore) -> Result<()> {
+    /// One step on `parameters` (the same list, in the same order, as at construction)
+    /// with their gradients `grads`, one per parameter.
+    pub fn step(&mut self, parameters: &[Var], grads: &[Tensor]) -> Result<()> {
         assert_eq!(
             parameters.len(),
             self.moments.len(),
             "parameter list changed"
         );
-        let grads: Vec<Option<Tensor>> = parameters
+        assert_eq!(grads.len(), parameters.len(), "one gradient per parameter");
+        let grads: Vec<Tensor> = grads
             .iter()
-            .map(|p| grads.get(p).map(Tensor::contiguous).transpose())
+            .map(Tensor::contiguous)
             .collect::<Result<_>>()?;
         let clip = match self.max_grad_norm {
             Some(max_norm) => clip_coefficient(&grads, max_norm)?,
@@ -75,7 +75,6 @@ impl Adam {
         let correction2 = 1.0 - self.beta2.powi(self.t);
         let step_size = self.learning_rate * correction2.sqrt() / correction1;
         for ((parameter, grad), (m, v)) in parameters.iter().zip(&grads).zip(&mut self.moments) {
-            let Some(grad) = grad else { continue };
             let kernel = AdamKernel {
                 m: RefCell::new(m),
                 v: RefCell::new(v),
@@ -92,9 +91,9 @@ impl Adam {
 }
 
 /// PyTorch's `clip_grad_norm_`: scale every gradient by `max / (‖g‖ + 1e-6)` when below 1.
-fn clip_coefficient(grads: &[Option<Tensor>], max_norm: f64) -> Result<f64> {
+fn clip_coefficient(grads: &[Tensor], max_norm: f64) -> Result<f64> {
     let mut sum_sq = 0.0f64;
-    for grad in grads.iter().flatten() {
+    for grad in grads {
         sum_sq += with_f32(grad, |g| {
             g.iter().map(|&x| f64::from(x).powi(2)).sum::<f64>()
         })?;
@@ -160,6 +159,11 @@ mod tests {
         DqnConfig::default()
     }
 
+    fn step(adam: &mut Adam, theta: &Var, loss: &Tensor) {
+        let grad = loss.backward().unwrap().get(theta).unwrap().clone();
+        adam.step(std::slice::from_ref(theta), &[grad]).unwrap();
+    }
+
     /// Chainer's update written out for one scalar parameter.
     fn chainer_adam(theta: f64, grads: &[f64], c: &DqnConfig) -> f64 {
         let (mut theta, mut m, mut v) = (theta, 0.0, 0.0);
@@ -178,12 +182,11 @@ mod tests {
     fn follows_chainers_update() {
         // loss = k·θ, so the gradient is k, a different constant at each step.
         let theta = Var::new(&[0.5f32], &Device::Cpu).unwrap();
-        let mut adam = Adam::new(&[theta.clone()], &config());
+        let mut adam = Adam::new(std::slice::from_ref(&theta), &config());
         let ks = [2.0, -0.5, 0.01, 3.0];
         for &k in &ks {
             let loss = (theta.as_tensor() * k).unwrap().sum_all().unwrap();
-            adam.step(&[theta.clone()], &loss.backward().unwrap())
-                .unwrap();
+            step(&mut adam, &theta, &loss);
         }
         let got = f64::from(theta.as_tensor().to_vec1::<f32>().unwrap()[0]);
         let want = chainer_adam(0.5, &ks, &config());
@@ -200,9 +203,8 @@ mod tests {
         // Gradient (30, 40) has norm 50: clipped to (0.6, 0.8).
         let weights = Tensor::new(&[30.0f32, 40.0], &Device::Cpu).unwrap();
         let loss = theta.as_tensor().mul(&weights).unwrap().sum_all().unwrap();
-        let mut adam = Adam::new(&[theta.clone()], &c);
-        adam.step(&[theta.clone()], &loss.backward().unwrap())
-            .unwrap();
+        let mut adam = Adam::new(std::slice::from_ref(&theta), &c);
+        step(&mut adam, &theta, &loss);
         let got = theta.as_tensor().to_vec1::<f32>().unwrap();
         let want = [chainer_adam(0.0, &[0.6], &c), chainer_adam(0.0, &[0.8], &c)];
         for (g, w) in got.iter().zip(want) {

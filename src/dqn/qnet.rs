@@ -1,7 +1,7 @@
 //! The Q-network: a multilayer perceptron with ReLU between layers and a linear output,
 //! one Q-value per action.
 
-use candle_core::{DType, Device, Module, Tensor, Var};
+use candle_core::{DType, Device, Tensor, Var};
 use candle_nn::Linear;
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -81,6 +81,8 @@ impl std::fmt::Display for Architecture {
 #[derive(Debug)]
 pub struct QNet {
     architecture: Architecture,
+    /// Detached views of the parameters: the passes in `backprop.rs` never need candle to
+    /// record a graph.
     layers: Vec<Linear>,
     /// Weight then bias of each layer; the layers share their storage.
     parameters: Vec<Var>,
@@ -146,7 +148,7 @@ impl QNet {
         }
         let layers = parameters
             .chunks(2)
-            .map(|wb| Linear::new(wb[0].as_tensor().clone(), Some(wb[1].as_tensor().clone())))
+            .map(|wb| Linear::new(wb[0].as_detached_tensor(), Some(wb[1].as_detached_tensor())))
             .collect();
         Ok(Self {
             architecture,
@@ -174,14 +176,14 @@ impl QNet {
             .collect()
     }
 
+    pub(super) fn layers(&self) -> &[Linear] {
+        &self.layers
+    }
+
     /// Q-values `[batch, action_count]` of observations `[batch, observation_size]`.
+    /// Not differentiable by candle's autograd; training uses `backprop.rs`.
     pub fn forward(&self, obs: &Tensor) -> candle_core::Result<Tensor> {
-        let (last, hidden) = self.layers.split_last().expect("at least one layer");
-        let mut x = obs.clone();
-        for layer in hidden {
-            x = layer.forward(&x)?.relu()?;
-        }
-        last.forward(&x)
+        Ok(self.forward_train(obs)?.0)
     }
 
     /// Q-values of one observation.
