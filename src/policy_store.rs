@@ -152,13 +152,15 @@ fn write_pair(
     [weights_tmp, metadata_tmp]: [&Path; 2],
     [weights_path, metadata_path]: [&Path; 2],
 ) -> Result<PolicyMetadata, StoreError> {
-    let tensors: HashMap<String, _> = net.named_parameters().into_iter().collect();
-    candle_core::safetensors::save(&tensors, weights_tmp).map_err(|e| StoreError::Write {
-        path: weights_tmp.to_path_buf(),
-        source: std::io::Error::other(e.to_string()),
+    // "format": "pt" tells Hugging Face tooling the tensors are laid out as PyTorch's.
+    let header = HashMap::from([("format".to_string(), "pt".to_string())]);
+    let weights = safetensors::serialize(net.named_parameters(), Some(header)).map_err(|e| {
+        StoreError::Invalid {
+            path: weights_path.to_path_buf(),
+            message: format!("cannot serialise weights: {e}"),
+        }
     })?;
-    let weights = read(weights_tmp)?;
-    sync(weights_tmp)?;
+    write_synced(weights_tmp, &weights)?;
 
     let metadata = PolicyMetadata {
         architecture: net.architecture().clone(),
@@ -171,13 +173,14 @@ fn write_pair(
         crate_version: env!("CARGO_PKG_VERSION").to_string(),
         weights_sha256: sha256_hex(&weights),
     };
+    let pretty = ron::ser::PrettyConfig::default().compact_arrays(true);
     let text = ron_options()
-        .to_string_pretty(&metadata, ron::ser::PrettyConfig::default())
+        .to_string_pretty(&metadata, pretty)
         .map_err(|e| StoreError::Invalid {
             path: metadata_path.to_path_buf(),
             message: format!("cannot serialise metadata: {e}"),
         })?;
-    write_synced(metadata_tmp, text.as_bytes())?;
+    write_synced(metadata_tmp, format!("{text}\n").as_bytes())?;
 
     rename(weights_tmp, weights_path)?;
     rename(metadata_tmp, metadata_path)?;
@@ -371,15 +374,6 @@ fn write_synced(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
         path: path.to_path_buf(),
         source,
     })
-}
-
-fn sync(path: &Path) -> Result<(), StoreError> {
-    fs::File::open(path)
-        .and_then(|f| f.sync_all())
-        .map_err(|source| StoreError::Write {
-            path: path.to_path_buf(),
-            source,
-        })
 }
 
 fn rename(from: &Path, to: &Path) -> Result<(), StoreError> {

@@ -112,37 +112,19 @@ impl DqnAgent {
 
     /// One gradient update on `batch`; returns the loss and folds it into the statistic loss.
     /// A non-finite loss is an error and leaves the weights untouched.
+    ///
+    /// # Panics
+    /// If `batch` is empty.
     pub fn update(&mut self, batch: &Batch) -> Result<f64, DqnError> {
-        let (n, obs_size) = (batch.len(), batch.obs_size());
-        // y = r + γ·max_a' Q_target(s', a'), without the bootstrap after a terminal state.
-        let next_obs = Tensor::from_slice(batch.next_obs(), (n, obs_size), &Device::Cpu)?;
-        let next_q = self.target.forward(&next_obs)?;
-        let cut_by_truncation = self.config.truncation_as_terminal;
-        let gamma = self.config.gamma as f32;
-        self.targets.clear();
-        with_f32(&next_q, |next_q| {
-            let rows = next_q.chunks(next_q.len() / n);
-            for (b, row) in rows.enumerate() {
-                let terminal = batch.terminated()[b] || (cut_by_truncation && batch.truncated()[b]);
-                let bootstrap = if terminal {
-                    0.0
-                } else {
-                    gamma * row.iter().copied().fold(f32::MIN, f32::max)
-                };
-                self.targets.push(batch.rewards()[b] + bootstrap);
-            }
-        })?;
-
-        let obs = Tensor::from_slice(batch.obs(), (n, obs_size), &Device::Cpu)?;
+        assert!(!batch.is_empty(), "cannot learn from an empty batch");
+        self.compute_td_targets(batch)?;
+        let obs = Tensor::from_slice(batch.obs(), (batch.len(), batch.obs_size()), &Device::Cpu)?;
         let (q, layer_inputs) = self.online.forward_train(&obs)?;
         let (actions, targets, delta) = (batch.actions(), &self.targets, self.config.huber_delta);
         let (loss, grad_q) = with_f32(&q, |q| td_huber_loss(q, actions, targets, delta))??;
         if !loss.is_finite() {
-            return Err(DqnError::NonFiniteLoss {
-                step: self.steps,
-                update: self.updates + 1,
-                loss,
-            });
+            let (step, update) = (self.steps, self.updates + 1);
+            return Err(DqnError::NonFiniteLoss { step, update, loss });
         }
         let grad_q = Tensor::from_vec(grad_q, q.shape(), &Device::Cpu)?;
         let grads = self.online.backward(&layer_inputs, grad_q)?;
@@ -155,6 +137,32 @@ impl DqnAgent {
         self.statistic_loss *= decay;
         self.statistic_loss += (1.0 - decay) * loss;
         Ok(loss)
+    }
+
+    /// `y = r + γ·max_a' Q_target(s', a')` for every transition of `batch`, without the
+    /// bootstrap after a terminal state (or a truncation, if `truncation_as_terminal`).
+    fn compute_td_targets(&mut self, batch: &Batch) -> Result<(), DqnError> {
+        let shape = (batch.len(), batch.obs_size());
+        let next_obs = Tensor::from_slice(batch.next_obs(), shape, &Device::Cpu)?;
+        let next_q = self.target.forward(&next_obs)?;
+        let gamma = self.config.gamma as f32;
+        let truncation_is_terminal = self.config.truncation_as_terminal;
+        let targets = &mut self.targets;
+        targets.clear();
+        with_f32(&next_q, |next_q| {
+            let rows = next_q.chunks_exact(next_q.len() / batch.len());
+            for (b, row) in rows.enumerate() {
+                let terminal =
+                    batch.terminated()[b] || (truncation_is_terminal && batch.truncated()[b]);
+                let bootstrap = if terminal {
+                    0.0
+                } else {
+                    gamma * row.iter().copied().fold(f32::MIN, f32::max)
+                };
+                targets.push(batch.rewards()[b] + bootstrap);
+            }
+        })?;
+        Ok(())
     }
 
     /// Copies the online network into the target network.
