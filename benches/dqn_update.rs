@@ -3,7 +3,10 @@
 //! 4-100-2, 4-100-100-2 and 4-100-100-100-2 at batch 32. Sampling is not timed: the batches
 //! are drawn before the clock starts.
 //!
-//! `cargo bench --bench dqn_update`
+//! `cargo bench --bench dqn_update`; the PyTorch peer, in the same session:
+//! `python3 shared/bench/torch_update_bench.py --batches 32`.
+//!
+//! Also times one greedy action, the forward pass an agent makes every step.
 
 use std::time::Duration;
 
@@ -67,5 +70,20 @@ fn update(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, update);
+/// Acting costs a forward pass of one observation every environment step.
+fn greedy_action(c: &mut Criterion) {
+    let mut group = c.benchmark_group("dqn_greedy_action");
+    for hidden in [&[100][..], &[100, 100, 100]] {
+        let architecture = Architecture::new(4, hidden, 2);
+        let name = architecture.to_string();
+        let net = QNet::new(architecture, &mut StdRng::seed_from_u64(0)).expect("network");
+        let obs = [0.01f32, -0.2, 0.03, 0.4];
+        group.bench_function(name, |b| {
+            b.iter(|| net.greedy_action(&obs).expect("action"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, update, greedy_action);
 criterion_main!(benches);

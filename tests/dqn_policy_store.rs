@@ -244,6 +244,14 @@ fn bad_metadata_is_located() {
 }
 
 #[test]
+fn an_absent_library_lists_no_policies() {
+    let dir = tempfile::tempdir().unwrap();
+    assert!(policy_store::list(&dir.path().join("none"))
+        .unwrap()
+        .is_empty());
+}
+
+#[test]
 fn names_must_be_plain_file_names() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["", "../p", "a/b", ".hidden"] {
