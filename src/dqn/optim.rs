@@ -134,6 +134,14 @@ impl InplaceOp2 for AdamKernel<'_> {
         };
         let (theta, grad) = (&mut theta[t0..t1], &grad[g0..g1]);
         let (mut m, mut v) = (self.m.borrow_mut(), self.v.borrow_mut());
+        if grad.len() != theta.len() || m.len() != theta.len() {
+            bail!(
+                "adam-step: {} values, {} gradients, {} moments",
+                theta.len(),
+                grad.len(),
+                m.len()
+            )
+        }
         let (b1, b2) = (self.beta1, self.beta2);
         for (((p, &g), m), v) in theta
             .iter_mut()
