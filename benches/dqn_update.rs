@@ -1,0 +1,89 @@
+//! One DQN gradient update, as `shared/bench/torch_update_bench.py` times PyTorch's: online
+//! forward and gather, target forward, TD target, Huber loss, backward, Adam step, for
+//! 4-100-2, 4-100-100-2 and 4-100-100-100-2 at batch 32. Sampling is not timed: the batches
+//! are drawn before the clock starts.
+//!
+//! `cargo bench --bench dqn_update`; the PyTorch peer, in the same session:
+//! `python3 shared/bench/torch_update_bench.py --batches 32`.
+//!
+//! Also times one greedy action, the forward pass an agent makes every step.
+
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use rand::{rngs::StdRng, Rng, SeedableRng};
+use rand_distr::StandardNormal;
+use sapnet::config::DqnConfig;
+use sapnet::dqn::{Architecture, Batch, DqnAgent, QNet, Transition};
+
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+const BATCH: usize = 32;
+const POOL: usize = 64;
+
+fn random_batches(obs_size: usize, actions: usize, rng: &mut StdRng) -> Vec<Batch> {
+    (0..POOL)
+        .map(|_| {
+            let mut batch = Batch::new();
+            for _ in 0..BATCH {
+                let obs: Vec<f32> = (0..obs_size).map(|_| rng.sample(StandardNormal)).collect();
+                let next_obs: Vec<f32> =
+                    (0..obs_size).map(|_| rng.sample(StandardNormal)).collect();
+                batch.push(Transition {
+                    obs: &obs,
+                    action: rng.random_range(0..actions),
+                    reward: rng.sample(StandardNormal),
+                    next_obs: &next_obs,
+                    terminated: rng.random::<f64>() < 0.05,
+                    truncated: false,
+                });
+            }
+            batch
+        })
+        .collect()
+}
+
+fn update(c: &mut Criterion) {
+    // candle sizes its matmul thread pool from RAYON_NUM_THREADS; at these sizes one thread
+    // beats two, and the PyTorch peer runs on one.
+    if std::env::var_os("RAYON_NUM_THREADS").is_none() {
+        std::env::set_var("RAYON_NUM_THREADS", "1");
+    }
+    let mut group = c.benchmark_group("dqn_update");
+    group.measurement_time(Duration::from_secs(5));
+    for hidden in [&[100][..], &[100, 100], &[100, 100, 100]] {
+        let mut rng = StdRng::seed_from_u64(0);
+        let architecture = Architecture::new(4, hidden, 2);
+        let name = architecture.to_string();
+        let net = QNet::new(architecture, &mut rng).expect("network");
+        let mut agent = DqnAgent::new(net, &DqnConfig::default()).expect("agent");
+        let batches = random_batches(4, 2, &mut rng);
+        let mut i = 0;
+        group.bench_function(BenchmarkId::new("batch32", name), |b| {
+            b.iter(|| {
+                i = (i + 1) % POOL;
+                agent.update(&batches[i]).expect("finite loss")
+            })
+        });
+    }
+    group.finish();
+}
+
+/// Acting costs a forward pass of one observation every environment step.
+fn greedy_action(c: &mut Criterion) {
+    let mut group = c.benchmark_group("dqn_greedy_action");
+    for hidden in [&[100][..], &[100, 100, 100]] {
+        let architecture = Architecture::new(4, hidden, 2);
+        let name = architecture.to_string();
+        let net = QNet::new(architecture, &mut StdRng::seed_from_u64(0)).expect("network");
+        let obs = [0.01f32, -0.2, 0.03, 0.4];
+        group.bench_function(name, |b| {
+            b.iter(|| net.greedy_action(&obs).expect("action"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, update, greedy_action);
+criterion_main!(benches);

@@ -1,0 +1,203 @@
+//! The DQN learner (ChainerRL's `DQN` agent, with the hyper-parameters of `DqnConfig`).
+
+use candle_core::{Device, Tensor};
+use rand::Rng;
+
+use super::host::with_f32;
+use super::{td_huber_loss, Adam, Batch, DqnError, EpsilonGreedy, QNet, ReplayBuffer};
+use crate::config::DqnConfig;
+
+/// What one round of learning did, for SAP-Net's judgment `T_a = E_{t+1} − E_t` (eq. 7).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UpdateReport {
+    /// The raw loss of the last gradient update of the round.
+    pub loss: f64,
+    /// The statistic loss `E_t` before the round.
+    pub previous_statistic_loss: f64,
+    /// The statistic loss `E_{t+1}` after it.
+    pub statistic_loss: f64,
+}
+
+impl UpdateReport {
+    /// `T_a = E_{t+1} − E_t`; `≤ 0` is a positive transition.
+    pub fn transition(&self) -> f64 {
+        self.statistic_loss - self.previous_statistic_loss
+    }
+}
+
+/// One policy that acts and learns: an online Q-network, its target copy and its Adam state.
+/// It borrows the replay buffer, so several learners can share one.
+#[derive(Debug)]
+pub struct DqnAgent {
+    online: QNet,
+    target: QNet,
+    optimizer: Adam,
+    explorer: EpsilonGreedy,
+    config: DqnConfig,
+    /// Environment steps this policy has taken (drives ε, updates and target copies).
+    steps: u64,
+    updates: u64,
+    /// `E`, ChainerRL's `average_loss`: an exponential moving average of the loss from 0.
+    statistic_loss: f64,
+    last_loss: Option<f64>,
+    /// Reused between updates.
+    batch: Batch,
+    targets: Vec<f32>,
+}
+
+impl DqnAgent {
+    /// A learner that trains `online`; the target network starts as its copy.
+    pub fn new(online: QNet, config: &DqnConfig) -> Result<Self, DqnError> {
+        Ok(Self {
+            target: online.deep_copy()?,
+            optimizer: Adam::new(online.parameters(), config),
+            explorer: EpsilonGreedy::new(config.exploration.clone()),
+            online,
+            config: config.clone(),
+            steps: 0,
+            updates: 0,
+            statistic_loss: 0.0,
+            last_loss: None,
+            batch: Batch::new(),
+            targets: Vec::new(),
+        })
+    }
+
+    /// The ε-greedy action for `obs` at this policy's current step.
+    pub fn act(&self, obs: &[f32], rng: &mut impl Rng) -> Result<usize, DqnError> {
+        let actions = self.online.architecture().action_count;
+        self.explorer
+            .choose(self.steps, actions, rng, || self.online.greedy_action(obs))
+    }
+
+    /// The greedy action, for testing a policy.
+    pub fn greedy_action(&self, obs: &[f32]) -> Result<usize, DqnError> {
+        self.online.greedy_action(obs)
+    }
+
+    /// Call once for every environment step this policy took, after its transition is in
+    /// `replay`. Copies the target network every `target_update_interval` steps, then, once
+    /// `replay` holds `replay_start_size` transitions, runs `gradient_steps` updates every
+    /// `update_interval` steps (ChainerRL's order). Returns what the updates did, if any.
+    pub fn observe(
+        &mut self,
+        replay: &ReplayBuffer,
+        rng: &mut impl Rng,
+    ) -> Result<Option<UpdateReport>, DqnError> {
+        self.steps += 1;
+        if self.steps % self.config.target_update_interval == 0 {
+            self.sync_target()?;
+        }
+        if replay.len() < self.config.replay_start_size
+            || self.steps % self.config.update_interval != 0
+            || self.config.gradient_steps == 0
+        {
+            return Ok(None);
+        }
+        let previous_statistic_loss = self.statistic_loss;
+        let mut loss = 0.0;
+        for _ in 0..self.config.gradient_steps {
+            let mut batch = std::mem::take(&mut self.batch);
+            replay.sample_into(self.config.batch_size, &mut batch, rng);
+            let result = self.update(&batch);
+            self.batch = batch;
+            loss = result?;
+        }
+        Ok(Some(UpdateReport {
+            loss,
+            previous_statistic_loss,
+            statistic_loss: self.statistic_loss,
+        }))
+    }
+
+    /// One gradient update on `batch`; returns the loss and folds it into the statistic loss.
+    /// A non-finite loss is an error and leaves the weights untouched.
+    ///
+    /// # Panics
+    /// If `batch` is empty.
+    pub fn update(&mut self, batch: &Batch) -> Result<f64, DqnError> {
+        assert!(!batch.is_empty(), "cannot learn from an empty batch");
+        self.compute_td_targets(batch)?;
+        let obs = Tensor::from_slice(batch.obs(), (batch.len(), batch.obs_size()), &Device::Cpu)?;
+        let (q, layer_inputs) = self.online.forward_train(&obs)?;
+        let (actions, targets, delta) = (batch.actions(), &self.targets, self.config.huber_delta);
+        let (loss, grad_q) = with_f32(&q, |q| td_huber_loss(q, actions, targets, delta))??;
+        if !loss.is_finite() {
+            let (step, update) = (self.steps, self.updates + 1);
+            return Err(DqnError::NonFiniteLoss { step, update, loss });
+        }
+        let grad_q = Tensor::from_vec(grad_q, q.shape(), &Device::Cpu)?;
+        let grads = self.online.backward(&layer_inputs, grad_q)?;
+        self.optimizer.step(self.online.parameters(), &grads)?;
+
+        self.updates += 1;
+        self.last_loss = Some(loss);
+        // ChainerRL's two statements, so E matches it to the last bit.
+        let decay = self.config.loss_decay;
+        self.statistic_loss *= decay;
+        self.statistic_loss += (1.0 - decay) * loss;
+        Ok(loss)
+    }
+
+    /// `y = r + γ·max_a' Q_target(s', a')` for every transition of `batch`, without the
+    /// bootstrap after a terminal state (or a truncation, if `truncation_as_terminal`).
+    fn compute_td_targets(&mut self, batch: &Batch) -> Result<(), DqnError> {
+        let shape = (batch.len(), batch.obs_size());
+        let next_obs = Tensor::from_slice(batch.next_obs(), shape, &Device::Cpu)?;
+        let next_q = self.target.forward(&next_obs)?;
+        let gamma = self.config.gamma as f32;
+        let truncation_is_terminal = self.config.truncation_as_terminal;
+        let targets = &mut self.targets;
+        targets.clear();
+        with_f32(&next_q, |next_q| {
+            let rows = next_q.chunks_exact(next_q.len() / batch.len());
+            for (b, row) in rows.enumerate() {
+                let terminal =
+                    batch.terminated()[b] || (truncation_is_terminal && batch.truncated()[b]);
+                let bootstrap = if terminal {
+                    0.0
+                } else {
+                    gamma * row.iter().copied().fold(f32::MIN, f32::max)
+                };
+                targets.push(batch.rewards()[b] + bootstrap);
+            }
+        })?;
+        Ok(())
+    }
+
+    /// Copies the online network into the target network.
+    pub fn sync_target(&mut self) -> Result<(), DqnError> {
+        self.target.copy_from(&self.online)
+    }
+
+    /// The statistic loss `E` (0 before the first update).
+    pub fn statistic_loss(&self) -> f64 {
+        self.statistic_loss
+    }
+
+    /// The raw loss of the last update.
+    pub fn last_loss(&self) -> Option<f64> {
+        self.last_loss
+    }
+
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    pub fn updates(&self) -> u64 {
+        self.updates
+    }
+
+    pub fn online(&self) -> &QNet {
+        &self.online
+    }
+
+    pub fn target(&self) -> &QNet {
+        &self.target
+    }
+
+    /// The trained network, for saving to the policy library.
+    pub fn into_online(self) -> QNet {
+        self.online
+    }
+}

@@ -1,0 +1,15 @@
+/// What can go wrong while acting or learning.
+#[derive(Debug, thiserror::Error)]
+pub enum DqnError {
+    /// The loss diverged; the weights were left as they were before this update.
+    #[error("DQN loss is {loss} (not finite) at step {step} of this policy (update {update})")]
+    NonFiniteLoss { step: u64, update: u64, loss: f64 },
+    #[error("observation has {got} values, the Q-network takes {expected}")]
+    ObservationSize { expected: usize, got: usize },
+    #[error("action {action} is out of range for {action_count} actions")]
+    ActionOutOfRange { action: usize, action_count: usize },
+    #[error("invalid Q-network architecture: {0}")]
+    Architecture(String),
+    #[error("tensor operation failed: {0}")]
+    Candle(#[from] candle_core::Error),
+}

@@ -1,0 +1,26 @@
+//! Deep Q-learning on candle: the Q-network, the replay buffer, ε-greedy exploration, the
+//! optimiser and the learner.
+//!
+//! Nothing outside this module and the policy store touches candle types. Every random
+//! choice takes the caller's generator, so one seed gives the same numbers.
+//!
+//! The learner does not own its replay buffer: in the transfer loop (Algorithm 3) N learners
+//! train from one shared buffer, so [`DqnAgent::observe`] borrows it.
+
+mod agent;
+mod backprop;
+mod error;
+mod exploration;
+mod host;
+mod loss;
+mod optim;
+mod qnet;
+mod replay;
+
+pub use agent::{DqnAgent, UpdateReport};
+pub use error::DqnError;
+pub use exploration::EpsilonGreedy;
+pub use loss::{huber, td_huber_loss};
+pub use optim::Adam;
+pub use qnet::{Architecture, QNet};
+pub use replay::{Batch, ReplayBuffer, Transition};

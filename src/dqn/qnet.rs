@@ -1,0 +1,343 @@
+//! The Q-network: a multilayer perceptron with ReLU between layers and a linear output,
+//! one Q-value per action.
+
+use candle_core::{DType, Device, Tensor, Var};
+use candle_nn::Linear;
+use rand::Rng;
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+use super::host::with_f32;
+use super::DqnError;
+
+/// The shape of a Q-network.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Architecture {
+    pub observation_size: usize,
+    /// Units of each hidden layer, input side first.
+    pub hidden: Vec<usize>,
+    pub action_count: usize,
+}
+
+impl Architecture {
+    pub fn new(observation_size: usize, hidden: &[usize], action_count: usize) -> Self {
+        Self {
+            observation_size,
+            hidden: hidden.to_vec(),
+            action_count,
+        }
+    }
+
+    /// Every size must be at least 1; no hidden layer at all is allowed (a linear Q).
+    pub fn validate(&self) -> Result<(), DqnError> {
+        if self.observation_size == 0 || self.action_count == 0 || self.hidden.contains(&0) {
+            return Err(DqnError::Architecture(format!(
+                "every layer needs at least one unit, got {self}"
+            )));
+        }
+        Ok(())
+    }
+
+    /// `(out, in)` of each linear layer, input side first.
+    pub fn layer_shapes(&self) -> Vec<(usize, usize)> {
+        let mut sizes = vec![self.observation_size];
+        sizes.extend(&self.hidden);
+        sizes.push(self.action_count);
+        sizes.windows(2).map(|w| (w[1], w[0])).collect()
+    }
+
+    /// Name and shape of every parameter, in the order of [`QNet::parameters`]:
+    /// `layers.{i}.weight` `[out, in]` then `layers.{i}.bias` `[out]`, as PyTorch's
+    /// `nn.Linear` stores them (`y = x·Wᵀ + b`).
+    pub fn parameter_shapes(&self) -> Vec<(String, Vec<usize>)> {
+        self.layer_shapes()
+            .into_iter()
+            .enumerate()
+            .flat_map(|(i, (out, inp))| {
+                [
+                    (format!("layers.{i}.weight"), vec![out, inp]),
+                    (format!("layers.{i}.bias"), vec![out]),
+                ]
+            })
+            .collect()
+    }
+}
+
+impl std::fmt::Display for Architecture {
+    /// `4-100-100-2`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.observation_size)?;
+        for units in &self.hidden {
+            write!(f, "-{units}")?;
+        }
+        write!(f, "-{}", self.action_count)
+    }
+}
+
+/// An MLP Q-network on the CPU. Its parameters are candle [`Var`]s, so it can be trained
+/// and moved to another thread. Not `Clone`: a clone would share the parameters; see
+/// [`QNet::deep_copy`].
+#[derive(Debug)]
+pub struct QNet {
+    architecture: Architecture,
+    /// Detached views of the parameters: the passes in `backprop.rs` never need candle to
+    /// record a graph.
+    layers: Vec<Linear>,
+    /// Weight then bias of each layer; the layers share their storage.
+    parameters: Vec<Var>,
+}
+
+impl QNet {
+    /// A freshly initialised network, as Chainer's `L.Linear` (which ChainerRL's Q-functions
+    /// use) initialises one: weights `W ~ N(0, 1/fan_in)` (LeCun normal), biases 0. candle's
+    /// own initialisers draw from an unseedable generator, so the draw is ours.
+    pub fn new(architecture: Architecture, rng: &mut impl Rng) -> Result<Self, DqnError> {
+        architecture.validate()?;
+        let values = architecture
+            .parameter_shapes()
+            .into_iter()
+            .map(|(name, shape)| {
+                let values = if name.ends_with("weight") {
+                    let scale = (1.0 / shape[1] as f64).sqrt();
+                    let n = shape[0] * shape[1];
+                    (0..n)
+                        .map(|_| {
+                            let z: f64 = StandardNormal.sample(rng);
+                            (scale * z) as f32
+                        })
+                        .collect()
+                } else {
+                    vec![0.0; shape[0]]
+                };
+                Tensor::from_vec(values, shape, &Device::Cpu)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Self::from_parameters(architecture, values)
+    }
+
+    /// A network with the given parameters, in the order of
+    /// [`Architecture::parameter_shapes`]. The values are copied.
+    pub fn from_parameters(
+        architecture: Architecture,
+        values: Vec<Tensor>,
+    ) -> Result<Self, DqnError> {
+        architecture.validate()?;
+        let expected = architecture.parameter_shapes();
+        if values.len() != expected.len() {
+            return Err(DqnError::Architecture(format!(
+                "{architecture} has {} parameter tensors, got {}",
+                expected.len(),
+                values.len()
+            )));
+        }
+        let mut parameters = Vec::with_capacity(values.len());
+        for ((name, shape), value) in expected.iter().zip(values) {
+            if value.dims() != shape.as_slice() {
+                return Err(DqnError::Architecture(format!(
+                    "{name} of {architecture} has shape {shape:?}, got {:?}",
+                    value.dims()
+                )));
+            }
+            // Detached, so that `from_tensor` copies even a tensor that is another's `Var`.
+            let value = value
+                .to_device(&Device::Cpu)?
+                .to_dtype(DType::F32)?
+                .detach();
+            parameters.push(Var::from_tensor(&value)?);
+        }
+        let layers = parameters
+            .chunks(2)
+            .map(|wb| Linear::new(wb[0].as_detached_tensor(), Some(wb[1].as_detached_tensor())))
+            .collect();
+        Ok(Self {
+            architecture,
+            layers,
+            parameters,
+        })
+    }
+
+    pub fn architecture(&self) -> &Architecture {
+        &self.architecture
+    }
+
+    /// Weight then bias of each layer, input side first.
+    pub fn parameters(&self) -> &[Var] {
+        &self.parameters
+    }
+
+    /// `(name, tensor)` of every parameter, named as in [`Architecture::parameter_shapes`].
+    pub fn named_parameters(&self) -> Vec<(String, Tensor)> {
+        self.architecture
+            .parameter_shapes()
+            .into_iter()
+            .zip(&self.parameters)
+            .map(|((name, _), var)| (name, var.as_detached_tensor()))
+            .collect()
+    }
+
+    pub(super) fn layers(&self) -> &[Linear] {
+        &self.layers
+    }
+
+    /// Q-values `[batch, action_count]` of observations `[batch, observation_size]`.
+    /// Not differentiable by candle's autograd; training uses `backprop.rs`.
+    pub fn forward(&self, obs: &Tensor) -> candle_core::Result<Tensor> {
+        Ok(self.forward_train(obs)?.0)
+    }
+
+    /// Q-values of one observation.
+    pub fn q_values(&self, obs: &[f32]) -> Result<Vec<f32>, DqnError> {
+        let expected = self.architecture.observation_size;
+        if obs.len() != expected {
+            return Err(DqnError::ObservationSize {
+                expected,
+                got: obs.len(),
+            });
+        }
+        let x = Tensor::from_slice(obs, (1, expected), &Device::Cpu)?;
+        Ok(with_f32(&self.forward(&x)?, <[f32]>::to_vec)?)
+    }
+
+    /// The action of highest Q-value; ties go to the lowest index, as `argmax` does.
+    pub fn greedy_action(&self, obs: &[f32]) -> Result<usize, DqnError> {
+        Ok(argmax(&self.q_values(obs)?))
+    }
+
+    /// Overwrites this network's parameters with `source`'s (the hard target update).
+    ///
+    /// # Panics
+    /// If the architectures differ (a caller bug).
+    pub fn copy_from(&self, source: &QNet) -> Result<(), DqnError> {
+        assert_eq!(
+            self.architecture, source.architecture,
+            "copy between architectures"
+        );
+        for (dst, src) in self.parameters.iter().zip(&source.parameters) {
+            dst.set(src.as_tensor())?;
+        }
+        Ok(())
+    }
+
+    /// An independent copy: training one does not move the other.
+    pub fn deep_copy(&self) -> Result<Self, DqnError> {
+        let values = self
+            .parameters
+            .iter()
+            .map(|v| v.as_tensor().clone())
+            .collect();
+        Self::from_parameters(self.architecture.clone(), values)
+    }
+}
+
+/// Index of the first maximum; NaN never wins.
+pub(crate) fn argmax(values: &[f32]) -> usize {
+    let mut best = 0;
+    for (i, &v) in values.iter().enumerate() {
+        if v > values[best] || values[best].is_nan() {
+            best = i;
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{rngs::StdRng, SeedableRng};
+
+    fn net(hidden: &[usize], seed: u64) -> QNet {
+        let arch = Architecture::new(4, hidden, 2);
+        QNet::new(arch, &mut StdRng::seed_from_u64(seed)).unwrap()
+    }
+
+    fn flat(net: &QNet) -> Vec<f32> {
+        net.parameters()
+            .iter()
+            .flat_map(|v| {
+                v.as_tensor()
+                    .flatten_all()
+                    .unwrap()
+                    .to_vec1::<f32>()
+                    .unwrap()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn any_hidden_shape_maps_a_batch_to_one_q_per_action() {
+        for hidden in [&[100][..], &[87, 113], &[60, 40, 90], &[]] {
+            let q = net(hidden, 0);
+            let x = Tensor::zeros((32, 4), DType::F32, &Device::Cpu).unwrap();
+            assert_eq!(q.forward(&x).unwrap().dims(), &[32, 2]);
+            assert_eq!(q.parameters().len(), 2 * (hidden.len() + 1));
+        }
+        assert_eq!(net(&[87, 113], 0).architecture().to_string(), "4-87-113-2");
+    }
+
+    #[test]
+    fn initialisation_is_seeded_lecun_normal_with_zero_bias() {
+        assert_eq!(flat(&net(&[50], 7)), flat(&net(&[50], 7)));
+        assert_ne!(flat(&net(&[50], 7)), flat(&net(&[50], 8)));
+        let q = net(&[400], 1);
+        let w = q.parameters()[2].as_tensor().flatten_all().unwrap();
+        let w = w.to_vec1::<f32>().unwrap();
+        let var = w.iter().map(|x| x * x).sum::<f32>() / w.len() as f32;
+        assert!((var - 1.0 / 400.0).abs() < 0.2 / 400.0, "{var}");
+        let b = q.parameters()[1].as_tensor().to_vec1::<f32>().unwrap();
+        assert!(b.iter().all(|&x| x == 0.0));
+    }
+
+    #[test]
+    fn greedy_action_is_the_argmax_of_the_batch_forward() {
+        let q = net(&[16], 3);
+        let obs = [0.1, -0.4, 0.3, 2.0];
+        let x = Tensor::from_slice(&obs, (1, 4), &Device::Cpu).unwrap();
+        let batch = q.forward(&x).unwrap().to_vec2::<f32>().unwrap();
+        assert_eq!(q.q_values(&obs).unwrap(), batch[0]);
+        assert_eq!(q.greedy_action(&obs).unwrap(), argmax(&batch[0]));
+        assert!(matches!(
+            q.greedy_action(&[0.0; 3]),
+            Err(DqnError::ObservationSize {
+                expected: 4,
+                got: 3
+            })
+        ));
+    }
+
+    #[test]
+    fn argmax_takes_the_first_maximum() {
+        assert_eq!(argmax(&[1.0, 3.0, 3.0]), 1);
+        assert_eq!(argmax(&[f32::NAN, -1.0]), 1);
+    }
+
+    #[test]
+    fn copies_are_independent_and_copy_from_syncs() {
+        let a = net(&[8], 1);
+        let b = net(&[8], 2);
+        let c = a.deep_copy().unwrap();
+        b.copy_from(&a).unwrap();
+        assert_eq!(flat(&a), flat(&b));
+        a.parameters()[0]
+            .set(&a.parameters()[0].as_tensor().affine(2.0, 0.0).unwrap())
+            .unwrap();
+        assert_ne!(flat(&a), flat(&b));
+        assert_eq!(flat(&b), flat(&c));
+    }
+
+    #[test]
+    fn refuses_empty_layers_and_wrong_shapes() {
+        let arch = Architecture::new(4, &[0], 2);
+        assert!(QNet::new(arch, &mut StdRng::seed_from_u64(0)).is_err());
+        let arch = Architecture::new(4, &[3], 2);
+        let wrong = vec![Tensor::zeros((3, 5), DType::F32, &Device::Cpu).unwrap(); 4];
+        let err = QNet::from_parameters(arch, wrong).unwrap_err().to_string();
+        assert!(err.contains("layers.0.weight"), "{err}");
+    }
+
+    #[test]
+    fn is_send() {
+        fn send<T: Send>() {}
+        send::<QNet>();
+    }
+}

@@ -1,0 +1,384 @@
+//! The policy library on disk: `<dir>/<name>.safetensors` holds a Q-network's weights,
+//! `<dir>/<name>.ron` what they are.
+//!
+//! The weights file holds one `f32` tensor per parameter, named as PyTorch's `nn.Linear`
+//! stores them: `layers.{i}.weight` `[out, in]` and `layers.{i}.bias` `[out]`, input side
+//! first, with ReLU between layers. From Python:
+//! `safetensors.torch.load_file("p.safetensors")["layers.0.weight"]`.
+//!
+//! Saving is atomic: both files are written to temporary names in the same directory, the
+//! weights are renamed into place first and the metadata last. The metadata carries the
+//! SHA-256 of its weights, so an interrupted save (new weights, old metadata) is refused on
+//! load rather than read as a mismatched pair.
+
+use std::collections::HashMap;
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use candle_core::{DType, Device};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use crate::config::{parse_ron, ron_options, ConfigError};
+use crate::dqn::{Architecture, DqnError, QNet};
+use crate::env::EnvConfig;
+
+/// The only activation the Q-networks use.
+pub const ACTIVATION: &str = "relu";
+
+/// How much training produced a policy.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainingBudget {
+    pub episodes: u64,
+    pub steps: u64,
+}
+
+/// What a caller knows about a policy it saves; the store adds the rest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PolicyInfo {
+    /// The task it was trained on, with its physics.
+    pub source_task: EnvConfig,
+    pub training: TrainingBudget,
+    pub seed: u64,
+    /// Mean return of the greedy test episodes after training, if it was tested.
+    pub final_score: Option<f64>,
+}
+
+/// The contents of `<name>.ron`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolicyMetadata {
+    pub architecture: Architecture,
+    /// Always [`ACTIVATION`]; recorded so the file describes the network on its own.
+    pub activation: String,
+    /// `EnvConfig::task_name` of the source task.
+    pub source_task_name: String,
+    pub source_task: EnvConfig,
+    pub training: TrainingBudget,
+    pub seed: u64,
+    pub final_score: Option<f64>,
+    /// The version of sapnet that wrote the files.
+    pub crate_version: String,
+    /// SHA-256 of the weights file, lowercase hex: ties the pair together.
+    pub weights_sha256: String,
+}
+
+/// A policy read from the library.
+#[derive(Debug)]
+pub struct StoredPolicy {
+    pub net: QNet,
+    pub metadata: PolicyMetadata,
+}
+
+/// Why a policy could not be saved or loaded. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum StoreError {
+    #[error("policy file {} does not exist", path.display())]
+    Missing { path: PathBuf },
+    #[error("reading policy file {}: {source}", path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("writing policy file {}: {source}", path.display())]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("policy name {name:?} is not a plain file name")]
+    InvalidName { name: String },
+    #[error("policy metadata: {0}")]
+    Metadata(#[from] ConfigError),
+    #[error("policy file {}: {message}", path.display())]
+    Invalid { path: PathBuf, message: String },
+    #[error("policy weights {} do not match their metadata {}: {mismatch}", weights.display(), metadata.display())]
+    Mismatch {
+        weights: PathBuf,
+        metadata: PathBuf,
+        mismatch: String,
+    },
+    #[error("policy {} does not fit the task: {mismatch}", path.display())]
+    DoesNotFit { path: PathBuf, mismatch: String },
+}
+
+/// The two files of policy `name` in `dir`: `(weights, metadata)`.
+pub fn paths(dir: &Path, name: &str) -> (PathBuf, PathBuf) {
+    (
+        dir.join(format!("{name}.safetensors")),
+        dir.join(format!("{name}.ron")),
+    )
+}
+
+/// Writes `net` as policy `name` in `dir` (created if needed), replacing any policy of that
+/// name. Returns the metadata written.
+pub fn save(
+    dir: &Path,
+    name: &str,
+    net: &QNet,
+    info: &PolicyInfo,
+) -> Result<PolicyMetadata, StoreError> {
+    check_name(name)?;
+    fs::create_dir_all(dir).map_err(|source| StoreError::Write {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let (weights_path, metadata_path) = paths(dir, name);
+    let weights_tmp = temporary(&weights_path);
+    let metadata_tmp = temporary(&metadata_path);
+    let written = write_pair(
+        net,
+        info,
+        [&weights_tmp, &metadata_tmp],
+        [&weights_path, &metadata_path],
+    );
+    if written.is_err() {
+        // Best effort: leftovers are hidden `*.tmp` files that load never reads.
+        let _ = fs::remove_file(&weights_tmp);
+        let _ = fs::remove_file(&metadata_tmp);
+    }
+    // Make the renames themselves durable; not every platform can open a directory.
+    if let Ok(d) = fs::File::open(dir) {
+        let _ = d.sync_all();
+    }
+    written
+}
+
+/// Writes both temporary files, then renames weights first and metadata last.
+fn write_pair(
+    net: &QNet,
+    info: &PolicyInfo,
+    [weights_tmp, metadata_tmp]: [&Path; 2],
+    [weights_path, metadata_path]: [&Path; 2],
+) -> Result<PolicyMetadata, StoreError> {
+    // "format": "pt" tells Hugging Face tooling the tensors are laid out as PyTorch's.
+    let header = HashMap::from([("format".to_string(), "pt".to_string())]);
+    let weights = safetensors::serialize(net.named_parameters(), Some(header)).map_err(|e| {
+        StoreError::Invalid {
+            path: weights_path.to_path_buf(),
+            message: format!("cannot serialise weights: {e}"),
+        }
+    })?;
+    write_synced(weights_tmp, &weights)?;
+
+    let metadata = PolicyMetadata {
+        architecture: net.architecture().clone(),
+        activation: ACTIVATION.to_string(),
+        source_task_name: info.source_task.task_name().to_string(),
+        source_task: info.source_task.clone(),
+        training: info.training.clone(),
+        seed: info.seed,
+        final_score: info.final_score,
+        crate_version: env!("CARGO_PKG_VERSION").to_string(),
+        weights_sha256: sha256_hex(&weights),
+    };
+    let pretty = ron::ser::PrettyConfig::default().compact_arrays(true);
+    let text = ron_options()
+        .to_string_pretty(&metadata, pretty)
+        .map_err(|e| StoreError::Invalid {
+            path: metadata_path.to_path_buf(),
+            message: format!("cannot serialise metadata: {e}"),
+        })?;
+    write_synced(metadata_tmp, format!("{text}\n").as_bytes())?;
+
+    rename(weights_tmp, weights_path)?;
+    rename(metadata_tmp, metadata_path)?;
+    Ok(metadata)
+}
+
+/// Reads policy `name` from `dir`, checking the weights against the metadata.
+pub fn load(dir: &Path, name: &str) -> Result<StoredPolicy, StoreError> {
+    check_name(name)?;
+    let (weights_path, metadata_path) = paths(dir, name);
+    let text = String::from_utf8(read(&metadata_path)?).map_err(|_| StoreError::Invalid {
+        path: metadata_path.clone(),
+        message: "not UTF-8 text".to_string(),
+    })?;
+    let metadata: PolicyMetadata = parse_ron(&text, &metadata_path.display().to_string())?;
+    if metadata.activation != ACTIVATION {
+        return Err(StoreError::Invalid {
+            path: metadata_path,
+            message: format!(
+                "activation {:?} is not supported (only {ACTIVATION:?})",
+                metadata.activation
+            ),
+        });
+    }
+    if let Err(e) = metadata.architecture.validate() {
+        return Err(StoreError::Invalid {
+            path: metadata_path,
+            message: e.to_string(),
+        });
+    }
+
+    let weights = read(&weights_path)?;
+    let mismatch = |mismatch: String| StoreError::Mismatch {
+        weights: weights_path.clone(),
+        metadata: metadata_path.clone(),
+        mismatch,
+    };
+    let digest = sha256_hex(&weights);
+    if digest != metadata.weights_sha256 {
+        return Err(mismatch(format!(
+            "the weights' SHA-256 is {digest}, the metadata records {} (an interrupted save, or a file \
+             changed by hand)",
+            metadata.weights_sha256
+        )));
+    }
+    let mut tensors =
+        candle_core::safetensors::load_buffer(&weights, &Device::Cpu).map_err(|e| {
+            StoreError::Invalid {
+                path: weights_path.clone(),
+                message: format!("not a safetensors file: {e}"),
+            }
+        })?;
+    let arch = &metadata.architecture;
+    let mut values = Vec::new();
+    for (name, shape) in arch.parameter_shapes() {
+        let tensor = tensors
+            .remove(&name)
+            .ok_or_else(|| mismatch(format!("tensor {name} of {arch} is missing")))?;
+        if tensor.dims() != shape.as_slice() || tensor.dtype() != DType::F32 {
+            return Err(mismatch(format!(
+                "tensor {name} is {:?} {:?}, {arch} needs F32 {shape:?}",
+                tensor.dtype(),
+                tensor.dims()
+            )));
+        }
+        values.push(tensor);
+    }
+    if let Some(extra) = tensors.keys().min() {
+        return Err(mismatch(format!("tensor {extra} is not part of {arch}")));
+    }
+    let net = QNet::from_parameters(arch.clone(), values)
+        .map_err(|e: DqnError| mismatch(e.to_string()))?;
+    Ok(StoredPolicy { net, metadata })
+}
+
+/// Reads policy `name` and checks that it fits a task of `observation_size` inputs and
+/// `action_count` actions.
+pub fn load_for_task(
+    dir: &Path,
+    name: &str,
+    observation_size: usize,
+    action_count: usize,
+) -> Result<StoredPolicy, StoreError> {
+    let policy = load(dir, name)?;
+    let arch = &policy.metadata.architecture;
+    let mut problems = Vec::new();
+    if arch.observation_size != observation_size {
+        problems.push(format!(
+            "it takes {} observation values, the task gives {observation_size}",
+            arch.observation_size
+        ));
+    }
+    if arch.action_count != action_count {
+        problems.push(format!(
+            "it scores {} actions, the task has {action_count}",
+            arch.action_count
+        ));
+    }
+    if problems.is_empty() {
+        Ok(policy)
+    } else {
+        Err(StoreError::DoesNotFit {
+            path: paths(dir, name).1,
+            mismatch: problems.join("; "),
+        })
+    }
+}
+
+/// Names of the policies in `dir` (those with a metadata file), sorted; none if `dir` does
+/// not exist.
+pub fn list(dir: &Path) -> Result<Vec<String>, StoreError> {
+    let entries = match fs::read_dir(dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(source) => {
+            return Err(StoreError::Read {
+                path: dir.to_path_buf(),
+                source,
+            })
+        }
+    };
+    let mut names = Vec::new();
+    for entry in entries {
+        let entry = entry.map_err(|source| StoreError::Read {
+            path: dir.to_path_buf(),
+            source,
+        })?;
+        let path = entry.path();
+        if path.extension().is_some_and(|e| e == "ron") {
+            if let Some(stem) = path.file_stem().and_then(|s| s.to_str()) {
+                if check_name(stem).is_ok() {
+                    names.push(stem.to_string());
+                }
+            }
+        }
+    }
+    names.sort();
+    Ok(names)
+}
+
+/// SHA-256 of `bytes` as lowercase hex.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+fn check_name(name: &str) -> Result<(), StoreError> {
+    let plain = !name.is_empty()
+        && !name.starts_with('.')
+        && !name.contains(['/', '\\'])
+        && Path::new(name).file_name() == Some(name.as_ref());
+    if plain {
+        Ok(())
+    } else {
+        Err(StoreError::InvalidName {
+            name: name.to_string(),
+        })
+    }
+}
+
+/// A hidden sibling of `path`, unique to this process; `*.tmp` is ignored by git.
+fn temporary(path: &Path) -> PathBuf {
+    let file = path
+        .file_name()
+        .and_then(|f| f.to_str())
+        .unwrap_or("policy");
+    path.with_file_name(format!(".{file}.{}.tmp", std::process::id()))
+}
+
+fn read(path: &Path) -> Result<Vec<u8>, StoreError> {
+    fs::read(path).map_err(|source| match source.kind() {
+        std::io::ErrorKind::NotFound => StoreError::Missing {
+            path: path.to_path_buf(),
+        },
+        _ => StoreError::Read {
+            path: path.to_path_buf(),
+            source,
+        },
+    })
+}
+
+fn write_synced(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
+    let write = || {
+        let mut file = fs::File::create(path)?;
+        file.write_all(bytes)?;
+        file.sync_all()
+    };
+    write().map_err(|source| StoreError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn rename(from: &Path, to: &Path) -> Result<(), StoreError> {
+    fs::rename(from, to).map_err(|source| StoreError::Write {
+        path: to.to_path_buf(),
+        source,
+    })
+}
