@@ -31,6 +31,9 @@ pub struct Acrobot {
     /// sub-expression in Gymnasium so that the result is the same to the bit.
     derived: Derived,
     state: [f64; 4],
+    /// `sin_cos(state[1])`: the observation and the next step's first evaluation of the
+    /// dynamics both need it, and libm calls are most of the cost of a step.
+    sin_cos_theta2: (f64, f64),
     rng: StdRng,
     elapsed: u32,
 }
@@ -84,14 +87,65 @@ impl Derived {
     }
 }
 
-/// `x**2` as Python and NumPy evaluate it: a call to the C library's `pow`.
+/// `x**2` as Python and NumPy evaluate it: the C library's `pow(x, 2.0)`.
 ///
-/// glibc's `pow` is accurate to 0.52 ulp, not correctly rounded, so `pow(x, 2.0)` differs
-/// from `x * x` for about one input in a thousand. LLVM rewrites `pow(x, 2.0)` into
-/// `x * x`; hiding the exponent keeps the call.
+/// glibc's `pow` (Arm's optimized-routines, also in musl) is not correctly rounded: its
+/// documented worst case is 0.54 ulp, and `pow(x, 2.0)` differs from `x * x` for about one
+/// input in a thousand, where the exact square lies near the midpoint between two doubles.
+/// Elsewhere the only double within 0.54 ulp of the exact square is the correctly rounded
+/// `x * x`, so `pow` is called only near a midpoint: bit-exact, and most calls are saved
+/// (`pow` was a third of Acrobot's step).
 #[inline]
 fn py_square(x: f64) -> f64 {
+    /// Below this the rounding error of `x * x` could be subnormal and inexact.
+    const SMALLEST_CHECKED: f64 = 1e-290;
+    const EXPONENT_BITS: u64 = 0x7ff0_0000_0000_0000;
+    const MANTISSA_BITS: u64 = 0x000f_ffff_ffff_ffff;
+    let p = x * x;
+    if p.is_finite() && p > SMALLEST_CHECKED {
+        let e = square_error(x, p);
+        // Spacing of the doubles on the side of `p` where x² lies (halved below a power
+        // of two).
+        let mut ulp = f64::from_bits(p.to_bits() & EXPONENT_BITS) * f64::EPSILON;
+        if e < 0.0 && p.to_bits() & MANTISSA_BITS == 0 {
+            ulp *= 0.5;
+        }
+        // The nearest other double is at least 0.55 ulp from x², beyond pow's 0.54.
+        if e.abs() <= 0.45 * ulp {
+            return p;
+        }
+    }
+    libm_square(x)
+}
+
+/// The rounding error `e` of `p = x * x`, so that x² = p + e exactly (Dekker's product).
+///
+/// `x.mul_add(x, -p)` gives the same, but without FMA in the target (x86-64's baseline) it
+/// is a slow software routine. Exact while `p` is finite and `e` is not subnormal.
+#[inline]
+fn square_error(x: f64, p: f64) -> f64 {
+    // Veltkamp's split of x into 26 + 27 significant bits, whose products are exact.
+    const SPLITTER: f64 = 134_217_729.0; // 2^27 + 1
+    let c = SPLITTER * x;
+    let hi = c - (c - x);
+    let lo = x - hi;
+    ((hi * hi - p) + 2.0 * hi * lo) + lo * lo
+}
+
+/// The C library's `pow(x, 2.0)`. LLVM rewrites `pow(x, 2.0)` into `x * x`; hiding the
+/// exponent keeps the call.
+#[inline]
+fn libm_square(x: f64) -> f64 {
     x.powf(black_box(2.0))
+}
+
+/// `(x.sin(), x.cos())` in one `sincos` call, which gives the same bits.
+///
+/// Inlined, the branches of [`py_square`] let LLVM move the sine away from the cosine and
+/// miss the fusion, which costs a libm call per evaluation of the dynamics.
+#[inline(never)]
+fn sin_cos(x: f64) -> (f64, f64) {
+    x.sin_cos()
 }
 
 /// Gymnasium's `wrap`: shifts `x` by whole turns until it lies in `[lo, hi]`.
@@ -124,46 +178,73 @@ impl Acrobot {
             derived: Derived::new(&params),
             params,
             state: [0.0; 4],
+            sin_cos_theta2: sin_cos(0.0),
             rng: StdRng::seed_from_u64(0),
             elapsed: 0,
         }
     }
 
-    /// Gymnasium's `_dsdt` ("book" dynamics): the time derivative of `s` under torque `a`.
+    fn set(&mut self, state: [f64; 4]) {
+        self.state = state;
+        self.sin_cos_theta2 = sin_cos(state[1]);
+    }
+
+    /// Gymnasium's `_get_ob`, given `sin_cos(state[0])`.
     #[inline]
-    fn dsdt(&self, s: [f64; 4], a: f64) -> [f64; 4] {
+    fn observation_with(&self, (sin_theta1, cos_theta1): (f64, f64)) -> Observation {
+        let (sin_theta2, cos_theta2) = self.sin_cos_theta2;
+        let [_, _, dtheta1, dtheta2] = self.state;
+        Observation::from_slice(&[
+            cos_theta1 as f32,
+            sin_theta1 as f32,
+            cos_theta2 as f32,
+            sin_theta2 as f32,
+            dtheta1 as f32,
+            dtheta2 as f32,
+        ])
+    }
+
+    /// Gymnasium's `_dsdt` ("book" dynamics): the time derivative of `s` under torque `a`,
+    /// given `sin_cos(s[1])`.
+    #[inline]
+    fn dsdt(&self, s: [f64; 4], a: f64, (sin_theta2, cos_theta2): (f64, f64)) -> [f64; 4] {
         let d = &self.derived;
         let i1 = self.params.link_moi;
         let i2 = self.params.link_moi;
         let m2 = self.params.link_mass_2;
         let [theta1, theta2, dtheta1, dtheta2] = s;
-        let cos_theta2 = theta2.cos();
-        let sin_theta2 = theta2.sin();
+        let dtheta1_sq = py_square(dtheta1);
+        let dtheta2_sq = py_square(dtheta2);
 
         let d1 = d.m1_lc1_sq + m2 * (d.l1_sq_plus_lc2_sq + d.two_l1_lc2 * cos_theta2) + i1 + i2;
         let d2 = m2 * (d.lc2_sq + d.l1_lc2 * cos_theta2) + i2;
         let phi2 = d.m2_lc2_g * (theta1 + theta2 - PI / 2.0).cos();
-        let phi1 = d.neg_m2_l1_lc2 * py_square(dtheta2) * sin_theta2
+        let phi1 = d.neg_m2_l1_lc2 * dtheta2_sq * sin_theta2
             - d.two_m2_l1_lc2 * dtheta2 * dtheta1 * sin_theta2
             + d.phi1_gravity * (theta1 - PI / 2.0).cos()
             + phi2;
-        let ddtheta2 = (a + d2 / d1 * phi1 - d.m2_l1_lc2 * py_square(dtheta1) * sin_theta2 - phi2)
-            / (d.m2_lc2_sq_plus_i2 - py_square(d2) / d1);
+        let numerator = a + d2 / d1 * phi1 - d.m2_l1_lc2 * dtheta1_sq * sin_theta2 - phi2;
+        let ddtheta2 = numerator / (d.m2_lc2_sq_plus_i2 - py_square(d2) / d1);
         let ddtheta1 = -(d2 * ddtheta2 + phi1) / d1;
         [dtheta1, dtheta2, ddtheta1, ddtheta2]
     }
 
-    /// Gymnasium's `rk4` over the single interval `[0, dt]`. The torque rides along as a
-    /// fifth state variable with derivative 0 there, so it is passed unchanged here.
+    /// Gymnasium's `rk4` from the current state over the single interval `[0, dt]`. The
+    /// torque rides along as a fifth state variable with derivative 0 there, so it is passed
+    /// unchanged here.
     #[inline]
-    fn rk4(&self, y0: [f64; 4], torque: f64) -> [f64; 4] {
+    fn rk4(&self, torque: f64) -> [f64; 4] {
+        let y0 = self.state;
         let dt = self.params.dt;
         let dt2 = dt / 2.0;
-        let shifted = |k: [f64; 4], h: f64| std::array::from_fn(|i| y0[i] + h * k[i]);
-        let k1 = self.dsdt(y0, torque);
-        let k2 = self.dsdt(shifted(k1, dt2), torque);
-        let k3 = self.dsdt(shifted(k2, dt2), torque);
-        let k4 = self.dsdt(shifted(k3, dt), torque);
+        let derivative_at = |k: [f64; 4], h: f64| {
+            let y: [f64; 4] = std::array::from_fn(|i| y0[i] + h * k[i]);
+            self.dsdt(y, torque, sin_cos(y[1]))
+        };
+        let k1 = self.dsdt(y0, torque, self.sin_cos_theta2);
+        let k2 = derivative_at(k1, dt2);
+        let k3 = derivative_at(k2, dt2);
+        let k4 = derivative_at(k3, dt);
         let sixth = dt / 6.0;
         std::array::from_fn(|i| y0[i] + sixth * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
     }
@@ -193,9 +274,10 @@ impl Environment for Acrobot {
         if let Some(seed) = seed {
             self.rng = StdRng::seed_from_u64(seed);
         }
-        for v in &mut self.state {
-            *v = f64::from(self.rng.random_range(-RESET_BOUND..RESET_BOUND) as f32);
-        }
+        let state = std::array::from_fn(|_| {
+            f64::from(self.rng.random_range(-RESET_BOUND..RESET_BOUND) as f32)
+        });
+        self.set(state);
         self.elapsed = 0;
         self.observation()
     }
@@ -216,20 +298,22 @@ impl Environment for Acrobot {
                 .rng
                 .random_range(-p.torque_noise_max..p.torque_noise_max);
         }
-        let ns = self.rk4(self.state, torque);
+        let ns = self.rk4(torque);
         let p = &self.params;
-        self.state = [
-            wrap(ns[0], -PI, PI),
-            wrap(ns[1], -PI, PI),
+        let (theta1, theta2) = (wrap(ns[0], -PI, PI), wrap(ns[1], -PI, PI));
+        self.set([
+            theta1,
+            theta2,
             bound(ns[2], -p.max_vel_1, p.max_vel_1),
             bound(ns[3], -p.max_vel_2, p.max_vel_2),
-        ];
+        ]);
 
-        let [theta1, theta2, ..] = self.state;
-        let terminated = -theta1.cos() - (theta2 + theta1).cos() > 1.0;
+        let sin_cos_theta1 = sin_cos(theta1);
+        let terminated = -sin_cos_theta1.1 - (theta2 + theta1).cos() > 1.0;
         self.elapsed += 1;
+        let p = &self.params;
         Step {
-            obs: self.observation(),
+            obs: self.observation_with(sin_cos_theta1),
             reward: if terminated { 0.0 } else { -1.0 },
             terminated,
             truncated: self.elapsed >= p.max_episode_steps,
@@ -237,17 +321,8 @@ impl Environment for Acrobot {
     }
 
     /// Gymnasium's `_get_ob`.
-    #[inline]
     fn observation(&self) -> Observation {
-        let [theta1, theta2, dtheta1, dtheta2] = self.state;
-        Observation::from_slice(&[
-            theta1.cos() as f32,
-            theta1.sin() as f32,
-            theta2.cos() as f32,
-            theta2.sin() as f32,
-            dtheta1 as f32,
-            dtheta2 as f32,
-        ])
+        self.observation_with(sin_cos(self.state[0]))
     }
 
     fn state(&self) -> &[f64] {
@@ -255,11 +330,12 @@ impl Environment for Acrobot {
     }
 
     fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
-        self.state = state.try_into().map_err(|_| StateError::WrongLength {
+        let state = state.try_into().map_err(|_| StateError::WrongLength {
             env: "Acrobot",
             expected: 4,
             got: state.len(),
         })?;
+        self.set(state);
         Ok(())
     }
 
@@ -286,6 +362,40 @@ mod tests {
         let x = f64::from_bits(0xc010_db07_b8dd_0d73);
         assert_eq!(py_square(x).to_bits(), 0x4031_c1c5_d522_784f);
         assert_eq!((x * x).to_bits(), 0x4031_c1c5_d522_7850);
+    }
+
+    #[test]
+    fn square_shortcut_agrees_with_pow() {
+        let mut rng = StdRng::seed_from_u64(0);
+        let mut differs_from_product = 0;
+        let specials = [
+            0.0,
+            -0.0,
+            1.0,
+            2.0,
+            0.5,
+            1e-300,
+            1e-150,
+            1e200,
+            f64::MAX,
+            f64::NAN,
+        ];
+        let randoms = (0..1_000_000).map(|i| {
+            let magnitude = [1e-3, 1.0, 30.0, 1e8][i % 4];
+            rng.random_range(-magnitude..magnitude)
+        });
+        for x in specials.into_iter().chain(randoms) {
+            let (got, want) = (py_square(x), libm_square(x));
+            assert!(
+                got.to_bits() == want.to_bits() || (got.is_nan() && want.is_nan()),
+                "x = {x:e}: {got:e} but pow gives {want:e}"
+            );
+            differs_from_product += usize::from(want != x * x);
+        }
+        // The slow path must have been exercised where glibc's pow is not x * x.
+        if cfg!(all(target_os = "linux", target_env = "gnu")) {
+            assert!(differs_from_product > 100, "{differs_from_product}");
+        }
     }
 
     #[test]

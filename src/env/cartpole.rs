@@ -24,6 +24,9 @@ pub struct CartPole {
     /// Gymnasium's `polemass_length`.
     polemass_length: f64,
     state: [f64; 4],
+    /// `(sin θ, cos θ)` of the state, computed as soon as θ is known so that the libm call
+    /// overlaps the divisions of the step that sets θ.
+    sin_cos_theta: (f64, f64),
     rng: StdRng,
     elapsed: u32,
     /// Gymnasium's `steps_beyond_terminated is not None`: steps taken after the pole fell
@@ -38,6 +41,7 @@ impl CartPole {
             polemass_length: params.masspole * params.length,
             params,
             state: [0.0; 4],
+            sin_cos_theta: (0.0, 1.0),
             rng: StdRng::seed_from_u64(0),
             elapsed: 0,
             fell: false,
@@ -69,6 +73,7 @@ impl Environment for CartPole {
         for v in &mut self.state {
             *v = self.rng.random_range(-RESET_BOUND..RESET_BOUND);
         }
+        self.sin_cos_theta = self.state[2].sin_cos();
         self.elapsed = 0;
         self.fell = false;
         self.observation()
@@ -89,8 +94,7 @@ impl Environment for CartPole {
         } else {
             -p.force_mag
         };
-        let costheta = theta.cos();
-        let sintheta = theta.sin();
+        let (sintheta, costheta) = self.sin_cos_theta;
 
         let temp =
             (force + self.polemass_length * (theta_dot * theta_dot) * sintheta) / self.total_mass;
@@ -113,6 +117,7 @@ impl Environment for CartPole {
             }
         }
         self.state = [x, x_dot, theta, theta_dot];
+        self.sin_cos_theta = theta.sin_cos();
 
         let terminated = x < -p.x_threshold
             || x > p.x_threshold
@@ -144,6 +149,7 @@ impl Environment for CartPole {
             expected: 4,
             got: state.len(),
         })?;
+        self.sin_cos_theta = self.state[2].sin_cos();
         Ok(())
     }
 
