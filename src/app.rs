@@ -1,26 +1,31 @@
 //! Dispatches a parsed command line to the part of the crate that does the work.
 
 use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::time::{SystemTime, UNIX_EPOCH};
 
 use anyhow::{Context, Result};
 
 use crate::cli::{Cli, Command, EnvArgs, TeachArgs};
 use crate::config::Config;
-use crate::{assets, env, random_episodes};
+use crate::headless::{self, OutputOptions};
+use crate::{assets, env, random_episodes, trainer};
 
 pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Some(Command::Env(args)) => run_env(&cli, args),
         Some(Command::Teach(args)) => run_teach(&cli, args),
-        None => anyhow::bail!("not wired yet"),
+        None => run_experiment(&cli),
     }
 }
 
-/// The config the user named, or the embedded default, with `--seed` applied.
-fn load_config(cli: &Cli) -> Result<Config> {
+/// The config the user named, or `embedded` (with `label` for messages), with `--seed`
+/// applied.
+fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
     let mut config = match &cli.run.config {
         Some(path) => Config::from_file(path)?,
-        None => Config::from_ron(assets::CARTPOLE, "embedded assets/cartpole.ron")?,
+        None => Config::from_ron(embedded, label)?,
     };
     if let Some(seed) = cli.run.seed {
         config.seed = seed;
@@ -29,7 +34,7 @@ fn load_config(cli: &Cli) -> Result<Config> {
 }
 
 fn run_env(cli: &Cli, args: &EnvArgs) -> Result<()> {
-    let config = load_config(cli)?;
+    let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
     let mut env = env::make(&config.env);
     let episodes = random_episodes::run(env.as_mut(), args.episodes, config.seed);
     let mut out = std::io::stdout().lock();
@@ -45,5 +50,76 @@ fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
              `sapnet teach --headless --activate I`"
         );
     }
-    crate::teach::headless::run(cli.run.config.as_deref(), args, &mut std::io::stdout().lock())
+    crate::teach::headless::run(
+        cli.run.config.as_deref(),
+        args,
+        &mut std::io::stdout().lock(),
+    )
+}
+
+fn run_experiment(cli: &Cli) -> Result<()> {
+    if !cli.run.headless {
+        eprintln!("note: the live dashboard is not built yet; running headless (--headless).");
+    }
+    let config = load_config(
+        cli,
+        assets::DQN_CARTPOLE,
+        "embedded assets/dqn_cartpole.ron",
+    )?;
+    let dir = match &cli.run.out {
+        Some(dir) => dir.clone(),
+        None => default_out_dir(cli.run.config.as_deref()),
+    };
+    let output = OutputOptions {
+        dir,
+        force: cli.run.force,
+    };
+
+    let (commands, commands_rx) = mpsc::channel();
+    let on_interrupt = commands.clone();
+    ctrlc::set_handler(move || {
+        eprintln!("\ninterrupted: finishing the current step, keeping what was written");
+        let _ = on_interrupt.send(trainer::Command::Stop);
+    })
+    .context("installing the Ctrl-C handler")?;
+
+    let summary = headless::run(&config, &output, commands_rx)?;
+    drop(commands);
+    let dir = output.dir.display();
+    if summary.stopped() {
+        eprintln!("stopped by the user: the episodes so far are in {dir}/episodes.csv, the summary in {dir}/summary.json");
+    } else {
+        eprintln!("results in {dir}: episodes.csv, summary.json, policies/");
+    }
+    for run in &summary.runs {
+        let tests: Vec<String> = run
+            .record
+            .test_returns
+            .iter()
+            .map(|r| format!("{r:.0}"))
+            .collect();
+        eprintln!(
+            "{} run {}: {} episodes, best MA{} {}, greedy tests [{}]",
+            run.record.method,
+            run.record.run + 1,
+            run.record.episodes,
+            config.protocol.moving_average,
+            run.best_moving_average
+                .map_or("-".into(), |a| format!("{a:.1}")),
+            tests.join(", ")
+        );
+    }
+    Ok(())
+}
+
+/// `out/<config stem>-<unix seconds>`: a new directory per run, so the default never
+/// collides with earlier results.
+fn default_out_dir(config: Option<&Path>) -> PathBuf {
+    let stem = config
+        .and_then(|p| p.file_stem())
+        .map_or("dqn_cartpole".into(), |s| s.to_string_lossy().into_owned());
+    let seconds = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    PathBuf::from("out").join(format!("{stem}-{seconds}"))
 }

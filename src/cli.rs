@@ -6,8 +6,8 @@ use clap::{Args, Parser, Subcommand};
 
 /// SAP-Net: reuse a library of DQN policies by spreading activation over a policy graph.
 ///
-/// With no subcommand, runs the experiment of `--config` (default: the embedded CartPole
-/// configuration, the paper's settings).
+/// With no subcommand, runs the experiment of `--config` (default: the embedded
+/// `assets/dqn_cartpole.ron`, the paper's DQN on CartPole-v1).
 #[derive(Debug, Parser)]
 #[command(name = "sapnet", version, about, long_about = None)]
 pub struct Cli {
@@ -34,9 +34,14 @@ pub struct RunArgs {
     #[arg(long, value_name = "N", global = true)]
     pub seed: Option<u64>,
 
-    /// Directory for results (CSV, JSON, plots).
-    #[arg(long, value_name = "DIR", default_value = "out")]
-    pub out: PathBuf,
+    /// Directory for results (CSV, JSON, trained policies). Default: a new directory
+    /// `out/<config>-<unix time>`.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+
+    /// Replace results already in --out.
+    #[arg(long)]
+    pub force: bool,
 }
 
 #[derive(Debug, Subcommand)]

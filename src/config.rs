@@ -157,6 +157,9 @@ pub enum Method {
 pub struct ProtocolConfig {
     /// Training episodes per run (Table I: 5000 CartPole, 10000 MountainCar).
     pub episodes: u32,
+    /// Also stop a run after this many environment steps, cutting the episode in progress
+    /// (rl-baselines3-zoo budgets in steps). `None`: episodes only.
+    pub max_steps: Option<u64>,
     /// Independent runs per method, averaged (paper: 5).
     pub runs: u32,
     /// Greedy test episodes after training (Table I "Number of test": 5).
@@ -170,6 +173,7 @@ impl Default for ProtocolConfig {
     fn default() -> Self {
         Self {
             episodes: 5000,
+            max_steps: None,
             runs: 5,
             test_episodes: 5,
             moving_average: 10,
@@ -369,31 +373,9 @@ impl Config {
                 )?;
             }
         }
-        let s = &self.sapnet;
-        check(
-            s.threshold > 0.0 && s.threshold.is_finite(),
-            "sapnet.threshold",
-            "a finite number > 0",
-            s.threshold,
-        )?;
-        check(
-            s.temperature > 0.0 && s.temperature.is_finite(),
-            "sapnet.temperature",
-            "a finite number > 0",
-            s.temperature,
-        )?;
-        check(
-            s.coefficient.is_finite(),
-            "sapnet.coefficient",
-            "a finite number",
-            s.coefficient,
-        )?;
-        check(
-            s.delta.is_finite(),
-            "sapnet.delta",
-            "a finite number",
-            s.delta,
-        )?;
+        self.sapnet
+            .validate()
+            .map_err(|e| format!("section `sapnet`: {e}"))?;
         let src = &self.sources;
         check(src.count > 0, "sources.count", "at least 1", src.count)?;
         check(

@@ -255,13 +255,6 @@ struct Corridor {
 
 const LENGTH: usize = 4;
 
-impl Corridor {
-    fn observation(&self) -> Observation {
-        let x = self.position as f32 / (LENGTH - 1) as f32;
-        Observation::from_slice(&[x, 1.0 - x])
-    }
-}
-
 impl Environment for Corridor {
     fn id(&self) -> &'static str {
         "Corridor"
@@ -291,6 +284,10 @@ impl Environment for Corridor {
             terminated,
             truncated: self.steps >= 20,
         }
+    }
+    fn observation(&self) -> Observation {
+        let x = self.position as f32 / (LENGTH - 1) as f32;
+        Observation::from_slice(&[x, 1.0 - x])
     }
     fn state(&self) -> &[f64] {
         &[]
@@ -365,7 +362,6 @@ fn learns_to_walk_down_a_corridor() {
 }
 
 #[test]
-#[ignore = "runs once the native environments are merged (they are stubs on the dqn branch)"]
 fn trains_on_cartpole_through_env_make() {
     let mut env = env::make(&EnvConfig::CartPole(Default::default()));
     let config = DqnConfig::default();

@@ -170,6 +170,11 @@ impl DqnAgent {
         self.target.copy_from(&self.online)
     }
 
+    /// ε of ε-greedy at this policy's current step.
+    pub fn epsilon(&self) -> f64 {
+        self.explorer.epsilon(self.steps)
+    }
+
     /// The statistic loss `E` (0 before the first update).
     pub fn statistic_loss(&self) -> f64 {
         self.statistic_loss

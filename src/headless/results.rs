@@ -1,0 +1,162 @@
+//! The result files of a headless run.
+
+use std::fs::File;
+use std::io::Write;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+
+use crate::config::Config;
+use crate::trainer::{EpisodeRecord, RunRecord};
+
+/// `episodes.csv`, one row per episode, flushed row by row so that an interrupted run
+/// keeps every finished episode.
+pub struct EpisodeWriter {
+    csv: csv::Writer<File>,
+    path: String,
+}
+
+impl EpisodeWriter {
+    pub fn create(path: &Path) -> Result<Self> {
+        let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
+        Ok(Self {
+            csv: csv::Writer::from_writer(file),
+            path: path.display().to_string(),
+        })
+    }
+
+    pub fn write(&mut self, record: &EpisodeRecord) -> Result<()> {
+        self.csv
+            .serialize(record)
+            .and_then(|()| Ok(self.csv.flush()?))
+            .with_context(|| format!("writing {}", self.path))
+    }
+}
+
+/// `summary.json`.
+#[derive(Debug, Serialize)]
+pub struct Summary {
+    pub crate_version: &'static str,
+    pub config: Config,
+    pub runs: Vec<RunSummary>,
+    pub wall_s: f64,
+}
+
+/// One run in `summary.json`.
+#[derive(Debug, Serialize)]
+pub struct RunSummary {
+    #[serde(flatten)]
+    pub record: RunRecord,
+    /// Mean of the greedy test returns (absent when the run was stopped before testing).
+    pub mean_test_return: Option<f64>,
+    /// Moving average of the last `window` training returns.
+    pub final_moving_average: Option<f64>,
+    /// Best moving average over the run.
+    pub best_moving_average: Option<f64>,
+    /// First episode (1-based) whose moving average reached the best value.
+    pub best_moving_average_episode: Option<u32>,
+}
+
+impl Summary {
+    pub fn new(config: &Config) -> Self {
+        Self {
+            crate_version: env!("CARGO_PKG_VERSION"),
+            config: config.clone(),
+            runs: Vec::new(),
+            wall_s: 0.0,
+        }
+    }
+
+    pub fn push(&mut self, run: RunSummary) {
+        self.runs.push(run);
+    }
+
+    /// Some run was stopped by the user.
+    pub fn stopped(&self) -> bool {
+        self.runs.iter().any(|r| r.record.stopped)
+    }
+}
+
+impl RunSummary {
+    pub fn new(record: RunRecord, rewards: &[f64], window: usize) -> Self {
+        let averages = moving_average(rewards, window);
+        let best = averages
+            .iter()
+            .enumerate()
+            .fold(None, |best: Option<(usize, f64)>, (i, &a)| match best {
+                Some((_, b)) if b >= a => best,
+                _ => Some((i, a)),
+            });
+        let mean_test_return = (!record.test_returns.is_empty())
+            .then(|| record.test_returns.iter().sum::<f64>() / record.test_returns.len() as f64);
+        Self {
+            record,
+            mean_test_return,
+            final_moving_average: averages.last().copied(),
+            best_moving_average: best.map(|(_, a)| a),
+            best_moving_average_episode: best.map(|(i, _)| (i + window) as u32),
+        }
+    }
+}
+
+/// Means of every full window of `window` consecutive values (the paper's learning curves
+/// average 10 episodes). Element `i` covers values `i ..= i + window - 1`.
+pub fn moving_average(values: &[f64], window: usize) -> Vec<f64> {
+    if window == 0 || values.len() < window {
+        return Vec::new();
+    }
+    values
+        .windows(window)
+        .map(|w| w.iter().sum::<f64>() / window as f64)
+        .collect()
+}
+
+/// Writes `summary.json` atomically: a reader never sees half a file.
+pub fn write_summary(path: &Path, summary: &Summary) -> Result<()> {
+    let tmp = path.with_extension("json.tmp");
+    let write = || -> std::io::Result<()> {
+        let mut file = File::create(&tmp)?;
+        serde_json::to_writer_pretty(&mut file, summary)?;
+        file.write_all(b"\n")?;
+        file.sync_all()?;
+        std::fs::rename(&tmp, path)
+    };
+    write().with_context(|| format!("writing {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn moving_average_covers_full_windows_only() {
+        // (1+2+3)/3 = 2, (2+3+4)/3 = 3, (3+4+5)/3 = 4
+        assert_eq!(
+            moving_average(&[1.0, 2.0, 3.0, 4.0, 5.0], 3),
+            vec![2.0, 3.0, 4.0]
+        );
+        assert!(moving_average(&[1.0, 2.0], 3).is_empty());
+    }
+
+    #[test]
+    fn the_best_window_is_dated_by_its_last_episode() {
+        let record = RunRecord {
+            run: 0,
+            method: "dqn[4]".into(),
+            seed: 0,
+            episodes: 5,
+            steps: 0,
+            updates: 0,
+            test_returns: vec![10.0, 20.0],
+            stopped: false,
+            wall_s: 0.0,
+        };
+        let s = RunSummary::new(record, &[1.0, 5.0, 3.0, 9.0, 1.0], 2);
+        // windows: 3, 4, 6, 5 → best 6 over episodes 3–4.
+        assert_eq!(s.best_moving_average, Some(6.0));
+        assert_eq!(s.best_moving_average_episode, Some(4));
+        assert_eq!(s.final_moving_average, Some(5.0));
+        assert_eq!(s.mean_test_return, Some(15.0));
+    }
+}

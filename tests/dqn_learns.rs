@@ -1,0 +1,51 @@
+//! DQN learns CartPole-v1: a `[100]` network reaches a moving average of 10 returns of at
+//! least 195 within a fixed budget and seed.
+
+use std::path::Path;
+use std::sync::mpsc;
+
+use sapnet::config::{Config, Method};
+use sapnet::trainer::{self, DqnRunSpec, Event};
+
+#[test]
+fn a_100_unit_dqn_learns_cartpole() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/configs/learn_cartpole.ron");
+    let config = Config::from_file(&path).unwrap();
+    let Method::Dqn { hidden } = &config.protocol.methods[0] else {
+        panic!("the learning config runs a DQN");
+    };
+    let spec = DqnRunSpec {
+        run: 0,
+        method: trainer::dqn_label(hidden),
+        env: config.env.clone(),
+        dqn: config.dqn.clone(),
+        hidden: hidden.clone(),
+        episodes: config.protocol.episodes,
+        max_steps: None,
+        test_episodes: config.protocol.test_episodes,
+        seed: config.seed,
+    };
+    let (events, received) = mpsc::channel();
+    let (_commands, commands) = mpsc::channel();
+    let outcome = trainer::train(&spec, &events, &commands).unwrap();
+    drop(events);
+
+    let rewards: Vec<f64> = received
+        .iter()
+        .filter_map(|e| match e {
+            Event::EpisodeEnded(r) => Some(r.reward),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(rewards.len() as u32, config.protocol.episodes);
+    let best = rewards
+        .windows(10)
+        .map(|w| w.iter().sum::<f64>() / 10.0)
+        .fold(f64::MIN, f64::max);
+    assert!(
+        best >= 195.0,
+        "best MA(10) {best:.1} < 195 in {} episodes",
+        rewards.len()
+    );
+    assert_eq!(outcome.record.test_returns.len(), 5);
+}

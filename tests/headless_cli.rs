@@ -1,0 +1,168 @@
+//! Headless mode driven as a user would: the binary, its files and its exit codes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn sapnet(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn config(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/configs")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// `episodes.csv` without its `wall_s` column, which measures the machine, not the run.
+fn episodes_without_time(dir: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(dir.join("episodes.csv")).unwrap();
+    text.lines()
+        .map(|line| line.rsplit_once(',').unwrap().0.to_string())
+        .collect()
+}
+
+fn run_short(out: &Path, seed: &str) -> Output {
+    sapnet(&[
+        "--headless",
+        "--config",
+        &config("short_cartpole.ron"),
+        "--seed",
+        seed,
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
+#[test]
+fn the_same_seed_gives_the_same_episodes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b, c) = (
+        tmp.path().join("a"),
+        tmp.path().join("b"),
+        tmp.path().join("c"),
+    );
+    for (dir, seed) in [(&a, "7"), (&b, "7"), (&c, "8")] {
+        let output = run_short(dir, seed);
+        assert!(output.status.success(), "{}", stderr(&output));
+    }
+    let first = episodes_without_time(&a);
+    assert_eq!(
+        first[0],
+        "run,method,episode,reward,steps,loss,statistic_loss,epsilon"
+    );
+    assert_eq!(first.len(), 1 + 2 * 30, "two runs of 30 episodes");
+    assert_eq!(first, episodes_without_time(&b));
+    assert_ne!(first, episodes_without_time(&c));
+}
+
+#[test]
+fn a_run_writes_its_summary_and_policies() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let output = run_short(&out, "1");
+    assert!(output.status.success(), "{}", stderr(&output));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let runs = summary["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    for run in runs {
+        assert_eq!(run["method"], "dqn[16]");
+        assert_eq!(run["episodes"], 30);
+        assert_eq!(run["test_returns"].as_array().unwrap().len(), 2);
+        assert_eq!(run["stopped"], false);
+    }
+    for run in 0..2 {
+        let stem: PathBuf = out.join("policies").join(format!("dqn_16_-run{run}"));
+        assert!(stem.with_extension("safetensors").exists());
+        assert!(stem.with_extension("ron").exists());
+    }
+}
+
+#[test]
+fn results_are_not_overwritten_without_force() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    assert!(run_short(&out, "1").status.success());
+    let before = std::fs::read(out.join("episodes.csv")).unwrap();
+
+    let refused = run_short(&out, "2");
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(
+        stderr(&refused).contains("already holds results"),
+        "{}",
+        stderr(&refused)
+    );
+    assert!(stderr(&refused).contains("--force"), "{}", stderr(&refused));
+    assert_eq!(std::fs::read(out.join("episodes.csv")).unwrap(), before);
+
+    let forced = sapnet(&[
+        "--headless",
+        "--config",
+        &config("short_cartpole.ron"),
+        "--seed",
+        "2",
+        "--force",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(forced.status.success(), "{}", stderr(&forced));
+}
+
+#[test]
+fn an_unknown_config_path_is_exit_code_2() {
+    let output = sapnet(&["--headless", "--config", "no/such/file.ron"]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output).contains("no/such/file.ron"),
+        "{}",
+        stderr(&output)
+    );
+}
+
+#[test]
+fn an_unwritable_out_is_exit_code_2() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("a-file");
+    std::fs::write(&file, "not a directory").unwrap();
+    let out = file.join("out");
+    let output = run_short(&out, "1");
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output).contains("output directory"),
+        "{}",
+        stderr(&output)
+    );
+}
+
+#[test]
+fn a_bad_field_is_exit_code_2_with_its_location() {
+    let tmp = tempfile::tempdir().unwrap();
+    let bad = tmp.path().join("bad.ron");
+    std::fs::write(&bad, "(\n  dqn: (gamma: \"high\"),\n)\n").unwrap();
+    let output = sapnet(&["--headless", "--config", bad.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(message.contains("line 2"), "{message}");
+    assert!(message.contains("dqn.gamma"), "{message}");
+}
+
+#[test]
+fn the_env_subcommand_prints_every_episode() {
+    let output = sapnet(&["env", "--episodes", "3", "--seed", "1"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let stdout = String::from_utf8(output.stdout).unwrap();
+    assert!(
+        stdout.starts_with("CartPole-v1: 3 random-action episodes"),
+        "{stdout}"
+    );
+    assert_eq!(stdout.lines().count(), 2 + 3 + 1, "{stdout}");
+}
