@@ -18,9 +18,19 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match sapnet::app::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        // `sapnet teach --headless --json | head`: the reader left, nothing to report.
+        Err(err) if is_broken_pipe(&err) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("error: {err:#}");
             ExitCode::from(2)
         }
     }
+}
+
+fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    err.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
 }

@@ -81,7 +81,7 @@ fn a_run_writes_its_summary_and_policies() {
         assert_eq!(run["stopped"], false);
     }
     for run in 0..2 {
-        let stem: PathBuf = out.join("policies").join(format!("dqn_16_-run{run}"));
+        let stem: PathBuf = out.join("policies").join(format!("dqn-16-run{run}"));
         assert!(stem.with_extension("safetensors").exists());
         assert!(stem.with_extension("ron").exists());
     }

@@ -6,7 +6,8 @@
 //!   loss, statistic_loss, epsilon, wall_s`), flushed as episodes end, so a stopped run
 //!   keeps every finished episode;
 //! - `summary.json`: the config, each run's test returns and totals, whether it was stopped;
-//! - `policies/<method>-run<r>.{safetensors,ron}`: each trained network with its metadata.
+//! - `policies/<method>-run<r>.{safetensors,ron}` (e.g. `dqn-100-100-run0`): each trained
+//!   network with its metadata, in the policy library's format.
 
 mod progress;
 mod results;
@@ -80,11 +81,7 @@ pub fn run(
             .join()
             .map_err(|_| anyhow::anyhow!("the trainer thread of {} panicked", spec.method))?;
         commands = returned;
-        let name = format!(
-            "{}-run{}",
-            spec.method.replace(['[', ']', ','], "_"),
-            spec.run
-        );
+        let name = policy_file_name(&spec.method, spec.run);
         let policies = output.dir.join("policies");
         match outcome {
             Ok(outcome) => {
@@ -136,6 +133,16 @@ pub fn run(
     summary.wall_s = started.elapsed().as_secs_f64();
     results::write_summary(&output.dir.join("summary.json"), &summary)?;
     Ok(summary)
+}
+
+/// `dqn[100,100]`, run 0 → `dqn-100-100-run0`: a plain file name.
+fn policy_file_name(method: &str, run: u32) -> String {
+    let plain: String = method
+        .chars()
+        .filter(|&c| c != ']')
+        .map(|c| if c == '[' || c == ',' { '-' } else { c })
+        .collect();
+    format!("{plain}-run{run}")
 }
 
 /// One spec per (method, run), each with its own seed derived from the run seed.
@@ -196,5 +203,16 @@ fn policy_info(config: &Config, record: &trainer::RunRecord) -> PolicyInfo {
         },
         seed: record.seed,
         final_score,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn policy_file_names_are_plain() {
+        assert_eq!(policy_file_name("dqn[100,100]", 0), "dqn-100-100-run0");
+        assert_eq!(policy_file_name("dqn[16]", 3), "dqn-16-run3");
     }
 }
