@@ -2,6 +2,7 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::time::{SystemTime, UNIX_EPOCH};
 
@@ -77,8 +78,11 @@ fn run_experiment(cli: &Cli) -> Result<()> {
 
     let (commands, commands_rx) = mpsc::channel();
     let on_interrupt = commands.clone();
+    let interrupted = AtomicBool::new(false);
     ctrlc::set_handler(move || {
-        eprintln!("\ninterrupted: finishing the current step, keeping what was written");
+        if !interrupted.swap(true, Ordering::Relaxed) {
+            eprintln!("\ninterrupted: finishing the current step, keeping what was written");
+        }
         let _ = on_interrupt.send(trainer::Command::Stop);
     })
     .context("installing the Ctrl-C handler")?;
