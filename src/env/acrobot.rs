@@ -330,11 +330,7 @@ impl Environment for Acrobot {
     }
 
     fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
-        let state = state.try_into().map_err(|_| StateError::WrongLength {
-            env: "Acrobot",
-            expected: 4,
-            got: state.len(),
-        })?;
+        let state = StateError::check_length("Acrobot", state)?;
         self.set(state);
         Ok(())
     }

@@ -144,11 +144,7 @@ impl Environment for CartPole {
     }
 
     fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
-        self.state = state.try_into().map_err(|_| StateError::WrongLength {
-            env: "CartPole",
-            expected: 4,
-            got: state.len(),
-        })?;
+        self.state = StateError::check_length("CartPole", state)?;
         self.sin_cos_theta = self.state[2].sin_cos();
         Ok(())
     }

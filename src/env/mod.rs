@@ -51,6 +51,17 @@ pub enum StateError {
     },
 }
 
+impl StateError {
+    /// `state` as the fixed-size array an environment keeps, or the error naming `env`.
+    fn check_length<const N: usize>(env: &'static str, state: &[f64]) -> Result<[f64; N], Self> {
+        state.try_into().map_err(|_| StateError::WrongLength {
+            env,
+            expected: N,
+            got: state.len(),
+        })
+    }
+}
+
 /// A Gymnasium-shaped episodic environment with discrete actions.
 pub trait Environment: Send {
     /// Gymnasium's environment id, e.g. `CartPole-v1`.

@@ -97,11 +97,7 @@ impl Environment for MountainCar {
     }
 
     fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
-        self.state = state.try_into().map_err(|_| StateError::WrongLength {
-            env: "MountainCar",
-            expected: 2,
-            got: state.len(),
-        })?;
+        self.state = StateError::check_length("MountainCar", state)?;
         Ok(())
     }
 

@@ -113,7 +113,7 @@ pub fn run(
                     final_score: None,
                 };
                 let saved = policy_store::save(&policies, &name, &last_good, &info).is_ok();
-                progress.finish();
+                progress.finish(false);
                 bail!(
                     "policy {method} (run {run}) diverged: {source}; {}",
                     if saved {
@@ -129,7 +129,7 @@ pub fn run(
             Err(err) => return Err(err.into()),
         }
     }
-    progress.finish();
+    progress.finish(!summary.stopped());
     summary.wall_s = started.elapsed().as_secs_f64();
     results::write_summary(&output.dir.join("summary.json"), &summary)?;
     Ok(summary)

@@ -83,9 +83,14 @@ impl Progress {
         }
     }
 
-    pub fn finish(&mut self) {
+    /// Ends the bar; `complete` false leaves it where it stopped.
+    pub fn finish(&mut self, complete: bool) {
         if let Some(bar) = self.bar.take() {
-            bar.finish();
+            if complete {
+                bar.finish();
+            } else {
+                bar.abandon();
+            }
         }
     }
 }
