@@ -300,17 +300,25 @@ impl Config {
             "a number in [0, 1]",
             d.gamma,
         )?;
+        let positive = |x: f64| x > 0.0 && x.is_finite();
         check(
-            d.learning_rate > 0.0,
+            positive(d.learning_rate),
             "dqn.learning_rate",
-            "a number > 0",
+            "a finite number > 0",
             d.learning_rate,
         )?;
         check(
-            d.adam_epsilon > 0.0,
+            positive(d.adam_epsilon),
             "dqn.adam_epsilon",
-            "a number > 0",
+            "a finite number > 0",
             d.adam_epsilon,
+        )?;
+        let (beta1, beta2) = d.adam_betas;
+        check(
+            (0.0..1.0).contains(&beta1) && (0.0..1.0).contains(&beta2),
+            "dqn.adam_betas",
+            "(β₁, β₂) with each in [0, 1)",
+            format!("({beta1}, {beta2})"),
         )?;
         check(
             d.batch_size > 0,
@@ -337,7 +345,7 @@ impl Config {
             d.target_update_interval,
         )?;
         check(
-            d.huber_delta > 0.0,
+            positive(d.huber_delta),
             "dqn.huber_delta",
             "a number > 0",
             d.huber_delta,

@@ -4,9 +4,13 @@
 //!
 //! - [`sapnet`]: the paper's section II — categories, the policy graph, selection,
 //!   activation and spreading. Pure maths.
-//! - [`env`]: native CartPole, MountainCar and Acrobot, exact to Gymnasium.
-//! - [`config`]: the RON run configuration, with the paper's values as defaults.
+//! - [`env`](mod@env): native CartPole, MountainCar and Acrobot, with Gymnasium's dynamics
+//!   to the bit.
+//! - [`dqn`]: the DQN on candle; [`policy_store`]: policies on disk.
+//! - [`trainer`]: training runs on their own thread, reporting through events;
+//!   [`headless`]: the scripted front end over those events.
 //! - [`teach`]: stepping activation and spreading by hand on a small graph.
+//! - [`config`]: the RON run configuration, with the paper's values as defaults.
 
 pub mod app;
 pub mod assets;

@@ -7,6 +7,7 @@ use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
 use crate::env::Environment;
+use crate::seeds;
 
 /// How one episode went.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -17,13 +18,15 @@ pub struct EpisodeSummary {
     pub terminated: bool,
 }
 
-/// Runs `episodes` episodes, actions drawn uniformly from a generator seeded with `seed`;
-/// the first reset uses `seed` too, later ones continue the environment's generator.
+/// Runs `episodes` episodes with actions drawn uniformly. The actions and the environment's
+/// resets draw from two streams derived from `seed`; resets after the first continue the
+/// environment's generator.
 pub fn run(env: &mut dyn Environment, episodes: u32, seed: u64) -> Vec<EpisodeSummary> {
-    let mut rng = StdRng::seed_from_u64(seed);
+    let mut rng = StdRng::seed_from_u64(seeds::derive(seed, &[0]));
+    let env_seed = seeds::derive(seed, &[1]);
     (0..episodes)
         .map(|episode| {
-            env.reset((episode == 0).then_some(seed));
+            env.reset((episode == 0).then_some(env_seed));
             let mut summary = EpisodeSummary {
                 steps: 0,
                 episode_return: 0.0,

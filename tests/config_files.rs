@@ -12,13 +12,6 @@ fn asset(name: &str) -> std::path::PathBuf {
 }
 
 #[test]
-fn every_shipped_run_config_loads() {
-    for name in ["cartpole.ron", "mountain_car.ron", "acrobot.ron"] {
-        Config::from_file(&asset(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-    }
-}
-
-#[test]
 fn the_cartpole_config_spells_out_the_defaults() {
     // assets/cartpole.ron writes every field; it must say exactly what the code defaults
     // to, so that reading the file tells the truth about a run without it.
@@ -94,4 +87,41 @@ fn an_out_of_range_value_names_the_field() {
 fn a_missing_file_names_the_path() {
     let err = Config::from_file(Path::new("no/such/config.ron")).unwrap_err();
     assert!(err.to_string().contains("no/such/config.ron"), "{err}");
+}
+
+#[test]
+fn every_shipped_config_loads() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dirs = [
+        root.join("assets"),
+        root.join("benches/configs"),
+        root.join("tests/configs"),
+    ];
+    let mut loaded = 0;
+    for dir in dirs {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            // Teaching graphs have their own schema (tests/teach_cli.rs loads them).
+            if path.extension().is_some_and(|e| e == "ron") && !name.starts_with("teach_") {
+                Config::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
+                loaded += 1;
+            }
+        }
+    }
+    assert!(loaded >= 10, "only {loaded} configs found");
+}
+
+#[test]
+fn adam_betas_must_be_below_one() {
+    let err = Config::from_ron("(dqn: (adam_betas: (1.0, 0.999)))", "bad.ron").unwrap_err();
+    assert!(err.to_string().contains("dqn.adam_betas"), "{err}");
+}
+
+#[test]
+fn prototype_weights_that_would_make_a_distance_nonpositive_are_refused() {
+    // 1 + δ·ω = 1 − 0.5·3 = −0.5: two policies of one category would be at distance −0.5.
+    let text = "(sapnet: (prototypes: [(prototype: HiddenLayers, omega: 3.0)], delta: -0.5))";
+    let err = Config::from_ron(text, "bad.ron").unwrap_err();
+    assert!(err.to_string().contains("delta"), "{err}");
 }

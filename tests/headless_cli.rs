@@ -166,3 +166,34 @@ fn the_env_subcommand_prints_every_episode() {
     );
     assert_eq!(stdout.lines().count(), 2 + 3 + 1, "{stdout}");
 }
+
+#[test]
+fn a_diverging_run_stops_with_an_error_and_keeps_its_last_good_weights() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let output = sapnet(&[
+        "--headless",
+        "--config",
+        &config("diverging_cartpole.ron"),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(
+        message.contains("policy dqn[8] (run 0) diverged"),
+        "{message}"
+    );
+    assert!(message.contains("at step"), "{message}");
+    assert!(message.contains("last good weights are in"), "{message}");
+
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert!(summary["error"].as_str().unwrap().contains("diverged"));
+
+    let policy = sapnet::policy_store::load(&out.join("policies"), "dqn-8-run0").unwrap();
+    for (name, tensor) in policy.net.named_parameters() {
+        let values = tensor.flatten_all().unwrap().to_vec1::<f32>().unwrap();
+        assert!(values.iter().all(|v| v.is_finite()), "{name} is not finite");
+    }
+}

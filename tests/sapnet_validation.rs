@@ -20,25 +20,23 @@ fn a_weight_that_is_not_positive_and_finite_names_its_pair() {
 }
 
 #[test]
-fn eq5_pushing_a_weight_to_zero_names_the_pair() {
+fn eq5_pushing_a_weight_to_zero_is_refused_at_its_parameters() {
     let policies: Vec<_> = [1, 2, 1]
         .iter()
         .map(|&l| PolicyDescription::new(vec![100; l], "CartPole-v1"))
         .collect();
-    // δ·ω_c = −10·0.1 = −1: the same-category pair (0, 2) would weigh 1 − 1 = 0.
+    // δ·ω_c = −10·0.1 = −1: the same-category pair (0, 2) would weigh 1 − 1 = 0. The
+    // parameters alone say so, before any graph is built.
     let params = SapNetParams {
         delta: -10.0,
         ..SapNetParams::default()
     };
     let err = Graph::from_categories(&policies, &params).unwrap_err();
-    assert_eq!(
-        err,
-        SapNetError::BadWeight {
-            i: 0,
-            j: 2,
-            weight: 0.0
-        }
+    assert!(
+        matches!(&err, SapNetError::BadParameter { name, .. } if name == "delta"),
+        "{err:?}"
     );
+    assert!(err.to_string().contains("1 + δ·Σω_c > 0"), "{err}");
 }
 
 #[test]
@@ -158,4 +156,36 @@ fn initial_activations_must_fit_the_graph() {
         SapNet::with_activations(graph(), p(), vec![0.0, f64::NAN]).unwrap_err(),
         SapNetError::BadActivation { i: 1, .. }
     ));
+}
+
+#[test]
+fn a_graph_whose_walks_would_explode_is_refused() {
+    // Six policies, degree up to 5, weight 0.05, T_ω = 1: walks go ⌊1/0.05⌋ + 1 = 21 hops
+    // deep, up to Σ 5^h ≈ 6·10^14 calls for one activation.
+    let mut edges: Vec<(usize, usize, f64)> = (1..6).map(|j| (0, j, 0.05)).collect();
+    edges.extend([
+        (1, 2, 0.05),
+        (2, 3, 0.05),
+        (3, 4, 0.05),
+        (4, 5, 0.05),
+        (5, 1, 0.05),
+    ]);
+    let graph = Graph::from_edges(6, edges).unwrap();
+    let err = SapNet::new(graph, SapNetParams::default()).unwrap_err();
+    assert!(
+        matches!(err, SapNetError::UnboundedSpreading { degree: 5, .. }),
+        "{err:?}"
+    );
+    assert!(err.to_string().contains("lightest edge 0.05"), "{err}");
+
+    // Two policies ping-ponging: degree 1 but 10^9 hops.
+    let graph = Graph::from_edges(2, [(0, 1, 1e-9)]).unwrap();
+    assert!(matches!(
+        SapNet::new(graph, SapNetParams::default()),
+        Err(SapNetError::UnboundedSpreading { degree: 1, .. })
+    ));
+
+    // The paper's Fig. 2 at weight 0.4 is fine: 3 hops, at most 3 + 9 + 27 calls.
+    let fig2 = Graph::from_edges(4, [(0, 1, 0.4), (0, 2, 0.4), (1, 2, 0.4), (1, 3, 0.4)]).unwrap();
+    assert!(SapNet::new(fig2, SapNetParams::default()).is_ok());
 }

@@ -128,6 +128,15 @@ impl DqnAgent {
         }
         let grad_q = Tensor::from_vec(grad_q, q.shape(), &Device::Cpu)?;
         let grads = self.online.backward(&layer_inputs, grad_q)?;
+        // A finite loss can still overflow in the backward pass; with finite gradients and
+        // the validated Adam parameters the step keeps every weight finite, so the weights
+        // are never worse than "last good".
+        for grad in &grads {
+            if !with_f32(grad, |g| g.iter().all(|x| x.is_finite()))? {
+                let (step, update) = (self.steps, self.updates + 1);
+                return Err(DqnError::NonFiniteGradient { step, update, loss });
+            }
+        }
         self.optimizer.step(self.online.parameters(), &grads)?;
 
         self.updates += 1;

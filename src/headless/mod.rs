@@ -22,12 +22,12 @@ use anyhow::{bail, Context, Result};
 use crate::config::{Config, Method};
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::seeds;
-use crate::trainer::{self, dqn_label, Command, DqnRunSpec, Event, TrainerError};
+use crate::trainer::{self, dqn_label, Command, Divergence, DqnRunSpec, Event, TrainerError};
 
 pub use results::{RunSummary, Summary};
 
-/// Files that mark a directory as holding results already.
-const RESULT_FILES: [&str; 2] = ["episodes.csv", "summary.json"];
+/// Entries that mark a directory as holding results already.
+const RESULT_FILES: [&str; 3] = ["episodes.csv", "summary.json", "policies"];
 
 /// Where results go and whether old ones may be replaced.
 #[derive(Debug, Clone)]
@@ -85,9 +85,13 @@ pub fn run(
         let policies = output.dir.join("policies");
         match outcome {
             Ok(outcome) => {
-                let info = policy_info(config, &outcome.record);
-                policy_store::save(&policies, &name, &outcome.net, &info)
-                    .with_context(|| format!("saving the trained {}", spec.method))?;
+                // A run stopped before its first step (Ctrl-C during the previous run's
+                // greedy test) trained nothing worth keeping.
+                if outcome.record.steps > 0 {
+                    let info = policy_info(config, &outcome.record);
+                    policy_store::save(&policies, &name, &outcome.net, &info)
+                        .with_context(|| format!("saving the trained {}", spec.method))?;
+                }
                 summary.push(RunSummary::new(
                     outcome.record,
                     &rewards,
@@ -97,34 +101,37 @@ pub fn run(
                     break;
                 }
             }
-            Err(TrainerError::Diverged {
-                method,
-                run,
-                source,
-                last_good,
-            }) => {
+            Err(TrainerError::Diverged(divergence)) => {
+                let Divergence {
+                    method,
+                    run,
+                    source,
+                    episodes,
+                    steps,
+                    last_good,
+                } = *divergence;
                 let info = PolicyInfo {
                     source_task: config.env.clone(),
                     training: TrainingBudget {
-                        episodes: 0,
-                        steps: 0,
+                        episodes: u64::from(episodes),
+                        steps,
                     },
                     seed: spec.seed,
                     final_score: None,
                 };
-                let saved = policy_store::save(&policies, &name, &last_good, &info).is_ok();
+                let kept = match policy_store::save(&policies, &name, &last_good, &info) {
+                    Ok(_) => format!(
+                        "its last good weights are in {}",
+                        policies.join(&name).display()
+                    ),
+                    Err(err) => format!("its last good weights could not be saved: {err}"),
+                };
                 progress.finish(false);
-                bail!(
-                    "policy {method} (run {run}) diverged: {source}; {}",
-                    if saved {
-                        format!(
-                            "its last good weights are in {}",
-                            policies.join(&name).display()
-                        )
-                    } else {
-                        "its last good weights could not be saved".to_string()
-                    }
-                );
+                let message = format!("policy {method} (run {run}) diverged: {source}; {kept}");
+                summary.error = Some(message.clone());
+                summary.wall_s = started.elapsed().as_secs_f64();
+                results::write_summary(&output.dir.join("summary.json"), &summary)?;
+                bail!(message);
             }
             Err(err) => return Err(err.into()),
         }
@@ -188,6 +195,12 @@ fn prepare_output(output: &OutputOptions) -> Result<()> {
             output.dir.display(),
             existing.join(", ")
         );
+    }
+    // Old policies must not sit beside new results as if this run had trained them.
+    let policies = output.dir.join("policies");
+    if policies.exists() {
+        std::fs::remove_dir_all(&policies)
+            .with_context(|| format!("removing the old results in {}", policies.display()))?;
     }
     Ok(())
 }

@@ -41,6 +41,8 @@ pub struct Summary {
     pub config: Config,
     pub runs: Vec<RunSummary>,
     pub wall_s: f64,
+    /// Why the experiment ended early, if it failed (the runs above finished before).
+    pub error: Option<String>,
 }
 
 /// One run in `summary.json`.
@@ -65,6 +67,7 @@ impl Summary {
             config: config.clone(),
             runs: Vec::new(),
             wall_s: 0.0,
+            error: None,
         }
     }
 
@@ -122,7 +125,10 @@ pub fn write_summary(path: &Path, summary: &Summary) -> Result<()> {
         file.sync_all()?;
         std::fs::rename(&tmp, path)
     };
-    write().with_context(|| format!("writing {}", path.display()))
+    write().map_err(|err| {
+        let _ = std::fs::remove_file(&tmp);
+        anyhow::Error::new(err).context(format!("writing {}", path.display()))
+    })
 }
 
 #[cfg(test)]

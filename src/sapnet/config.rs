@@ -82,7 +82,8 @@ impl Default for SapNetParams {
 
 impl SapNetParams {
     /// Checks what the types cannot: T_ω and τ finite and > 0 (a walk must be able to
-    /// stop, a softmax must be defined), 𝒜, δ and every ω_c finite, bucket widths ≥ 1.
+    /// stop, a softmax must be defined), 𝒜, δ and every ω_c finite, bucket widths ≥ 1, and
+    /// every edge eq. 5 can produce heavier than 0.
     pub fn validate(&self) -> Result<(), SapNetError> {
         let bad = |name: &str, value: f64, expected| SapNetError::BadParameter {
             name: name.to_string(),
@@ -112,6 +113,22 @@ impl SapNetParams {
             if let Prototype::UnitsBucket { width: 0 } = weighted.prototype {
                 return Err(bad(&format!("prototypes[{c}].width"), 0.0, "at least 1"));
             }
+        }
+        // Two policies that share every category are joined by 1 + δ·Σ ω_c (eq. 3, 5); the
+        // lightest that can happen must still be a positive distance.
+        let lightest = 1.0
+            + self
+                .prototypes
+                .iter()
+                .map(|p| (self.delta * p.omega).min(0.0))
+                .sum::<f64>();
+        if lightest <= 0.0 {
+            return Err(bad(
+                "delta",
+                self.delta,
+                "δ and ω_c with 1 + δ·Σω_c > 0, or policies sharing every category \
+                 would be joined by a weight ≤ 0",
+            ));
         }
         Ok(())
     }

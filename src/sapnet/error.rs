@@ -9,6 +9,18 @@ pub enum SapNetError {
          or spreading would never end"
     )]
     BadWeight { i: usize, j: usize, weight: f64 },
+    #[error(
+        "one activation could make up to {calls:.2e} spreading calls (lightest edge {lightest}, \
+         T_ω = {threshold}, a policy with {degree} neighbours); the limit is {limit:.0e}: \
+         raise the lightest weight or lower the threshold"
+    )]
+    UnboundedSpreading {
+        calls: f64,
+        limit: f64,
+        lightest: f64,
+        threshold: f64,
+        degree: usize,
+    },
     #[error("edge ({i}, {j}) names a policy that does not exist: there are {n} policies, numbered from 0")]
     EdgeOutOfRange { i: usize, j: usize, n: usize },
     #[error("edge ({i}, {i}) joins a policy to itself")]

@@ -27,6 +27,41 @@ pub use judgment::judge;
 pub use policy::PolicyDescription;
 pub use spreading::{Call, NoTrace, Spreader, Spreading, TraceSink, TraceStep};
 
+/// Most `spread` calls one activation may make. Positive weights make every walk end
+/// (eq. 10), but a light graph under a high threshold can still take longer than the age
+/// of the universe; refuse it rather than hang.
+pub const MAX_SPREAD_CALLS: f64 = 1e7;
+
+/// Bounds the calls of one activation: a call at hop h has Ω ≥ h·w_min, so calls go at most
+/// H = ⌊T_ω / w_min⌋ + 1 hops deep, and there are at most Σ_{h=1..H} d^h of them for the
+/// largest degree d.
+fn check_spreading_bound(graph: &Graph, threshold: f64) -> Result<(), SapNetError> {
+    let lightest = (0..graph.len())
+        .map(|i| graph.lightest(i))
+        .fold(f64::INFINITY, f64::min);
+    let degree = (0..graph.len()).map(|i| graph.degree(i)).max().unwrap_or(0);
+    if !lightest.is_finite() || degree == 0 {
+        return Ok(());
+    }
+    let hops = (threshold / lightest).floor() + 1.0;
+    let d = degree as f64;
+    let calls = if degree == 1 {
+        hops
+    } else {
+        d * (d.powf(hops) - 1.0) / (d - 1.0)
+    };
+    if calls > MAX_SPREAD_CALLS {
+        return Err(SapNetError::UnboundedSpreading {
+            calls,
+            limit: MAX_SPREAD_CALLS,
+            lightest,
+            threshold,
+            degree,
+        });
+    }
+    Ok(())
+}
+
 /// A SAP-Net with its activations 𝔸: what the transfer loop selects from and activates.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SapNet {
@@ -58,6 +93,7 @@ impl SapNet {
         activations: Vec<f64>,
     ) -> Result<Self, SapNetError> {
         params.validate()?;
+        check_spreading_bound(&graph, params.threshold)?;
         check_activations(graph.len(), &activations)?;
         Ok(Self {
             graph,

@@ -127,7 +127,12 @@ impl TeachConfig {
             Graph::from_categories(&self.descriptions, &params).map_err(in_field("descriptions"))?
         };
         let initial = self.initial.clone().unwrap_or_else(|| vec![0.0; n]);
-        let net = SapNet::with_activations(graph, params, initial).map_err(in_field("initial"))?;
+        let net = SapNet::with_activations(graph, params, initial).map_err(|e| match e {
+            SapNetError::UnboundedSpreading { .. } => {
+                format!("fields `edges` and `threshold`: {e}")
+            }
+            other => in_field("initial")(other),
+        })?;
         let names = if self.names.is_empty() {
             (0..n).map(|i| format!("π{i}")).collect()
         } else {

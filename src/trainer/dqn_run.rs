@@ -7,7 +7,7 @@ use rand::rngs::StdRng;
 use rand::SeedableRng;
 
 use super::events::{Command, EpisodeRecord, Event, RunRecord};
-use super::TrainerError;
+use super::{Divergence, TrainerError};
 use crate::config::DqnConfig;
 use crate::dqn::{Architecture, DqnAgent, QNet, ReplayBuffer, Transition};
 use crate::env::{self, EnvConfig, Environment};
@@ -113,12 +113,14 @@ pub fn train(
                 truncated: step.truncated,
             });
             if let Err(err) = agent.observe(&replay, &mut rng) {
-                return Err(TrainerError::Diverged {
+                return Err(TrainerError::Diverged(Box::new(Divergence {
                     method: spec.method.clone(),
                     run: spec.run,
                     source: err,
-                    last_good: Box::new(agent.into_online()),
-                });
+                    episodes: record.episodes,
+                    steps: agent.steps(),
+                    last_good: agent.into_online(),
+                })));
             }
             reward += step.reward;
             steps += 1;

@@ -16,7 +16,8 @@ pub struct EpisodeRecord {
     pub episode: u32,
     pub reward: f64,
     pub steps: u32,
-    /// Raw loss of the episode's last update (empty before learning starts).
+    /// Raw loss of the policy's latest update at the end of the episode (empty before
+    /// learning starts; with `update_interval` > 1 it may come from an earlier episode).
     pub loss: Option<f64>,
     /// The statistic loss E at the end of the episode.
     pub statistic_loss: f64,
@@ -31,8 +32,11 @@ pub struct EpisodeRecord {
 pub struct RunRecord {
     pub run: u32,
     pub method: MethodLabel,
+    /// The seed of this run's random streams, derived from the config's run seed, the
+    /// method's index and the run's index (`seeds::derive(seed, &[method, run])`).
     pub seed: u64,
-    /// Training episodes completed.
+    /// Training episodes completed (a step budget may cut a last, partial episode, which is
+    /// not counted; `steps` counts its steps).
     pub episodes: u32,
     pub steps: u64,
     pub updates: u64,

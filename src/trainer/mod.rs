@@ -15,14 +15,21 @@ use crate::dqn::{DqnError, QNet};
 pub enum TrainerError {
     #[error(transparent)]
     Dqn(#[from] DqnError),
-    /// The loss became NaN or infinite; `last_good` holds the weights before that update.
-    #[error("policy {method} (run {run}) diverged: {source}")]
-    Diverged {
-        method: String,
-        run: u32,
-        source: DqnError,
-        last_good: Box<QNet>,
-    },
+    /// The loss or a gradient became NaN or infinite.
+    #[error("policy {} (run {}) diverged: {}", .0.method, .0.run, .0.source)]
+    Diverged(Box<Divergence>),
+}
+
+/// A run that diverged: what it had done, and the weights before the update that failed.
+#[derive(Debug)]
+pub struct Divergence {
+    pub method: String,
+    pub run: u32,
+    pub source: DqnError,
+    /// Complete episodes and steps before the failure.
+    pub episodes: u32,
+    pub steps: u64,
+    pub last_good: QNet,
 }
 
 /// The label of a from-scratch DQN in results: `dqn[100,100]`.
