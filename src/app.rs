@@ -8,7 +8,7 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use anyhow::{Context, Result};
 
-use crate::cli::{Cli, Command, EnvArgs, TeachArgs};
+use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, TeachArgs};
 use crate::config::Config;
 use crate::headless::{self, OutputOptions};
 use crate::{assets, env, random_episodes, trainer};
@@ -17,6 +17,7 @@ pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Some(Command::Env(args)) => run_env(&cli, args),
         Some(Command::Teach(args)) => run_teach(&cli, args),
+        Some(Command::Sources(args)) => run_sources(&cli, args),
         None => run_experiment(&cli),
     }
 }
@@ -76,19 +77,7 @@ fn run_experiment(cli: &Cli) -> Result<()> {
         force: cli.run.force,
     };
 
-    let (commands, commands_rx) = mpsc::channel();
-    let on_interrupt = commands.clone();
-    let interrupted = AtomicBool::new(false);
-    ctrlc::set_handler(move || {
-        if !interrupted.swap(true, Ordering::Relaxed) {
-            eprintln!("\ninterrupted: finishing the current step, keeping what was written");
-        }
-        let _ = on_interrupt.send(trainer::Command::Stop);
-    })
-    .context("installing the Ctrl-C handler")?;
-
-    let summary = headless::run(&config, &output, commands_rx)?;
-    drop(commands);
+    let summary = headless::run(&config, &output, on_interrupt()?)?;
     let dir = output.dir.display();
     if summary.stopped() {
         eprintln!("stopped by the user: the episodes so far are in {dir}/episodes.csv, the summary in {dir}/summary.json");
@@ -114,6 +103,32 @@ fn run_experiment(cli: &Cli) -> Result<()> {
         );
     }
     Ok(())
+}
+
+fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
+    let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
+    let dir = crate::sources::train_library(&config, &args.library, args.retrain, on_interrupt()?)?;
+    eprintln!(
+        "{} source policies in {}",
+        config.sources.count,
+        dir.display()
+    );
+    Ok(())
+}
+
+/// The trainer's command channel, on which Ctrl-C asks it to stop. The handler keeps the
+/// sender for the life of the process.
+fn on_interrupt() -> Result<mpsc::Receiver<trainer::Command>> {
+    let (sender, commands) = mpsc::channel();
+    let interrupted = AtomicBool::new(false);
+    ctrlc::set_handler(move || {
+        if !interrupted.swap(true, Ordering::Relaxed) {
+            eprintln!("\ninterrupted: finishing the current step");
+        }
+        let _ = sender.send(trainer::Command::Stop);
+    })
+    .context("installing the Ctrl-C handler")?;
+    Ok(commands)
 }
 
 /// `out/<config stem>-<unix seconds>`: a new directory per run, so the default never

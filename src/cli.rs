@@ -51,6 +51,20 @@ pub enum Command {
     Env(EnvArgs),
     /// Step SAP-Net's activation and spreading by hand on a small graph.
     Teach(TeachArgs),
+    /// Train the library of source policies the config describes (`sources`: N random
+    /// architectures) and write it to <LIBRARY>/<task>/.
+    Sources(SourcesArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct SourcesArgs {
+    /// Replace a library already on disk.
+    #[arg(long)]
+    pub retrain: bool,
+
+    /// The policy library's root directory.
+    #[arg(long, value_name = "DIR", default_value = "saved_policies")]
+    pub library: PathBuf,
 }
 
 #[derive(Debug, Args)]

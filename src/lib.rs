@@ -23,5 +23,6 @@ pub mod policy_store;
 pub mod random_episodes;
 pub mod sapnet;
 pub mod seeds;
+pub mod sources;
 pub mod teach;
 pub mod trainer;

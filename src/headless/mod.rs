@@ -24,6 +24,7 @@ use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::seeds;
 use crate::trainer::{self, dqn_label, Command, Divergence, DqnRunSpec, Event, TrainerError};
 
+pub(crate) use progress::Progress;
 pub use results::{RunSummary, Summary};
 
 /// Entries that mark a directory as holding results already.
@@ -54,19 +55,8 @@ pub fn run(
     let mut commands = commands;
 
     for spec in specs {
-        let (events_tx, events_rx) = mpsc::channel();
-        let worker = {
-            let spec = spec.clone();
-            thread::Builder::new()
-                .name(format!("trainer {} run {}", spec.method, spec.run))
-                .spawn(move || {
-                    let outcome = trainer::train(&spec, &events_tx, &commands);
-                    (outcome, commands)
-                })
-                .context("starting the trainer thread")?
-        };
         let mut rewards = Vec::new();
-        for event in events_rx {
+        let (outcome, returned) = drive(&spec, commands, |event| {
             match event {
                 Event::RunStarted { run, method, .. } => progress.run_started(&method, run),
                 Event::EpisodeEnded(record) => {
@@ -76,10 +66,8 @@ pub fn run(
                 }
                 Event::RunEnded(_) => {}
             }
-        }
-        let (outcome, returned) = worker
-            .join()
-            .map_err(|_| anyhow::anyhow!("the trainer thread of {} panicked", spec.method))?;
+            Ok(())
+        })?;
         commands = returned;
         let name = policy_file_name(&spec.method, spec.run);
         let policies = output.dir.join("policies");
@@ -140,6 +128,35 @@ pub fn run(
     summary.wall_s = started.elapsed().as_secs_f64();
     results::write_summary(&output.dir.join("summary.json"), &summary)?;
     Ok(summary)
+}
+
+/// Trains `spec` on a thread of its own and hands its events to `on_event`, on this thread,
+/// as they arrive. Gives back the command receiver with the outcome, for the next run.
+pub(crate) fn drive(
+    spec: &DqnRunSpec,
+    commands: Receiver<Command>,
+    mut on_event: impl FnMut(Event) -> Result<()>,
+) -> Result<(
+    Result<trainer::DqnRunOutcome, TrainerError>,
+    Receiver<Command>,
+)> {
+    let (events_tx, events_rx) = mpsc::channel();
+    let worker = {
+        let spec = spec.clone();
+        thread::Builder::new()
+            .name(format!("trainer {} run {}", spec.method, spec.run))
+            .spawn(move || {
+                let outcome = trainer::train(&spec, &events_tx, &commands);
+                (outcome, commands)
+            })
+            .context("starting the trainer thread")?
+    };
+    for event in events_rx {
+        on_event(event)?;
+    }
+    worker
+        .join()
+        .map_err(|_| anyhow::anyhow!("the trainer thread of {} panicked", spec.method))
 }
 
 /// `dqn[100,100]`, run 0 → `dqn-100-100-run0`: a plain file name.

@@ -1,0 +1,175 @@
+//! `sapnet sources`: trains the library of source policies (paper III-B) — N DQNs of random
+//! architectures, "assuming that a person cannot manually design an optimal hidden layer" —
+//! and writes it to `<library>/<task>/source-<i>.{safetensors,ron}`.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::Receiver;
+
+use anyhow::{bail, Context, Result};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+use crate::config::Config;
+use crate::env::EnvConfig;
+use crate::headless::drive;
+use crate::policy_store::{self, PolicyInfo, TrainingBudget};
+use crate::seeds;
+use crate::trainer::{Command, DqnRunOutcome, DqnRunSpec, Event, TrainerError};
+
+/// Stream key of the source library's seeds, apart from the experiments' `[method, run]`.
+const SOURCES_STREAM: u64 = u64::MAX;
+
+/// One source policy to train.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourcePlan {
+    pub name: String,
+    pub hidden: Vec<usize>,
+    pub seed: u64,
+}
+
+/// The source task: `sources.env` when given, else the target task.
+pub fn source_task(config: &Config) -> &EnvConfig {
+    config.sources.env.as_ref().unwrap_or(&config.env)
+}
+
+/// `<library>/<source task>`, where the library of `config` lives.
+pub fn library_dir(library: &Path, config: &Config) -> PathBuf {
+    library.join(source_task(config).task_name())
+}
+
+/// The N architectures and seeds, drawn from the run seed: the number of hidden layers and
+/// the units of each layer uniformly from the config's inclusive ranges.
+pub fn plan(config: &Config) -> Vec<SourcePlan> {
+    let s = &config.sources;
+    let mut rng = StdRng::seed_from_u64(seeds::derive(config.seed, &[SOURCES_STREAM]));
+    (0..s.count)
+        .map(|i| {
+            let layers = rng.random_range(s.hidden_layers.0..=s.hidden_layers.1);
+            let hidden = (0..layers)
+                .map(|_| rng.random_range(s.units.0..=s.units.1))
+                .collect();
+            SourcePlan {
+                name: format!("source-{i}"),
+                hidden,
+                seed: seeds::derive(config.seed, &[SOURCES_STREAM, i as u64]),
+            }
+        })
+        .collect()
+}
+
+/// Trains every planned source, then writes them all. Nothing is written if one fails or
+/// the user stops, and a library already on disk is replaced only when `retrain` is set.
+pub fn train_library(
+    config: &Config,
+    library: &Path,
+    retrain: bool,
+    commands: Receiver<Command>,
+) -> Result<PathBuf> {
+    let dir = library_dir(library, config);
+    let existing = policy_store::list(&dir)?;
+    if !existing.is_empty() && !retrain {
+        bail!(
+            "{} already holds {} policies; pass --retrain to replace them",
+            dir.display(),
+            existing.len()
+        );
+    }
+    let plans = plan(config);
+    let mut progress = crate::headless::Progress::new(
+        u64::from(config.sources.training_episodes) * plans.len() as u64,
+    );
+    let mut commands = commands;
+    let mut trained = Vec::with_capacity(plans.len());
+    for (i, source) in plans.iter().enumerate() {
+        let spec = DqnRunSpec {
+            run: i as u32,
+            method: source.name.clone(),
+            env: source_task(config).clone(),
+            dqn: config.dqn.clone(),
+            hidden: source.hidden.clone(),
+            episodes: config.sources.training_episodes,
+            max_steps: None,
+            test_episodes: config.protocol.test_episodes,
+            seed: source.seed,
+        };
+        let (outcome, returned) = drive(&spec, commands, |event| {
+            match event {
+                Event::RunStarted { method, .. } => progress.run_started(&method, 0),
+                Event::EpisodeEnded(record) => progress.episode(&record),
+                Event::RunEnded(_) => {}
+            }
+            Ok(())
+        })?;
+        commands = returned;
+        let outcome: DqnRunOutcome = outcome.map_err(|err: TrainerError| {
+            anyhow::Error::new(err).context(format!("training {}", source.name))
+        })?;
+        if outcome.record.stopped {
+            progress.finish(false);
+            bail!(
+                "stopped by the user: nothing in {} was changed",
+                dir.display()
+            );
+        }
+        trained.push(outcome);
+    }
+    progress.finish(true);
+
+    for (source, outcome) in plans.iter().zip(&trained) {
+        let returns = &outcome.record.test_returns;
+        let info = PolicyInfo {
+            source_task: source_task(config).clone(),
+            training: TrainingBudget {
+                episodes: u64::from(outcome.record.episodes),
+                steps: outcome.record.steps,
+            },
+            seed: source.seed,
+            final_score: (!returns.is_empty())
+                .then(|| returns.iter().sum::<f64>() / returns.len() as f64),
+        };
+        policy_store::save(&dir, &source.name, &outcome.net, &info)
+            .with_context(|| format!("writing {} to {}", source.name, dir.display()))?;
+    }
+    // A smaller library replaces a larger one: its extra sources must go.
+    for stale in existing
+        .iter()
+        .filter(|name| !plans.iter().any(|p| &p.name == *name))
+    {
+        let (weights, metadata) = policy_store::paths(&dir, stale);
+        for path in [metadata, weights] {
+            match std::fs::remove_file(&path) {
+                Err(err) if err.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(err)
+                        .with_context(|| format!("removing the old policy {}", path.display()));
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(dir)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plans_stay_in_range_and_follow_the_seed() {
+        let mut config = Config::default();
+        config.sources.count = 50;
+        let plans = plan(&config);
+        assert_eq!(plans.len(), 50);
+        for p in &plans {
+            assert!((1..=3).contains(&p.hidden.len()), "{p:?}");
+            assert!(p.hidden.iter().all(|u| (50..=150).contains(u)), "{p:?}");
+        }
+        // All three depths occur among 50 draws (a failure here is a broken draw, not luck:
+        // P(a depth missing) < 3·(2/3)^50 ≈ 5e-9).
+        for layers in 1..=3 {
+            assert!(plans.iter().any(|p| p.hidden.len() == layers));
+        }
+        assert_eq!(plans, plan(&config));
+        config.seed = 1;
+        assert_ne!(plans, plan(&config));
+    }
+}
