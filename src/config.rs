@@ -123,7 +123,9 @@ pub struct SourcesConfig {
     pub hidden_layers: (usize, usize),
     /// Inclusive range of units per hidden layer, drawn uniformly (around 100).
     pub units: (usize, usize),
-    /// Episodes each source policy trains on the source task.
+    /// Episodes each source policy trains on the source task (default: Table I's 5000 for
+    /// CartPole; with the paper's ε and target interval, a few hundred leave most sources
+    /// at ~10-step episodes, see BENCHMARKS.md "Learning").
     pub training_episodes: u32,
     /// The source task, when it differs from the target task (`None`: the same).
     pub env: Option<EnvConfig>,
@@ -135,7 +137,7 @@ impl Default for SourcesConfig {
             count: 10,
             hidden_layers: (1, 3),
             units: (50, 150),
-            training_episodes: 300,
+            training_episodes: 5000,
             env: None,
         }
     }
