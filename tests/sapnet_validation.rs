@@ -160,8 +160,8 @@ fn initial_activations_must_fit_the_graph() {
 
 #[test]
 fn a_graph_whose_walks_would_explode_is_refused() {
-    // Six policies, degree up to 5, weight 0.05, T_ω = 1: walks go ⌊1/0.05⌋ + 1 = 21 hops
-    // deep, up to Σ 5^h ≈ 6·10^14 calls for one activation.
+    // Six policies, degree up to 5, weight 0.05, T_ω = 1: walks deposit up to ⌊1/0.05⌋ = 20
+    // hops deep, up to Σ 5^h ≈ 1.2·10^14 deposits for one activation.
     let mut edges: Vec<(usize, usize, f64)> = (1..6).map(|j| (0, j, 0.05)).collect();
     edges.extend([
         (1, 2, 0.05),
@@ -185,7 +185,10 @@ fn a_graph_whose_walks_would_explode_is_refused() {
         Err(SapNetError::UnboundedSpreading { degree: 1, .. })
     ));
 
-    // The paper's Fig. 2 at weight 0.4 is fine: 3 hops, at most 3 + 9 + 27 calls.
-    let fig2 = Graph::from_edges(4, [(0, 1, 0.4), (0, 2, 0.4), (1, 2, 0.4), (1, 3, 0.4)]).unwrap();
-    assert!(SapNet::new(fig2, SapNetParams::default()).is_ok());
+    // The paper's Fig. 2 at weight 0.4 is fine: deposits 2 hops deep, at most 3 + 9.
+    // So is a hub with 5000 neighbours at Table II's 0.95: one hop, 5000 deposits (walks
+    // the threshold stops, 5000² of them, are not made, so they do not count).
+    let n = 5001;
+    let hub = Graph::from_edges(n, (1..n).map(|j| (0, j, 0.95))).unwrap();
+    assert!(SapNet::new(hub, SapNetParams::default()).is_ok());
 }

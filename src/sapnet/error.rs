@@ -10,7 +10,7 @@ pub enum SapNetError {
     )]
     BadWeight { i: usize, j: usize, weight: f64 },
     #[error(
-        "one activation could make up to {calls:.2e} spreading calls (lightest edge {lightest}, \
+        "one activation could make up to {calls:.2e} deposits (lightest edge {lightest}, \
          T_ω = {threshold}, a policy with {degree} neighbours); the limit is {limit:.0e}: \
          raise the lightest weight or lower the threshold"
     )]

@@ -27,14 +27,16 @@ pub use judgment::judge;
 pub use policy::PolicyDescription;
 pub use spreading::{Call, NoTrace, Spreader, Spreading, TraceSink, TraceStep};
 
-/// Most `spread` calls one activation may make. Positive weights make every walk end
-/// (eq. 10), but a light graph under a high threshold can still take longer than the age
-/// of the universe; refuse it rather than hang.
+/// Most depositing `spread` calls one activation may make. Positive weights make every
+/// walk end (eq. 10), but a light graph under a high threshold can still take longer than
+/// anyone will wait; refuse it rather than hang.
 pub const MAX_SPREAD_CALLS: f64 = 1e7;
 
-/// Bounds the calls of one activation: a call at hop h has Ω ≥ h·w_min, so calls go at most
-/// H = ⌊T_ω / w_min⌋ + 1 hops deep, and there are at most Σ_{h=1..H} d^h of them for the
-/// largest degree d.
+/// Bounds the depositing calls of one activation: a call at hop h has Ω ≥ h·w_min and
+/// deposits only while Ω < T_ω, so deposits happen at most H = ⌊T_ω / w_min⌋ hops deep
+/// (⌊⌋ rather than ⌈⌉ − 1 allows for rounding in Ω's sum), at most Σ_{h=1..H} d^h of them
+/// for the largest degree d. Calls the threshold stops are not made unless a trace asks
+/// for them (at most d per deposit more).
 fn check_spreading_bound(graph: &Graph, threshold: f64) -> Result<(), SapNetError> {
     let lightest = (0..graph.len())
         .map(|i| graph.lightest(i))
@@ -43,7 +45,7 @@ fn check_spreading_bound(graph: &Graph, threshold: f64) -> Result<(), SapNetErro
     if !lightest.is_finite() || degree == 0 {
         return Ok(());
     }
-    let hops = (threshold / lightest).floor() + 1.0;
+    let hops = (threshold / lightest).floor();
     let d = degree as f64;
     let calls = if degree == 1 {
         hops
