@@ -186,6 +186,8 @@ fn a_graph_whose_walks_would_explode_is_refused() {
     ));
 
     // The paper's Fig. 2 at weight 0.4 is fine: deposits 2 hops deep, at most 3 + 9.
+    let fig2 = Graph::from_edges(4, [(0, 1, 0.4), (0, 2, 0.4), (1, 2, 0.4), (1, 3, 0.4)]).unwrap();
+    assert!(SapNet::new(fig2, SapNetParams::default()).is_ok());
     // So is a hub with 5000 neighbours at Table II's 0.95: one hop, 5000 deposits (walks
     // the threshold stops, 5000² of them, are not made, so they do not count).
     let n = 5001;
