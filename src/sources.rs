@@ -14,7 +14,7 @@ use crate::env::EnvConfig;
 use crate::headless::drive;
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::seeds;
-use crate::trainer::{Command, DqnRunOutcome, DqnRunSpec, Event, TrainerError};
+use crate::trainer::{Command, DqnRunSpec, Event, RunOutcome, StreamOptions, TrainerError};
 
 /// Stream key of the source library's seeds, apart from the experiments' `[method, run]`.
 const SOURCES_STREAM: u64 = u64::MAX;
@@ -91,17 +91,18 @@ pub fn train_library(
             max_steps: None,
             test_episodes: config.protocol.test_episodes,
             seed: source.seed,
+            stream: StreamOptions::episodes(),
         };
         let (outcome, returned) = drive(&spec, commands, |event| {
             match event {
                 Event::RunStarted { method, .. } => progress.run_started(&method, 0),
                 Event::EpisodeEnded(record) => progress.episode(&record),
-                Event::RunEnded(_) => {}
+                _ => {}
             }
             Ok(())
         })?;
         commands = returned;
-        let outcome: DqnRunOutcome = outcome.map_err(|err: TrainerError| {
+        let outcome: RunOutcome = outcome.map_err(|err: TrainerError| {
             anyhow::Error::new(err).context(format!("training {}", source.name))
         })?;
         if outcome.record.stopped {

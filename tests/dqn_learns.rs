@@ -5,7 +5,7 @@ use std::path::Path;
 use std::sync::mpsc;
 
 use sapnet::config::{Config, Method};
-use sapnet::trainer::{self, DqnRunSpec, Event};
+use sapnet::trainer::{self, DqnRunSpec, Event, StreamOptions};
 
 #[test]
 fn a_100_unit_dqn_learns_cartpole() {
@@ -24,6 +24,7 @@ fn a_100_unit_dqn_learns_cartpole() {
         max_steps: None,
         test_episodes: config.protocol.test_episodes,
         seed: config.seed,
+        stream: StreamOptions::episodes(),
     };
     let (events, received) = mpsc::channel();
     let (_commands, commands) = mpsc::channel();

@@ -6,7 +6,7 @@ use std::thread;
 
 use sapnet::config::DqnConfig;
 use sapnet::env::{CartPoleParams, EnvConfig};
-use sapnet::trainer::{self, Command, DqnRunSpec, Event};
+use sapnet::trainer::{self, Command, DqnRunSpec, Event, StreamOptions};
 
 fn spec() -> DqnRunSpec {
     DqnRunSpec {
@@ -19,6 +19,7 @@ fn spec() -> DqnRunSpec {
         max_steps: None,
         test_episodes: 5,
         seed: 3,
+        stream: StreamOptions::episodes(),
     }
 }
 

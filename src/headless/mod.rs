@@ -64,7 +64,7 @@ pub fn run(
                     progress.episode(&record);
                     rewards.push(record.reward);
                 }
-                Event::RunEnded(_) => {}
+                _ => {}
             }
             Ok(())
         })?;
@@ -137,7 +137,7 @@ pub(crate) fn drive(
     commands: Receiver<Command>,
     mut on_event: impl FnMut(Event) -> Result<()>,
 ) -> Result<(
-    Result<trainer::DqnRunOutcome, TrainerError>,
+    Result<trainer::RunOutcome, TrainerError>,
     Receiver<Command>,
 )> {
     let (events_tx, events_rx) = mpsc::channel();
@@ -192,6 +192,7 @@ fn run_specs(config: &Config) -> Result<Vec<DqnRunSpec>> {
                 max_steps: config.protocol.max_steps,
                 test_episodes: config.protocol.test_episodes,
                 seed: seeds::derive(config.seed, &[m as u64, u64::from(run)]),
+                stream: trainer::StreamOptions::episodes(),
             });
         }
     }

@@ -154,6 +154,7 @@ mod tests {
             episodes: 5,
             steps: 0,
             updates: 0,
+            chosen: None,
             test_returns: vec![10.0, 20.0],
             stopped: false,
             wall_s: 0.0,

@@ -1,13 +1,14 @@
 //! One run of DQN from scratch: the paper's baselines, and how source policies are trained.
 
-use std::sync::mpsc::{Receiver, Sender, TryRecvError};
+use std::sync::mpsc::{Receiver, Sender};
 use std::time::Instant;
 
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 
-use super::events::{Command, EpisodeRecord, Event, RunRecord};
-use super::{Divergence, TrainerError};
+use super::control::{Control, Next};
+use super::events::{Command, EpisodeRecord, Event, RunRecord, StepRecord, StreamOptions};
+use super::{Divergence, RunOutcome, TrainerError};
 use crate::config::DqnConfig;
 use crate::dqn::{Architecture, DqnAgent, QNet, ReplayBuffer, Transition};
 use crate::env::{self, EnvConfig, Environment};
@@ -26,45 +27,43 @@ pub struct DqnRunSpec {
     pub max_steps: Option<u64>,
     pub test_episodes: u32,
     pub seed: u64,
-}
-
-/// A finished run: its record and the trained network (for the policy library).
-#[derive(Debug)]
-pub struct DqnRunOutcome {
-    pub record: RunRecord,
-    pub net: QNet,
+    pub stream: StreamOptions,
 }
 
 /// The seeds of a run's independent random streams.
-struct Streams {
-    weights: u64,
-    agent: u64,
-    env: u64,
-    test_env: u64,
+pub(super) struct Streams {
+    pub weights: u64,
+    /// ε-greedy and minibatch sampling.
+    pub agent: u64,
+    pub env: u64,
+    pub test_env: u64,
+    /// SAP-Net's draws from eq. 6.
+    pub selection: u64,
 }
 
 impl Streams {
-    fn new(seed: u64) -> Self {
+    pub fn new(seed: u64) -> Self {
         Self {
             weights: seeds::derive(seed, &[0]),
             agent: seeds::derive(seed, &[1]),
             env: seeds::derive(seed, &[2]),
             test_env: seeds::derive(seed, &[3]),
+            selection: seeds::derive(seed, &[4]),
         }
     }
 }
 
 /// Trains one DQN for `spec.episodes` episodes (or `spec.max_steps` steps, whichever comes
-/// first), then tests it greedily. Sends an
-/// [`Event::EpisodeEnded`] per episode; a [`Command::Stop`] (or a closed command channel)
-/// ends training early, and the run is then reported as stopped, untested.
+/// first), then tests it greedily. Sends the events of `spec.stream` and obeys `commands`
+/// (see [`Command`]); a [`Command::Stop`] (or a closed command channel) ends training early,
+/// and the run is then reported as stopped, untested.
 ///
 /// On a non-finite loss the error carries the network with its last good weights.
 pub fn train(
     spec: &DqnRunSpec,
     events: &Sender<Event>,
     commands: &Receiver<Command>,
-) -> Result<DqnRunOutcome, TrainerError> {
+) -> Result<RunOutcome, TrainerError> {
     let started = Instant::now();
     let streams = Streams::new(spec.seed);
     let mut env = env::make(&spec.env);
@@ -73,11 +72,13 @@ pub fn train(
     let mut agent = DqnAgent::new(net, &spec.dqn)?;
     let mut replay = ReplayBuffer::new(spec.dqn.replay_capacity, env.observation_size());
     let mut rng = StdRng::seed_from_u64(streams.agent);
+    let mut control = Control::new(commands, spec.stream.trace);
 
     let _ = events.send(Event::RunStarted {
         run: spec.run,
         method: spec.method.clone(),
         planned_episodes: spec.episodes,
+        sapnet: None,
     });
     let mut record = RunRecord {
         run: spec.run,
@@ -86,6 +87,7 @@ pub fn train(
         episodes: 0,
         steps: 0,
         updates: 0,
+        chosen: None,
         test_returns: Vec::new(),
         stopped: false,
         wall_s: 0.0,
@@ -98,7 +100,7 @@ pub fn train(
             if agent.steps() >= step_budget {
                 break 'episodes;
             }
-            if stop_requested(commands) {
+            if control.before_step() == Next::Stop {
                 record.stopped = true;
                 break 'episodes;
             }
@@ -112,15 +114,31 @@ pub fn train(
                 terminated: step.terminated,
                 truncated: step.truncated,
             });
-            if let Err(err) = agent.observe(&replay, &mut rng) {
-                return Err(TrainerError::Diverged(Box::new(Divergence {
-                    method: spec.method.clone(),
+            let report = match agent.observe(&replay, &mut rng) {
+                Ok(report) => report,
+                Err(err) => {
+                    return Err(TrainerError::Diverged(Box::new(Divergence {
+                        method: spec.method.clone(),
+                        run: spec.run,
+                        source: err,
+                        episodes: record.episodes,
+                        steps: agent.steps(),
+                        last_good: agent.into_online(),
+                    })));
+                }
+            };
+            if spec.stream.steps {
+                let _ = events.send(Event::Step(StepRecord {
                     run: spec.run,
-                    source: err,
-                    episodes: record.episodes,
-                    steps: agent.steps(),
-                    last_good: agent.into_online(),
-                })));
+                    step: agent.steps(),
+                    episode,
+                    policy: 0,
+                    action,
+                    reward: step.reward,
+                    loss: report.map(|r| r.loss),
+                    transition: None,
+                    warm_up: false,
+                }));
             }
             reward += step.reward;
             steps += 1;
@@ -143,6 +161,7 @@ pub fn train(
             loss: agent.last_loss(),
             statistic_loss: agent.statistic_loss(),
             epsilon: agent.epsilon(),
+            policy: None,
             wall_s: started.elapsed().as_secs_f64(),
         }));
     }
@@ -160,7 +179,7 @@ pub fn train(
     }
     record.wall_s = started.elapsed().as_secs_f64();
     let _ = events.send(Event::RunEnded(record.clone()));
-    Ok(DqnRunOutcome { record, net })
+    Ok(RunOutcome { record, net })
 }
 
 /// Returns of `episodes` greedy episodes (the paper's "Number of test").
@@ -185,11 +204,4 @@ pub fn test_greedy(
         returns.push(total);
     }
     Ok(returns)
-}
-
-fn stop_requested(commands: &Receiver<Command>) -> bool {
-    match commands.try_recv() {
-        Ok(Command::Stop) | Err(TryRecvError::Disconnected) => true,
-        Err(TryRecvError::Empty) => false,
-    }
 }

@@ -1,7 +1,18 @@
 //! The contract between the trainer and the front ends: the trainer only *sends* [`Event`]s,
 //! front ends only render them and send [`Command`]s.
+//!
+//! A run sends, in order: `RunStarted`, then for every step a `Step` (only if its
+//! [`StreamOptions::steps`] is on) and for every positive activation a `Trace` (only while
+//! tracing is on), an `Activations` snapshot at most every
+//! [`StreamOptions::snapshot_interval`] (every step while paused or throttled, and always
+//! just before each `EpisodeEnded` of a SAP-Net run), then `EpisodeEnded` per episode and
+//! `RunEnded` last.
+
+use std::time::Duration;
 
 use serde::Serialize;
+
+use crate::sapnet::{PolicyDescription, SapNet, TraceStep};
 
 /// Which learner a run trains, as it appears in results (`dqn[100,100]`, `sapnet`).
 pub type MethodLabel = String;
@@ -16,15 +27,29 @@ pub struct EpisodeRecord {
     pub episode: u32,
     pub reward: f64,
     pub steps: u32,
-    /// Raw loss of the policy's latest update at the end of the episode (empty before
-    /// learning starts; with `update_interval` > 1 it may come from an earlier episode).
+    /// Raw loss of the latest update at the end of the episode (empty before learning
+    /// starts; with `update_interval` > 1 it may come from an earlier episode). For SAP-Net,
+    /// the loss of the policy that acted last.
     pub loss: Option<f64>,
-    /// The statistic loss E at the end of the episode.
+    /// The statistic loss E at the end of the episode (SAP-Net: of the policy that acted
+    /// last).
     pub statistic_loss: f64,
     /// ε at the end of the episode.
     pub epsilon: f64,
+    /// SAP-Net: the policy that acted most often in this episode (empty for DQN).
+    pub policy: Option<u32>,
     /// Seconds since the run started.
     pub wall_s: f64,
+}
+
+/// The policy a SAP-Net run ends with: the highest activation (Algorithm 3).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ChosenPolicy {
+    pub index: usize,
+    /// Its name in the source library, e.g. `source-3`.
+    pub name: String,
+    pub hidden: Vec<usize>,
+    pub activation: f64,
 }
 
 /// How a run ended.
@@ -40,11 +65,78 @@ pub struct RunRecord {
     pub episodes: u32,
     pub steps: u64,
     pub updates: u64,
+    /// SAP-Net: the chosen policy, whose greedy returns `test_returns` are.
+    pub chosen: Option<ChosenPolicy>,
     /// Returns of the greedy test episodes after training (empty if stopped before).
     pub test_returns: Vec<f64>,
     /// Stopped by the user before the planned episodes were done.
     pub stopped: bool,
     pub wall_s: f64,
+}
+
+/// A source policy as front ends show it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourceSummary {
+    /// Its name in the library, e.g. `source-3`.
+    pub name: String,
+    pub description: PolicyDescription,
+    /// Mean greedy return when it was trained, if it was tested.
+    pub final_score: Option<f64>,
+}
+
+/// What a SAP-Net run starts from: its policies and the SAP-Net (graph, weights M,
+/// parameters and the initial activations), enough to draw the graph or teach on it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SapNetStart {
+    pub policies: Vec<SourceSummary>,
+    pub net: SapNet,
+}
+
+/// One environment step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepRecord {
+    pub run: u32,
+    /// Steps of the run so far, this one included.
+    pub step: u64,
+    /// The episode this step belongs to (1-based).
+    pub episode: u32,
+    /// The policy that acted (always 0 for DQN).
+    pub policy: usize,
+    pub action: usize,
+    pub reward: f64,
+    /// The loss of the update this step made, if it made one.
+    pub loss: Option<f64>,
+    /// SAP-Net: `T_a = E_{t+1} − E_t` of that update (eq. 7); `≤ 0` activated the policy.
+    pub transition: Option<f64>,
+    /// One of the first `N × replay_start_size` steps, acted in turn without learning.
+    pub warm_up: bool,
+}
+
+/// The state of SAP-Net at a step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ActivationSnapshot {
+    pub run: u32,
+    pub step: u64,
+    pub episode: u32,
+    /// 𝔸.
+    pub activations: Vec<f64>,
+    /// P(π_i), eq. 6.
+    pub probabilities: Vec<f64>,
+    /// Steps each policy acted after the warm-up, since the run started.
+    pub selections: Vec<u64>,
+    /// Positive and negative transitions of each policy (eq. 7), since the run started.
+    pub positive: Vec<u64>,
+    pub negative: Vec<u64>,
+}
+
+/// Every `spread` call of one activation (eq. 8–11), in the order they were made.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TraceRecord {
+    pub run: u32,
+    pub step: u64,
+    /// The activated policy.
+    pub policy: usize,
+    pub calls: Vec<TraceStep>,
 }
 
 /// What the trainer tells the front ends.
@@ -54,7 +146,12 @@ pub enum Event {
         run: u32,
         method: MethodLabel,
         planned_episodes: u32,
+        /// Present for SAP-Net runs.
+        sapnet: Option<Box<SapNetStart>>,
     },
+    Step(StepRecord),
+    Activations(ActivationSnapshot),
+    Trace(TraceRecord),
     EpisodeEnded(EpisodeRecord),
     RunEnded(RunRecord),
 }
@@ -64,4 +161,51 @@ pub enum Event {
 pub enum Command {
     /// Finish the current step, then end the run as stopped.
     Stop,
+    /// Wait before the next step until `Resume`, `Step` or `Stop`.
+    Pause,
+    Resume,
+    /// While paused: take one step, then wait again.
+    Step,
+    /// Sleep this long before every step (zero: full speed). Slows the trainer so that a
+    /// person can follow it; the front end never slows it otherwise.
+    Throttle(Duration),
+    /// Send a `Trace` of every positive activation (SAP-Net runs).
+    Trace(bool),
+}
+
+/// What a run streams besides episodes, chosen by the front end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StreamOptions {
+    /// Send a `Step` for every step.
+    pub steps: bool,
+    /// Start with tracing on (see [`Command::Trace`]).
+    pub trace: bool,
+    /// Least time between two `Activations` snapshots while running at full speed.
+    pub snapshot_interval: Duration,
+}
+
+impl StreamOptions {
+    /// Episodes and per-episode snapshots only: what results on disk need.
+    pub fn episodes() -> Self {
+        Self {
+            steps: false,
+            trace: false,
+            snapshot_interval: Duration::MAX,
+        }
+    }
+
+    /// Steps and about 30 snapshots a second: what a live view needs.
+    pub fn live() -> Self {
+        Self {
+            steps: true,
+            trace: false,
+            snapshot_interval: Duration::from_millis(33),
+        }
+    }
+}
+
+impl Default for StreamOptions {
+    fn default() -> Self {
+        Self::episodes()
+    }
 }

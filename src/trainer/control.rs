@@ -1,0 +1,156 @@
+//! How a run obeys the front end's [`Command`]s between steps.
+
+use std::sync::mpsc::{Receiver, TryRecvError};
+use std::time::Duration;
+
+use super::events::Command;
+
+/// The command channel of one run and what it has asked for so far.
+pub(crate) struct Control<'a> {
+    commands: &'a Receiver<Command>,
+    paused: bool,
+    /// Steps granted by `Command::Step` while paused.
+    granted: u32,
+    delay: Duration,
+    trace: bool,
+}
+
+/// What the run does next.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Next {
+    Step,
+    Stop,
+}
+
+impl<'a> Control<'a> {
+    pub fn new(commands: &'a Receiver<Command>, trace: bool) -> Self {
+        Self {
+            commands,
+            paused: false,
+            granted: 0,
+            delay: Duration::ZERO,
+            trace,
+        }
+    }
+
+    /// Called before every step: applies pending commands, waits while paused (a closed
+    /// channel counts as `Stop`), and sleeps the throttle delay.
+    pub fn before_step(&mut self) -> Next {
+        loop {
+            match self.commands.try_recv() {
+                Ok(command) => {
+                    if self.apply(command) == Next::Stop {
+                        return Next::Stop;
+                    }
+                }
+                Err(TryRecvError::Disconnected) => return Next::Stop,
+                Err(TryRecvError::Empty) => break,
+            }
+        }
+        while self.paused && self.granted == 0 {
+            match self.commands.recv() {
+                Ok(command) => {
+                    if self.apply(command) == Next::Stop {
+                        return Next::Stop;
+                    }
+                }
+                Err(_) => return Next::Stop,
+            }
+        }
+        if self.paused {
+            self.granted -= 1;
+        }
+        if !self.delay.is_zero() {
+            std::thread::sleep(self.delay);
+        }
+        Next::Step
+    }
+
+    fn apply(&mut self, command: Command) -> Next {
+        match command {
+            Command::Stop => return Next::Stop,
+            Command::Pause => self.paused = true,
+            Command::Resume => {
+                self.paused = false;
+                self.granted = 0;
+            }
+            Command::Step => {
+                if self.paused {
+                    self.granted += 1;
+                }
+            }
+            Command::Throttle(delay) => self.delay = delay,
+            Command::Trace(on) => self.trace = on,
+        }
+        Next::Step
+    }
+
+    /// A person is watching step by step (paused or throttled): every step deserves a
+    /// snapshot.
+    pub fn is_slow(&self) -> bool {
+        self.paused || self.delay >= Duration::from_millis(1)
+    }
+
+    pub fn trace(&self) -> bool {
+        self.trace
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::mpsc;
+
+    use super::*;
+
+    #[test]
+    fn runs_until_stopped() {
+        let (tx, rx) = mpsc::channel();
+        let mut control = Control::new(&rx, false);
+        assert_eq!(control.before_step(), Next::Step);
+        tx.send(Command::Stop).unwrap();
+        assert_eq!(control.before_step(), Next::Stop);
+    }
+
+    #[test]
+    fn a_closed_channel_stops() {
+        let (tx, rx) = mpsc::channel::<Command>();
+        drop(tx);
+        assert_eq!(Control::new(&rx, false).before_step(), Next::Stop);
+    }
+
+    #[test]
+    fn paused_runs_take_only_granted_steps() {
+        let (tx, rx) = mpsc::channel();
+        let mut control = Control::new(&rx, false);
+        for command in [Command::Pause, Command::Step, Command::Step] {
+            tx.send(command).unwrap();
+        }
+        assert_eq!(control.before_step(), Next::Step);
+        assert!(control.is_slow());
+        assert_eq!(control.before_step(), Next::Step);
+        // No grant left: the next call blocks until a command arrives.
+        tx.send(Command::Resume).unwrap();
+        assert_eq!(control.before_step(), Next::Step);
+        assert!(!control.is_slow());
+    }
+
+    #[test]
+    fn stop_ends_a_pause() {
+        let (tx, rx) = mpsc::channel();
+        let mut control = Control::new(&rx, false);
+        tx.send(Command::Pause).unwrap();
+        tx.send(Command::Stop).unwrap();
+        assert_eq!(control.before_step(), Next::Stop);
+    }
+
+    #[test]
+    fn trace_and_throttle_are_remembered() {
+        let (tx, rx) = mpsc::channel();
+        let mut control = Control::new(&rx, false);
+        tx.send(Command::Trace(true)).unwrap();
+        tx.send(Command::Throttle(Duration::from_millis(2))).unwrap();
+        assert_eq!(control.before_step(), Next::Step);
+        assert!(control.trace());
+        assert!(control.is_slow());
+    }
+}
