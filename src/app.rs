@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 
 use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, TeachArgs};
 use crate::config::Config;
-use crate::headless::{self, OutputOptions};
+use crate::headless::{self, OutputOptions, RunOptions};
 use crate::{assets, env, random_episodes, trainer};
 
 pub fn run(cli: Cli) -> Result<()> {
@@ -63,11 +63,10 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     if !cli.run.headless {
         eprintln!("note: the live dashboard is not built yet; running headless (--headless).");
     }
-    let config = load_config(
-        cli,
-        assets::DQN_CARTPOLE,
-        "embedded assets/dqn_cartpole.ron",
-    )?;
+    let mut config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
+    if cli.run.quick {
+        config.quick();
+    }
     let dir = match &cli.run.out {
         Some(dir) => dir.clone(),
         None => default_out_dir(cli.run.config.as_deref()),
@@ -77,12 +76,18 @@ fn run_experiment(cli: &Cli) -> Result<()> {
         force: cli.run.force,
     };
 
-    let summary = headless::run(&config, &output, on_interrupt()?)?;
+    let options = RunOptions {
+        jobs: cli.run.jobs.unwrap_or_else(|| {
+            std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+        }),
+        library: cli.run.library.clone(),
+    };
+    let summary = headless::run(&config, &output, &options, on_interrupt()?)?;
     let dir = output.dir.display();
     if summary.stopped() {
-        eprintln!("stopped by the user: the episodes so far are in {dir}/episodes.csv, the summary in {dir}/summary.json");
+        eprintln!("stopped by the user: what was done so far is in {dir} (episodes.csv, tests.csv, summary.json, plots)");
     } else {
-        eprintln!("results in {dir}: episodes.csv, summary.json, policies/");
+        eprintln!("results in {dir}: episodes.csv, tests.csv, summary.json, policies/, learning_curve.png, tests.png");
     }
     for run in &summary.runs {
         let tests: Vec<String> = run
@@ -101,13 +106,19 @@ fn run_experiment(cli: &Cli) -> Result<()> {
                 .map_or("-".into(), |a| format!("{a:.1}")),
             tests.join(", ")
         );
+        if let Some(chosen) = &run.record.chosen {
+            eprintln!(
+                "  chosen policy {} {:?} (activation {:.2})",
+                chosen.name, chosen.hidden, chosen.activation
+            );
+        }
     }
     Ok(())
 }
 
 fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
     let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
-    let dir = crate::sources::train_library(&config, &args.library, args.retrain, on_interrupt()?)?;
+    let dir = crate::sources::train_library(&config, &cli.run.library, args.retrain, on_interrupt()?)?;
     eprintln!(
         "{} source policies in {}",
         config.sources.count,
@@ -136,7 +147,7 @@ fn on_interrupt() -> Result<mpsc::Receiver<trainer::Command>> {
 fn default_out_dir(config: Option<&Path>) -> PathBuf {
     let stem = config
         .and_then(|p| p.file_stem())
-        .map_or("dqn_cartpole".into(), |s| s.to_string_lossy().into_owned());
+        .map_or("cartpole".into(), |s| s.to_string_lossy().into_owned());
     let seconds = SystemTime::now()
         .duration_since(UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());

@@ -7,7 +7,8 @@ use clap::{Args, Parser, Subcommand};
 /// SAP-Net: reuse a library of DQN policies by spreading activation over a policy graph.
 ///
 /// With no subcommand, runs the experiment of `--config` (default: the embedded
-/// `assets/dqn_cartpole.ron`, the paper's DQN on CartPole-v1).
+/// `assets/cartpole.ron`, the paper's CartPole-v1 experiment: SAP-Net and three DQN
+/// baselines).
 #[derive(Debug, Parser)]
 #[command(name = "sapnet", version, about, long_about = None)]
 pub struct Cli {
@@ -42,6 +43,19 @@ pub struct RunArgs {
     /// Replace results already in --out.
     #[arg(long)]
     pub force: bool,
+
+    /// A smoke run of about a minute: the protocol cut to 1/20 of its episodes and at most
+    /// 2 runs per method (on the same source library).
+    #[arg(long)]
+    pub quick: bool,
+
+    /// Runs trained at the same time. Default: one per core.
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
+
+    /// The policy library's root directory: SAP-Net reuses <LIBRARY>/<source task>/.
+    #[arg(long, value_name = "DIR", default_value = "saved_policies", global = true)]
+    pub library: PathBuf,
 }
 
 #[derive(Debug, Subcommand)]
@@ -61,10 +75,6 @@ pub struct SourcesArgs {
     /// Replace a library already on disk.
     #[arg(long)]
     pub retrain: bool,
-
-    /// The policy library's root directory.
-    #[arg(long, value_name = "DIR", default_value = "saved_policies")]
-    pub library: PathBuf,
 }
 
 #[derive(Debug, Args)]

@@ -294,6 +294,15 @@ impl Config {
     }
 
     /// Checks the values serde cannot: ranges and relations between fields.
+    /// Cuts the protocol for a smoke run: 1/20 of the episodes, at most 2 runs per method.
+    /// The source library is the real one (a library trained on a cut budget would be
+    /// reused by later full runs).
+    pub fn quick(&mut self) {
+        self.protocol.episodes = (self.protocol.episodes / 20).max(1);
+        self.protocol.max_steps = self.protocol.max_steps.map(|s| (s / 20).max(1));
+        self.protocol.runs = self.protocol.runs.min(2);
+    }
+
     pub fn validate(&self) -> Result<(), String> {
         let d = &self.dqn;
         check(

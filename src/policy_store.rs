@@ -44,6 +44,9 @@ pub struct PolicyInfo {
     pub seed: u64,
     /// Mean return of the greedy test episodes after training, if it was tested.
     pub final_score: Option<f64>,
+    /// The library policy this one went on learning from (SAP-Net's chosen policy), as
+    /// `<task>/<name>`.
+    pub reused: Option<String>,
 }
 
 /// The contents of `<name>.ron`.
@@ -59,6 +62,9 @@ pub struct PolicyMetadata {
     pub training: TrainingBudget,
     pub seed: u64,
     pub final_score: Option<f64>,
+    /// See [`PolicyInfo::reused`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reused: Option<String>,
     /// The version of sapnet that wrote the files.
     pub crate_version: String,
     /// SHA-256 of the weights file, lowercase hex: ties the pair together.
@@ -170,6 +176,7 @@ fn write_pair(
         training: info.training.clone(),
         seed: info.seed,
         final_score: info.final_score,
+        reused: info.reused.clone(),
         crate_version: env!("CARGO_PKG_VERSION").to_string(),
         weights_sha256: sha256_hex(&weights),
     };

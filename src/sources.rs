@@ -14,7 +14,10 @@ use crate::env::EnvConfig;
 use crate::headless::drive;
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::seeds;
-use crate::trainer::{Command, DqnRunSpec, Event, RunOutcome, StreamOptions, TrainerError};
+use crate::sapnet::PolicyDescription;
+use crate::trainer::{
+    Command, DqnRunSpec, Event, RunOutcome, SourcePolicy, StreamOptions, TrainerError,
+};
 
 /// Stream key of the source library's seeds, apart from the experiments' `[method, run]`.
 const SOURCES_STREAM: u64 = u64::MAX;
@@ -65,6 +68,17 @@ pub fn train_library(
     retrain: bool,
     commands: Receiver<Command>,
 ) -> Result<PathBuf> {
+    train_library_with(config, library, retrain, commands)?;
+    Ok(library_dir(library, config))
+}
+
+/// [`train_library`], giving the command channel back for what follows.
+fn train_library_with(
+    config: &Config,
+    library: &Path,
+    retrain: bool,
+    commands: Receiver<Command>,
+) -> Result<Receiver<Command>> {
     let dir = library_dir(library, config);
     let existing = policy_store::list(&dir)?;
     if !existing.is_empty() && !retrain {
@@ -127,6 +141,7 @@ pub fn train_library(
             seed: source.seed,
             final_score: (!returns.is_empty())
                 .then(|| returns.iter().sum::<f64>() / returns.len() as f64),
+            reused: None,
         };
         policy_store::save(&dir, &source.name, &outcome.net, &info)
             .with_context(|| format!("writing {} to {}", source.name, dir.display()))?;
@@ -147,7 +162,82 @@ pub fn train_library(
             }
         }
     }
-    Ok(dir)
+    Ok(commands)
+}
+
+/// Reads the source library of `config` from `<library>/<source task>/` for reuse on the
+/// target task: every policy must load intact, fit the target task's sizes and have been
+/// trained on the config's source task.
+pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>> {
+    let dir = library_dir(library, config);
+    let mut names = policy_store::list(&dir)?;
+    if names.is_empty() {
+        bail!(
+            "the source library {} holds no policies; train it with `sapnet sources --config <FILE>`",
+            dir.display()
+        );
+    }
+    // source-2 before source-10.
+    names.sort_by_key(|name| natural_key(name));
+    let env = crate::env::make(&config.env);
+    let expected = source_task(config);
+    let mut sources = Vec::with_capacity(names.len());
+    for name in names {
+        let stored = policy_store::load_for_task(
+            &dir,
+            &name,
+            env.observation_size(),
+            env.action_count(),
+        )?;
+        if &stored.metadata.source_task != expected {
+            bail!(
+                "policy {} was trained on {:?}, but the config's source task is {:?}; retrain the \
+                 library with `sapnet sources --retrain` or use another --library",
+                policy_store::paths(&dir, &name).1.display(),
+                stored.metadata.source_task,
+                expected
+            );
+        }
+        sources.push(SourcePolicy {
+            description: PolicyDescription {
+                hidden: stored.metadata.architecture.hidden.clone(),
+                activation: stored.metadata.activation.clone(),
+                source_task: stored.metadata.source_task_name.clone(),
+            },
+            final_score: stored.metadata.final_score,
+            net: stored.net,
+            name,
+        });
+    }
+    Ok(sources)
+}
+
+/// The library of `config`, trained first if `<library>/<task>/` holds none (with progress
+/// on stderr), then loaded.
+pub fn ensure_library(
+    config: &Config,
+    library: &Path,
+    commands: Receiver<Command>,
+) -> Result<(Vec<SourcePolicy>, Receiver<Command>)> {
+    let dir = library_dir(library, config);
+    if policy_store::list(&dir)?.is_empty() {
+        eprintln!(
+            "no source library in {}: training {} source policies first ({} episodes each)",
+            dir.display(),
+            config.sources.count,
+            config.sources.training_episodes
+        );
+        let commands = train_library_with(config, library, false, commands)?;
+        return Ok((load_library(config, library)?, commands));
+    }
+    Ok((load_library(config, library)?, commands))
+}
+
+/// `source-10` → ("source-", 10): names with the same prefix sort by number.
+fn natural_key(name: &str) -> (String, u64) {
+    let digits = name.len() - name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+    let (prefix, number) = name.split_at(name.len() - digits);
+    (prefix.to_string(), number.parse().unwrap_or(0))
 }
 
 #[cfg(test)]
@@ -172,5 +262,12 @@ mod tests {
         assert_eq!(plans, plan(&config));
         config.seed = 1;
         assert_ne!(plans, plan(&config));
+    }
+
+    #[test]
+    fn numbered_names_sort_by_number() {
+        let mut names = vec!["source-10", "source-2", "source-1", "other"];
+        names.sort_by_key(|n| natural_key(n));
+        assert_eq!(names, ["other", "source-1", "source-2", "source-10"]);
     }
 }

@@ -1,34 +1,52 @@
 //! Headless mode: runs what the config's protocol lists, with progress on stderr and
 //! results on disk, consuming the trainer's event stream.
 //!
-//! Files in the output directory:
+//! Runs are spread over `jobs` threads (one per core by default). Files in the output
+//! directory, each written as results arrive, so a stopped experiment keeps what it did:
 //! - `episodes.csv`: one row per training episode (`run, method, episode, reward, steps,
-//!   loss, statistic_loss, epsilon, wall_s`), flushed as episodes end, so a stopped run
-//!   keeps every finished episode;
-//! - `summary.json`: the config, each run's test returns and totals, whether it was stopped;
-//! - `policies/<method>-run<r>.{safetensors,ron}` (e.g. `dqn-100-100-run0`): each trained
-//!   network with its metadata, in the policy library's format.
+//!   loss, statistic_loss, epsilon, policy, wall_s`; `policy` is the policy SAP-Net
+//!   selected most in the episode);
+//! - `tests.csv`: the greedy test returns of each run (`run, method, test, return, policy`);
+//! - `activations.csv`: SAP-Net's activations, probabilities and selections per episode;
+//! - `summary.json`: the config, the source library, each run's totals and test returns;
+//! - `policies/<method>-run<r>.{safetensors,ron}` (e.g. `dqn-100-100-run0`, `sapnet-run0`):
+//!   each trained network — SAP-Net's chosen policy after training — in the policy
+//!   library's format;
+//! - `learning_curve.png`/`.svg`, `tests.png`, `activations.png`: the paper's Fig. 5–8.
 
+mod plots;
 mod progress;
 mod results;
 
-use std::path::PathBuf;
-use std::sync::mpsc::{self, Receiver};
+use std::collections::{BTreeMap, VecDeque};
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
+use std::sync::Arc;
 use std::thread;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context, Result};
 
 use crate::config::{Config, Method};
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::seeds;
-use crate::trainer::{self, dqn_label, Command, Divergence, DqnRunSpec, Event, TrainerError};
+use crate::sources;
+use crate::trainer::{
+    self, dqn_label, Command, Divergence, DqnRunSpec, Event, RunHandle, RunOutcome, RunSpec,
+    SourcePolicy, StreamOptions, TrainerError, TransferRunSpec, SAPNET_LABEL,
+};
 
 pub(crate) use progress::Progress;
 pub use results::{RunSummary, Summary};
 
 /// Entries that mark a directory as holding results already.
-const RESULT_FILES: [&str; 3] = ["episodes.csv", "summary.json", "policies"];
+const RESULT_FILES: [&str; 5] = [
+    "episodes.csv",
+    "tests.csv",
+    "activations.csv",
+    "summary.json",
+    "policies",
+];
 
 /// Where results go and whether old ones may be replaced.
 #[derive(Debug, Clone)]
@@ -38,125 +56,363 @@ pub struct OutputOptions {
     pub force: bool,
 }
 
-/// Runs the protocol of `config`. `commands` carries [`Command::Stop`] (from Ctrl-C): the
-/// current run then ends early and everything written so far is kept.
+/// How the protocol runs.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// Runs trained at the same time.
+    pub jobs: usize,
+    /// Root of the policy library SAP-Net reuses (`<library>/<task>/`).
+    pub library: PathBuf,
+}
+
+/// Runs the protocol of `config`: trains the source library if SAP-Net needs one that is
+/// not there, then every (method, run). `commands` carries [`Command::Stop`] (from
+/// Ctrl-C): the runs in progress then end early, no new ones start, and everything written
+/// so far is kept.
 pub fn run(
     config: &Config,
     output: &OutputOptions,
+    options: &RunOptions,
     commands: Receiver<Command>,
 ) -> Result<Summary> {
-    let specs = run_specs(config)?;
     prepare_output(output)?;
-    let mut writer = results::EpisodeWriter::create(&output.dir.join("episodes.csv"))?;
-    let planned: u64 = specs.iter().map(|s| u64::from(s.episodes)).sum();
-    let mut progress = progress::Progress::new(planned);
-    let started = Instant::now();
     let mut summary = Summary::new(config);
-    let mut commands = commands;
+    let (sources, commands) = if config.protocol.methods.contains(&Method::SapNet) {
+        let (sources, commands) = sources::ensure_library(config, &options.library, commands)?;
+        summary.library = Some(
+            sources
+                .iter()
+                .map(|s| results::LibraryEntry {
+                    name: s.name.clone(),
+                    hidden: s.description.hidden.clone(),
+                    final_score: s.final_score,
+                })
+                .collect(),
+        );
+        (Some(Arc::new(sources)), commands)
+    } else {
+        (None, commands)
+    };
+    let specs = run_specs(config, sources.as_ref())?;
+    let mut sink = Sink::create(config, &output.dir, sources.as_deref(), &specs)?;
+    let started = Instant::now();
 
-    for spec in specs {
-        let mut rewards = Vec::new();
-        let (outcome, returned) = drive(&spec, commands, |event| {
-            match event {
-                Event::RunStarted { run, method, .. } => progress.run_started(&method, run),
-                Event::EpisodeEnded(record) => {
-                    writer.write(&record)?;
-                    progress.episode(&record);
-                    rewards.push(record.reward);
-                }
-                _ => {}
-            }
-            Ok(())
-        })?;
-        commands = returned;
-        let name = policy_file_name(&spec.method, spec.run);
-        let policies = output.dir.join("policies");
-        match outcome {
-            Ok(outcome) => {
-                // A run stopped before its first step (Ctrl-C during the previous run's
-                // greedy test) trained nothing worth keeping.
-                if outcome.record.steps > 0 {
-                    let info = policy_info(config, &outcome.record);
-                    policy_store::save(&policies, &name, &outcome.net, &info)
-                        .with_context(|| format!("saving the trained {}", spec.method))?;
-                }
-                summary.push(RunSummary::new(
-                    outcome.record,
-                    &rewards,
-                    config.protocol.moving_average,
-                ));
-                if summary.stopped() {
-                    break;
-                }
-            }
-            Err(TrainerError::Diverged(divergence)) => {
-                let Divergence {
-                    method,
-                    run,
-                    source,
-                    episodes,
-                    steps,
-                    last_good,
-                } = *divergence;
-                let info = PolicyInfo {
-                    source_task: config.env.clone(),
-                    training: TrainingBudget {
-                        episodes: u64::from(episodes),
-                        steps,
-                    },
-                    seed: spec.seed,
-                    final_score: None,
-                };
-                let kept = match policy_store::save(&policies, &name, &last_good, &info) {
-                    Ok(_) => format!(
-                        "its last good weights are in {}",
-                        policies.join(&name).display()
-                    ),
-                    Err(err) => format!("its last good weights could not be saved: {err}"),
-                };
-                progress.finish(false);
-                let message = format!("policy {method} (run {run}) diverged: {source}; {kept}");
-                summary.error = Some(message.clone());
-                summary.wall_s = started.elapsed().as_secs_f64();
-                results::write_summary(&output.dir.join("summary.json"), &summary)?;
-                bail!(message);
-            }
-            Err(err) => return Err(err.into()),
-        }
+    let outcome = schedule(specs, options.jobs, &commands, &mut sink, config, output);
+    sink.progress.finish(matches!(outcome, Ok(false)));
+    if let Err(err) = outcome {
+        summary.error = Some(format!("{err:#}"));
     }
-    progress.finish(!summary.stopped());
+    summary.runs = std::mem::take(&mut sink.finished).into_values().collect();
     summary.wall_s = started.elapsed().as_secs_f64();
     results::write_summary(&output.dir.join("summary.json"), &summary)?;
+    if let Some(error) = &summary.error {
+        bail!("{error}");
+    }
+    plots::write_all(&output.dir, &sink.plot_data(config))
+        .with_context(|| format!("drawing the plots in {}", output.dir.display()))?;
     Ok(summary)
 }
 
-/// Trains `spec` on a thread of its own and hands its events to `on_event`, on this thread,
-/// as they arrive. Gives back the command receiver with the outcome, for the next run.
-pub(crate) fn drive(
-    spec: &DqnRunSpec,
-    commands: Receiver<Command>,
-    mut on_event: impl FnMut(Event) -> Result<()>,
-) -> Result<(
-    Result<trainer::RunOutcome, TrainerError>,
-    Receiver<Command>,
-)> {
-    let (events_tx, events_rx) = mpsc::channel();
-    let worker = {
-        let spec = spec.clone();
-        thread::Builder::new()
-            .name(format!("trainer {} run {}", spec.method, spec.run))
-            .spawn(move || {
-                let outcome = trainer::train(&spec, &events_tx, &commands);
-                (outcome, commands)
-            })
-            .context("starting the trainer thread")?
-    };
-    for event in events_rx {
-        on_event(event)?;
+/// A run in progress.
+struct Active {
+    order: usize,
+    spec: RunSpec,
+    handle: RunHandle,
+}
+
+/// Runs `specs` in order, at most `jobs` at a time, feeding every event to `sink`.
+/// Returns whether the user stopped the experiment; a run that fails stops the others and
+/// is returned as the error (the other runs' results are kept in `sink`).
+fn schedule(
+    specs: Vec<RunSpec>,
+    jobs: usize,
+    commands: &Receiver<Command>,
+    sink: &mut Sink,
+    config: &Config,
+    output: &OutputOptions,
+) -> Result<bool> {
+    let (events_tx, events) = mpsc::channel();
+    let mut queue: VecDeque<(usize, RunSpec)> = specs.into_iter().enumerate().collect();
+    let mut active: Vec<Active> = Vec::new();
+    let mut stopping = false;
+    let mut failure: Option<anyhow::Error> = None;
+    loop {
+        while !stopping && active.len() < jobs.max(1) {
+            let Some((order, spec)) = queue.pop_front() else {
+                break;
+            };
+            let handle = trainer::spawn(spec.clone(), events_tx.clone())
+                .context("starting a trainer thread")?;
+            active.push(Active {
+                order,
+                spec,
+                handle,
+            });
+        }
+        if active.is_empty() {
+            break;
+        }
+        match events.recv_timeout(Duration::from_millis(50)) {
+            Ok(event) => sink.on_event(event)?,
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => unreachable!("this loop holds a sender"),
+        }
+        if !stopping && matches!(commands.try_recv(), Ok(Command::Stop)) {
+            stopping = true;
+            for run in &active {
+                let _ = run.handle.commands.send(Command::Stop);
+            }
+        }
+        let mut i = 0;
+        while i < active.len() {
+            if !active[i].handle.thread.is_finished() {
+                i += 1;
+                continue;
+            }
+            let run = active.swap_remove(i);
+            // A finished thread has sent all its events: take them before its outcome.
+            while let Ok(event) = events.try_recv() {
+                sink.on_event(event)?;
+            }
+            let outcome = run.handle.thread.join().map_err(|_| {
+                anyhow::anyhow!(
+                    "the trainer thread of {} run {} panicked",
+                    run.spec.method(),
+                    run.spec.run() + 1
+                )
+            })?;
+            match outcome {
+                Ok(outcome) => {
+                    stopping |= outcome.record.stopped;
+                    sink.on_finished(run.order, &run.spec, outcome, config, output)?;
+                }
+                Err(err) => {
+                    let err = sink.on_failed(&run.spec, err, config, output);
+                    failure.get_or_insert(err);
+                    stopping = true;
+                    for other in &active {
+                        let _ = other.handle.commands.send(Command::Stop);
+                    }
+                }
+            }
+        }
     }
-    worker
-        .join()
-        .map_err(|_| anyhow::anyhow!("the trainer thread of {} panicked", spec.method))
+    while let Ok(event) = events.try_recv() {
+        sink.on_event(event)?;
+    }
+    match failure {
+        Some(err) => Err(err),
+        None => Ok(stopping),
+    }
+}
+
+/// Everything the event stream writes: the CSV files, progress, and what the plots and
+/// the summary need.
+struct Sink {
+    episodes: results::EpisodeWriter,
+    tests: results::TestsWriter,
+    activations: Option<results::ActivationsWriter>,
+    progress: Progress,
+    /// Training returns per (method, run).
+    rewards: BTreeMap<(String, u32), Vec<f64>>,
+    /// SAP-Net: the latest snapshot of each run, and the selections counted before the
+    /// current episode.
+    snapshots: BTreeMap<u32, (trainer::ActivationSnapshot, Vec<u64>)>,
+    /// SAP-Net: activations at the end of every episode, per run.
+    activation_history: BTreeMap<u32, Vec<Vec<f64>>>,
+    names: Vec<String>,
+    finished: BTreeMap<usize, RunSummary>,
+    tested: BTreeMap<String, Vec<Vec<f64>>>,
+    window: usize,
+}
+
+impl Sink {
+    fn create(
+        config: &Config,
+        dir: &Path,
+        sources: Option<&Vec<SourcePolicy>>,
+        specs: &[RunSpec],
+    ) -> Result<Self> {
+        let names: Vec<String> = sources
+            .map(|s| s.iter().map(|p| p.name.clone()).collect())
+            .unwrap_or_default();
+        let activations = match sources {
+            Some(_) => Some(results::ActivationsWriter::create(
+                &dir.join("activations.csv"),
+                &names,
+            )?),
+            None => None,
+        };
+        let planned = specs.iter().map(|s| u64::from(s.episodes())).sum();
+        Ok(Self {
+            episodes: results::EpisodeWriter::create(&dir.join("episodes.csv"))?,
+            tests: results::TestsWriter::create(&dir.join("tests.csv"))?,
+            activations,
+            progress: Progress::new(planned),
+            rewards: BTreeMap::new(),
+            snapshots: BTreeMap::new(),
+            activation_history: BTreeMap::new(),
+            names,
+            finished: BTreeMap::new(),
+            tested: BTreeMap::new(),
+            window: config.protocol.moving_average,
+        })
+    }
+
+    fn on_event(&mut self, event: Event) -> Result<()> {
+        match event {
+            Event::RunStarted { run, method, .. } => self.progress.run_started(&method, run),
+            Event::Activations(snapshot) => {
+                let counted = self
+                    .snapshots
+                    .remove(&snapshot.run)
+                    .map_or_else(|| vec![0; snapshot.selections.len()], |(_, c)| c);
+                self.snapshots.insert(snapshot.run, (snapshot, counted));
+            }
+            Event::EpisodeEnded(record) => {
+                self.episodes.write(&record)?;
+                self.progress.episode(&record);
+                self.rewards
+                    .entry((record.method.clone(), record.run))
+                    .or_default()
+                    .push(record.reward);
+                if record.method == SAPNET_LABEL {
+                    self.write_activations(record.run, record.episode)?;
+                }
+            }
+            Event::Step(_) | Event::Trace(_) | Event::RunEnded(_) => {}
+        }
+        Ok(())
+    }
+
+    /// The row of `activations.csv` for an episode that just ended, from the snapshot the
+    /// trainer sends right before `EpisodeEnded`.
+    fn write_activations(&mut self, run: u32, episode: u32) -> Result<()> {
+        let (Some(writer), Some((snapshot, counted))) =
+            (&mut self.activations, self.snapshots.get_mut(&run))
+        else {
+            return Ok(());
+        };
+        let selected: Vec<u64> = snapshot
+            .selections
+            .iter()
+            .zip(counted.iter())
+            .map(|(now, before)| now - before)
+            .collect();
+        writer.write(
+            run,
+            episode,
+            &snapshot.activations,
+            &snapshot.probabilities,
+            &selected,
+        )?;
+        counted.clone_from(&snapshot.selections);
+        self.activation_history
+            .entry(run)
+            .or_default()
+            .push(snapshot.activations.clone());
+        Ok(())
+    }
+
+    fn on_finished(
+        &mut self,
+        order: usize,
+        spec: &RunSpec,
+        outcome: RunOutcome,
+        config: &Config,
+        output: &OutputOptions,
+    ) -> Result<()> {
+        let record = outcome.record;
+        // A run stopped before its first step trained nothing worth keeping.
+        if record.steps > 0 {
+            let name = policy_file_name(&record.method, record.run);
+            let info = policy_info(config, &record, spec);
+            policy_store::save(&output.dir.join("policies"), &name, &outcome.net, &info)
+                .with_context(|| format!("saving the trained {}", record.method))?;
+        }
+        self.tests.write(&record)?;
+        if !record.test_returns.is_empty() {
+            self.tested
+                .entry(record.method.clone())
+                .or_default()
+                .push(record.test_returns.clone());
+        }
+        let rewards = self
+            .rewards
+            .get(&(record.method.clone(), record.run))
+            .map_or(&[][..], Vec::as_slice);
+        self.finished
+            .insert(order, RunSummary::new(record, rewards, self.window));
+        Ok(())
+    }
+
+    /// Keeps what a failed run left (its last good weights) and says what happened.
+    fn on_failed(
+        &mut self,
+        spec: &RunSpec,
+        err: TrainerError,
+        config: &Config,
+        output: &OutputOptions,
+    ) -> anyhow::Error {
+        let TrainerError::Diverged(divergence) = err else {
+            return anyhow::Error::new(err)
+                .context(format!("{} run {}", spec.method(), spec.run() + 1));
+        };
+        let Divergence {
+            method,
+            run,
+            source,
+            episodes,
+            steps,
+            last_good,
+        } = *divergence;
+        let info = PolicyInfo {
+            source_task: config.env.clone(),
+            training: TrainingBudget {
+                episodes: u64::from(episodes),
+                steps,
+            },
+            seed: spec.seed(),
+            final_score: None,
+            reused: None,
+        };
+        let policies = output.dir.join("policies");
+        let name = policy_file_name(spec.method(), run);
+        let kept = match policy_store::save(&policies, &name, &last_good, &info) {
+            Ok(_) => format!(
+                "its last good weights are in {}",
+                policies.join(&name).display()
+            ),
+            Err(err) => format!("its last good weights could not be saved: {err}"),
+        };
+        anyhow::anyhow!("policy {method} (run {run}) diverged: {source}; {kept}")
+    }
+
+    fn plot_data(&self, config: &Config) -> plots::PlotData {
+        let mut curves = Vec::new();
+        for method in method_labels(config) {
+            let runs: Vec<&Vec<f64>> = self
+                .rewards
+                .iter()
+                .filter(|((m, _), _)| *m == method)
+                .map(|(_, r)| r)
+                .collect();
+            if !runs.is_empty() {
+                curves.push(plots::Curve {
+                    label: method.clone(),
+                    returns: runs.into_iter().cloned().collect(),
+                    tests: self.tested.get(&method).cloned().unwrap_or_default(),
+                });
+            }
+        }
+        plots::PlotData {
+            task: crate::env::make(&config.env).id().to_string(),
+            window: self.window,
+            curves,
+            policy_names: self.names.clone(),
+            activations: self.activation_history.values().cloned().collect(),
+        }
+    }
 }
 
 /// `dqn[100,100]`, run 0 → `dqn-100-100-run0`: a plain file name.
@@ -169,30 +425,62 @@ fn policy_file_name(method: &str, run: u32) -> String {
     format!("{plain}-run{run}")
 }
 
+/// The labels of the config's methods, in the protocol's order.
+fn method_labels(config: &Config) -> Vec<String> {
+    config
+        .protocol
+        .methods
+        .iter()
+        .map(|m| match m {
+            Method::SapNet => SAPNET_LABEL.to_string(),
+            Method::Dqn { hidden } => dqn_label(hidden),
+        })
+        .collect()
+}
+
 /// One spec per (method, run), each with its own seed derived from the run seed.
-fn run_specs(config: &Config) -> Result<Vec<DqnRunSpec>> {
+fn run_specs(config: &Config, sources: Option<&Arc<Vec<SourcePolicy>>>) -> Result<Vec<RunSpec>> {
+    let labels = method_labels(config);
+    if let Some(twice) = labels
+        .iter()
+        .enumerate()
+        .find(|(i, l)| labels[..*i].contains(l))
+    {
+        bail!(
+            "config field `protocol.methods` lists {} twice; each method runs once per run",
+            twice.1
+        );
+    }
     let mut specs = Vec::new();
-    for (m, method) in config.protocol.methods.iter().enumerate() {
-        let hidden = match method {
-            Method::Dqn { hidden } => hidden,
-            Method::SapNet => bail!(
-                "this build runs DQN from scratch only: SAP-Net transfer runs (Algorithm 3) \
-                 are not implemented yet. Use a config whose protocol.methods lists only Dqn \
-                 methods, e.g. assets/dqn_cartpole.ron"
-            ),
-        };
-        for run in 0..config.protocol.runs {
-            specs.push(DqnRunSpec {
-                run,
-                method: dqn_label(hidden),
-                env: config.env.clone(),
-                dqn: config.dqn.clone(),
-                hidden: hidden.clone(),
-                episodes: config.protocol.episodes,
-                max_steps: config.protocol.max_steps,
-                test_episodes: config.protocol.test_episodes,
-                seed: seeds::derive(config.seed, &[m as u64, u64::from(run)]),
-                stream: trainer::StreamOptions::episodes(),
+    for run in 0..config.protocol.runs {
+        for (m, method) in config.protocol.methods.iter().enumerate() {
+            let seed = seeds::derive(config.seed, &[m as u64, u64::from(run)]);
+            specs.push(match method {
+                Method::Dqn { hidden } => RunSpec::Dqn(DqnRunSpec {
+                    run,
+                    method: dqn_label(hidden),
+                    env: config.env.clone(),
+                    dqn: config.dqn.clone(),
+                    hidden: hidden.clone(),
+                    episodes: config.protocol.episodes,
+                    max_steps: config.protocol.max_steps,
+                    test_episodes: config.protocol.test_episodes,
+                    seed,
+                    stream: StreamOptions::episodes(),
+                }),
+                Method::SapNet => RunSpec::Transfer(TransferRunSpec {
+                    run,
+                    method: SAPNET_LABEL.to_string(),
+                    env: config.env.clone(),
+                    dqn: config.dqn.clone(),
+                    sapnet: config.sapnet.clone(),
+                    sources: Arc::clone(sources.expect("SAP-Net runs load the library first")),
+                    episodes: config.protocol.episodes,
+                    max_steps: config.protocol.max_steps,
+                    test_episodes: config.protocol.test_episodes,
+                    seed,
+                    stream: StreamOptions::episodes(),
+                }),
             });
         }
     }
@@ -214,18 +502,33 @@ fn prepare_output(output: &OutputOptions) -> Result<()> {
             existing.join(", ")
         );
     }
-    // Old policies must not sit beside new results as if this run had trained them.
+    // Old files must not sit beside new results as if this run had made them.
     let policies = output.dir.join("policies");
     if policies.exists() {
         std::fs::remove_dir_all(&policies)
             .with_context(|| format!("removing the old results in {}", policies.display()))?;
     }
+    for stale in ["activations.csv", "learning_curve.png", "learning_curve.svg", "tests.png", "activations.png"] {
+        let path = output.dir.join(stale);
+        if path.exists() {
+            std::fs::remove_file(&path)
+                .with_context(|| format!("removing the old result {}", path.display()))?;
+        }
+    }
     Ok(())
 }
 
-fn policy_info(config: &Config, record: &trainer::RunRecord) -> PolicyInfo {
+fn policy_info(config: &Config, record: &trainer::RunRecord, spec: &RunSpec) -> PolicyInfo {
     let final_score = (!record.test_returns.is_empty())
         .then(|| record.test_returns.iter().sum::<f64>() / record.test_returns.len() as f64);
+    let reused = match (spec, &record.chosen) {
+        (RunSpec::Transfer(_), Some(chosen)) => Some(format!(
+            "{}/{}",
+            sources::source_task(config).task_name(),
+            chosen.name
+        )),
+        _ => None,
+    };
     PolicyInfo {
         source_task: config.env.clone(),
         training: TrainingBudget {
@@ -234,7 +537,34 @@ fn policy_info(config: &Config, record: &trainer::RunRecord) -> PolicyInfo {
         },
         seed: record.seed,
         final_score,
+        reused,
     }
+}
+
+/// Trains `spec` on a thread of its own and hands its events to `on_event`, on this thread,
+/// as they arrive. Gives back the command receiver with the outcome, for the next run.
+pub(crate) fn drive(
+    spec: &DqnRunSpec,
+    commands: Receiver<Command>,
+    mut on_event: impl FnMut(Event) -> Result<()>,
+) -> Result<(Result<RunOutcome, TrainerError>, Receiver<Command>)> {
+    let (events_tx, events_rx) = mpsc::channel();
+    let worker = {
+        let spec = spec.clone();
+        thread::Builder::new()
+            .name(format!("trainer {} run {}", spec.method, spec.run))
+            .spawn(move || {
+                let outcome = trainer::train(&spec, &events_tx, &commands);
+                (outcome, commands)
+            })
+            .context("starting the trainer thread")?
+    };
+    for event in events_rx {
+        on_event(event)?;
+    }
+    worker
+        .join()
+        .map_err(|_| anyhow::anyhow!("the trainer thread of {} panicked", spec.method))
 }
 
 #[cfg(test)]
@@ -245,5 +575,17 @@ mod tests {
     fn policy_file_names_are_plain() {
         assert_eq!(policy_file_name("dqn[100,100]", 0), "dqn-100-100-run0");
         assert_eq!(policy_file_name("dqn[16]", 3), "dqn-16-run3");
+        assert_eq!(policy_file_name("sapnet", 1), "sapnet-run1");
+    }
+
+    #[test]
+    fn a_method_listed_twice_is_refused() {
+        let mut config = Config::default();
+        config.protocol.methods = vec![
+            Method::Dqn { hidden: vec![8] },
+            Method::Dqn { hidden: vec![8] },
+        ];
+        let err = run_specs(&config, None).unwrap_err().to_string();
+        assert!(err.contains("`protocol.methods` lists dqn[8] twice"), "{err}");
     }
 }

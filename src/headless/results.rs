@@ -34,11 +34,126 @@ impl EpisodeWriter {
     }
 }
 
+/// `tests.csv`: the greedy test returns of every run, one row per test episode.
+pub struct TestsWriter {
+    csv: csv::Writer<File>,
+    path: String,
+}
+
+#[derive(Serialize)]
+struct TestRow<'a> {
+    run: u32,
+    method: &'a str,
+    /// 1-based.
+    test: usize,
+    #[serde(rename = "return")]
+    test_return: f64,
+    /// SAP-Net: the chosen policy that was tested.
+    policy: Option<&'a str>,
+}
+
+impl TestsWriter {
+    pub fn create(path: &Path) -> Result<Self> {
+        let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
+        // The header is written by hand so that it is there even if no run gets to its tests.
+        let mut csv = csv::WriterBuilder::new()
+            .has_headers(false)
+            .from_writer(file);
+        csv.write_record(["run", "method", "test", "return", "policy"])
+            .and_then(|()| csv.flush().map_err(Into::into))
+            .with_context(|| format!("writing {}", path.display()))?;
+        Ok(Self {
+            csv,
+            path: path.display().to_string(),
+        })
+    }
+
+    pub fn write(&mut self, record: &RunRecord) -> Result<()> {
+        let policy = record.chosen.as_ref().map(|c| c.name.as_str());
+        for (i, &test_return) in record.test_returns.iter().enumerate() {
+            let row = TestRow {
+                run: record.run,
+                method: &record.method,
+                test: i + 1,
+                test_return,
+                policy,
+            };
+            self.csv
+                .serialize(row)
+                .with_context(|| format!("writing {}", self.path))?;
+        }
+        self.csv
+            .flush()
+            .with_context(|| format!("writing {}", self.path))
+    }
+}
+
+/// `activations.csv`: SAP-Net's state at the end of every episode of every transfer run:
+/// `run, episode, A_<name>…, P_<name>…, selected_<name>…` (steps each policy acted in that
+/// episode).
+pub struct ActivationsWriter {
+    csv: csv::Writer<File>,
+    path: String,
+    policies: usize,
+    row: Vec<String>,
+}
+
+impl ActivationsWriter {
+    pub fn create(path: &Path, names: &[String]) -> Result<Self> {
+        let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
+        let mut csv = csv::Writer::from_writer(file);
+        let mut header = vec!["run".to_string(), "episode".to_string()];
+        for prefix in ["A", "P", "selected"] {
+            header.extend(names.iter().map(|n| format!("{prefix}_{n}")));
+        }
+        csv.write_record(&header)
+            .and_then(|()| csv.flush().map_err(Into::into))
+            .with_context(|| format!("writing {}", path.display()))?;
+        Ok(Self {
+            csv,
+            path: path.display().to_string(),
+            policies: names.len(),
+            row: Vec::with_capacity(header.len()),
+        })
+    }
+
+    pub fn write(
+        &mut self,
+        run: u32,
+        episode: u32,
+        activations: &[f64],
+        probabilities: &[f64],
+        selected: &[u64],
+    ) -> Result<()> {
+        debug_assert_eq!(activations.len(), self.policies);
+        self.row.clear();
+        self.row.push(run.to_string());
+        self.row.push(episode.to_string());
+        self.row.extend(activations.iter().map(ToString::to_string));
+        self.row.extend(probabilities.iter().map(ToString::to_string));
+        self.row.extend(selected.iter().map(ToString::to_string));
+        self.csv
+            .write_record(&self.row)
+            .and_then(|()| self.csv.flush().map_err(Into::into))
+            .with_context(|| format!("writing {}", self.path))
+    }
+}
+
+/// A source policy as `summary.json` lists it.
+#[derive(Debug, Serialize)]
+pub struct LibraryEntry {
+    pub name: String,
+    pub hidden: Vec<usize>,
+    pub final_score: Option<f64>,
+}
+
 /// `summary.json`.
 #[derive(Debug, Serialize)]
 pub struct Summary {
     pub crate_version: &'static str,
     pub config: Config,
+    /// The source library SAP-Net reused (absent without a SAP-Net method).
+    pub library: Option<Vec<LibraryEntry>>,
     pub runs: Vec<RunSummary>,
     pub wall_s: f64,
     /// Why the experiment ended early, if it failed (the runs above finished before).
@@ -65,6 +180,7 @@ impl Summary {
         Self {
             crate_version: env!("CARGO_PKG_VERSION"),
             config: config.clone(),
+            library: None,
             runs: Vec::new(),
             wall_s: 0.0,
             error: None,
