@@ -118,7 +118,8 @@ fn run_experiment(cli: &Cli) -> Result<()> {
 
 fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
     let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
-    let dir = crate::sources::train_library(&config, &cli.run.library, args.retrain, on_interrupt()?)?;
+    let dir =
+        crate::sources::train_library(&config, &cli.run.library, args.retrain, on_interrupt()?)?;
     eprintln!(
         "{} source policies in {}",
         config.sources.count,

@@ -54,7 +54,12 @@ pub struct RunArgs {
     pub jobs: Option<usize>,
 
     /// The policy library's root directory: SAP-Net reuses <LIBRARY>/<source task>/.
-    #[arg(long, value_name = "DIR", default_value = "saved_policies", global = true)]
+    #[arg(
+        long,
+        value_name = "DIR",
+        default_value = "saved_policies",
+        global = true
+    )]
     pub library: PathBuf,
 }
 

@@ -129,6 +129,11 @@ pub struct SourcesConfig {
     pub training_episodes: u32,
     /// The source task, when it differs from the target task (`None`: the same).
     pub env: Option<EnvConfig>,
+    /// DQN settings for training the sources, when they differ from the experiment's `dqn`
+    /// (`None`: the same; fields left out take Table I's defaults). The paper does not say
+    /// how its sources were trained; with Table I's settings MountainCar sources never
+    /// reach the flag.
+    pub dqn: Option<DqnConfig>,
 }
 
 impl Default for SourcesConfig {
@@ -139,6 +144,7 @@ impl Default for SourcesConfig {
             units: (50, 150),
             training_episodes: 5000,
             env: None,
+            dqn: None,
         }
     }
 }
@@ -304,93 +310,9 @@ impl Config {
     }
 
     pub fn validate(&self) -> Result<(), String> {
-        let d = &self.dqn;
-        check(
-            d.gamma >= 0.0 && d.gamma <= 1.0,
-            "dqn.gamma",
-            "a number in [0, 1]",
-            d.gamma,
-        )?;
-        let positive = |x: f64| x > 0.0 && x.is_finite();
-        check(
-            positive(d.learning_rate),
-            "dqn.learning_rate",
-            "a finite number > 0",
-            d.learning_rate,
-        )?;
-        check(
-            positive(d.adam_epsilon),
-            "dqn.adam_epsilon",
-            "a finite number > 0",
-            d.adam_epsilon,
-        )?;
-        let (beta1, beta2) = d.adam_betas;
-        check(
-            (0.0..1.0).contains(&beta1) && (0.0..1.0).contains(&beta2),
-            "dqn.adam_betas",
-            "(β₁, β₂) with each in [0, 1)",
-            format!("({beta1}, {beta2})"),
-        )?;
-        check(
-            d.batch_size > 0,
-            "dqn.batch_size",
-            "at least 1",
-            d.batch_size,
-        )?;
-        check(
-            d.replay_capacity >= d.batch_size,
-            "dqn.replay_capacity",
-            "at least dqn.batch_size",
-            d.replay_capacity,
-        )?;
-        check(
-            d.update_interval > 0,
-            "dqn.update_interval",
-            "at least 1",
-            d.update_interval,
-        )?;
-        check(
-            d.target_update_interval > 0,
-            "dqn.target_update_interval",
-            "at least 1",
-            d.target_update_interval,
-        )?;
-        check(
-            positive(d.huber_delta),
-            "dqn.huber_delta",
-            "a number > 0",
-            d.huber_delta,
-        )?;
-        check(
-            d.loss_decay >= 0.0 && d.loss_decay < 1.0,
-            "dqn.loss_decay",
-            "a number in [0, 1)",
-            d.loss_decay,
-        )?;
-        if let Some(norm) = d.max_grad_norm {
-            check(norm > 0.0, "dqn.max_grad_norm", "a number > 0", norm)?;
-        }
-        match d.exploration {
-            Exploration::Constant { epsilon } => check(
-                (0.0..=1.0).contains(&epsilon),
-                "dqn.exploration.epsilon",
-                "a number in [0, 1]",
-                epsilon,
-            )?,
-            Exploration::Linear { start, end, .. } => {
-                check(
-                    (0.0..=1.0).contains(&start),
-                    "dqn.exploration.start",
-                    "a number in [0, 1]",
-                    start,
-                )?;
-                check(
-                    (0.0..=1.0).contains(&end),
-                    "dqn.exploration.end",
-                    "a number in [0, 1]",
-                    end,
-                )?;
-            }
+        check_dqn(&self.dqn, "dqn")?;
+        if let Some(sources) = &self.sources.dqn {
+            check_dqn(sources, "sources.dqn")?;
         }
         self.sapnet
             .validate()
@@ -442,6 +364,99 @@ fn check(ok: bool, field: &str, expected: &str, got: impl fmt::Display) -> Resul
         Ok(())
     } else {
         Err(format!("field `{field}`: expected {expected}, got {got}"))
+    }
+}
+
+/// The ranges of a DQN config found at `prefix` (`dqn`, `sources.dqn`).
+fn check_dqn(d: &DqnConfig, prefix: &str) -> Result<(), String> {
+    check(
+        d.gamma >= 0.0 && d.gamma <= 1.0,
+        &format!("{prefix}.gamma"),
+        "a number in [0, 1]",
+        d.gamma,
+    )?;
+    let positive = |x: f64| x > 0.0 && x.is_finite();
+    check(
+        positive(d.learning_rate),
+        &format!("{prefix}.learning_rate"),
+        "a finite number > 0",
+        d.learning_rate,
+    )?;
+    check(
+        positive(d.adam_epsilon),
+        &format!("{prefix}.adam_epsilon"),
+        "a finite number > 0",
+        d.adam_epsilon,
+    )?;
+    let (beta1, beta2) = d.adam_betas;
+    check(
+        (0.0..1.0).contains(&beta1) && (0.0..1.0).contains(&beta2),
+        &format!("{prefix}.adam_betas"),
+        "(β₁, β₂) with each in [0, 1)",
+        format!("({beta1}, {beta2})"),
+    )?;
+    check(
+        d.batch_size > 0,
+        &format!("{prefix}.batch_size"),
+        "at least 1",
+        d.batch_size,
+    )?;
+    check(
+        d.replay_capacity >= d.batch_size,
+        &format!("{prefix}.replay_capacity"),
+        "at least dqn.batch_size",
+        d.replay_capacity,
+    )?;
+    check(
+        d.update_interval > 0,
+        &format!("{prefix}.update_interval"),
+        "at least 1",
+        d.update_interval,
+    )?;
+    check(
+        d.target_update_interval > 0,
+        &format!("{prefix}.target_update_interval"),
+        "at least 1",
+        d.target_update_interval,
+    )?;
+    check(
+        positive(d.huber_delta),
+        &format!("{prefix}.huber_delta"),
+        "a number > 0",
+        d.huber_delta,
+    )?;
+    check(
+        d.loss_decay >= 0.0 && d.loss_decay < 1.0,
+        &format!("{prefix}.loss_decay"),
+        "a number in [0, 1)",
+        d.loss_decay,
+    )?;
+    if let Some(norm) = d.max_grad_norm {
+        check(
+            norm > 0.0,
+            &format!("{prefix}.max_grad_norm"),
+            "a number > 0",
+            norm,
+        )?;
+    }
+    check_exploration(&d.exploration, &format!("{prefix}.exploration"))
+}
+
+/// ε values are probabilities; `field` is where the schedule sits in the config.
+fn check_exploration(exploration: &Exploration, field: &str) -> Result<(), String> {
+    let probability = |value: f64, name: &str| {
+        check(
+            (0.0..=1.0).contains(&value),
+            &format!("{field}.{name}"),
+            "a number in [0, 1]",
+            value,
+        )
+    };
+    match *exploration {
+        Exploration::Constant { epsilon } => probability(epsilon, "epsilon"),
+        Exploration::Linear { start, end, .. } => {
+            probability(start, "start").and_then(|()| probability(end, "end"))
+        }
     }
 }
 

@@ -13,8 +13,8 @@ use crate::config::Config;
 use crate::env::EnvConfig;
 use crate::headless::drive;
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
-use crate::seeds;
 use crate::sapnet::PolicyDescription;
+use crate::seeds;
 use crate::trainer::{
     Command, DqnRunSpec, Event, RunOutcome, SourcePolicy, StreamOptions, TrainerError,
 };
@@ -92,6 +92,7 @@ fn train_library_with(
     let mut progress = crate::headless::Progress::new(
         u64::from(config.sources.training_episodes) * plans.len() as u64,
     );
+    let source_dqn = config.sources.dqn.as_ref().unwrap_or(&config.dqn);
     let mut commands = commands;
     let mut trained = Vec::with_capacity(plans.len());
     for (i, source) in plans.iter().enumerate() {
@@ -99,7 +100,7 @@ fn train_library_with(
             run: i as u32,
             method: source.name.clone(),
             env: source_task(config).clone(),
-            dqn: config.dqn.clone(),
+            dqn: source_dqn.clone(),
             hidden: source.hidden.clone(),
             episodes: config.sources.training_episodes,
             max_steps: None,
@@ -183,12 +184,8 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
     let expected = source_task(config);
     let mut sources = Vec::with_capacity(names.len());
     for name in names {
-        let stored = policy_store::load_for_task(
-            &dir,
-            &name,
-            env.observation_size(),
-            env.action_count(),
-        )?;
+        let stored =
+            policy_store::load_for_task(&dir, &name, env.observation_size(), env.action_count())?;
         if &stored.metadata.source_task != expected {
             bail!(
                 "policy {} was trained on {:?}, but the config's source task is {:?}; retrain the \

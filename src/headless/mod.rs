@@ -355,8 +355,11 @@ impl Sink {
         output: &OutputOptions,
     ) -> anyhow::Error {
         let TrainerError::Diverged(divergence) = err else {
-            return anyhow::Error::new(err)
-                .context(format!("{} run {}", spec.method(), spec.run() + 1));
+            return anyhow::Error::new(err).context(format!(
+                "{} run {}",
+                spec.method(),
+                spec.run() + 1
+            ));
         };
         let Divergence {
             method,
@@ -508,7 +511,13 @@ fn prepare_output(output: &OutputOptions) -> Result<()> {
         std::fs::remove_dir_all(&policies)
             .with_context(|| format!("removing the old results in {}", policies.display()))?;
     }
-    for stale in ["activations.csv", "learning_curve.png", "learning_curve.svg", "tests.png", "activations.png"] {
+    for stale in [
+        "activations.csv",
+        "learning_curve.png",
+        "learning_curve.svg",
+        "tests.png",
+        "activations.png",
+    ] {
         let path = output.dir.join(stale);
         if path.exists() {
             std::fs::remove_file(&path)
@@ -586,6 +595,9 @@ mod tests {
             Method::Dqn { hidden: vec![8] },
         ];
         let err = run_specs(&config, None).unwrap_err().to_string();
-        assert!(err.contains("`protocol.methods` lists dqn[8] twice"), "{err}");
+        assert!(
+            err.contains("`protocol.methods` lists dqn[8] twice"),
+            "{err}"
+        );
     }
 }

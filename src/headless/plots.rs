@@ -113,11 +113,18 @@ fn learning_curve<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotD
             (i, c, mean_over_runs(&averaged))
         })
         .collect();
-    let episodes = lines.iter().map(|(_, _, l)| l.len() + w - 1).max().unwrap_or(w);
+    let episodes = lines
+        .iter()
+        .map(|(_, _, l)| l.len() + w - 1)
+        .max()
+        .unwrap_or(w);
     let (low, high) = value_range(lines.iter().flat_map(|(_, _, l)| l.iter().copied()));
     let mut chart = ChartBuilder::on(&root)
         .caption(
-            format!("{}: moving average of {w} episodes, mean of runs", data.task),
+            format!(
+                "{}: moving average of {w} episodes, mean of runs",
+                data.task
+            ),
             (FAMILY, 22),
         )
         .margin(12)
@@ -137,12 +144,14 @@ fn learning_curve<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotD
         let runs = curve.returns.len();
         chart
             .draw_series(LineSeries::new(
-                line.iter()
-                    .enumerate()
-                    .map(|(e, &v)| ((e + w) as f64, v)),
+                line.iter().enumerate().map(|(e, &v)| ((e + w) as f64, v)),
                 colour.stroke_width(2),
             ))?
-            .label(format!("{} ({runs} run{})", curve.label, if runs == 1 { "" } else { "s" }))
+            .label(format!(
+                "{} ({runs} run{})",
+                curve.label,
+                if runs == 1 { "" } else { "s" }
+            ))
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
     }
     chart
@@ -166,7 +175,12 @@ fn test_bars<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotData) 
         .filter(|(_, c)| !c.tests.is_empty())
         .map(|(i, c)| (i, c, mean_over_runs(&c.tests)))
         .collect();
-    let tests = tested.iter().map(|(_, _, t)| t.len()).max().unwrap_or(1).max(1);
+    let tests = tested
+        .iter()
+        .map(|(_, _, t)| t.len())
+        .max()
+        .unwrap_or(1)
+        .max(1);
     let (low, high) = value_range(
         tested
             .iter()
@@ -199,7 +213,10 @@ fn test_bars<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotData) 
         let left = |t: usize| t as f64 + 1.0 - group / 2.0 + k as f64 * width;
         chart
             .draw_series(means.iter().enumerate().map(|(t, &v)| {
-                Rectangle::new([(left(t), 0.0), (left(t) + width * 0.9, v)], colour.filled())
+                Rectangle::new(
+                    [(left(t), 0.0), (left(t) + width * 0.9, v)],
+                    colour.filled(),
+                )
             }))?
             .label(curve.label.clone())
             .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 14, y + 6)], colour.filled()));
@@ -286,11 +303,15 @@ fn activation_lines<DB: DrawingBackend>(
 fn value_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (low, high) = values
         .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+            (l.min(v), h.max(v))
+        });
     if !low.is_finite() {
         return (0.0, 1.0);
     }
-    let pad = ((high - low) * 0.05).max(1e-9).max(if high == low { 1.0 } else { 0.0 });
+    let pad = ((high - low) * 0.05)
+        .max(1e-9)
+        .max(if high == low { 1.0 } else { 0.0 });
     (low - pad, high + pad)
 }
 
@@ -337,7 +358,12 @@ mod tests {
             activations: vec![vec![vec![0.0, 1.0], vec![1.5, 1.0]]],
         };
         write_all(dir.path(), &data).unwrap();
-        for file in ["learning_curve.png", "learning_curve.svg", "tests.png", "activations.png"] {
+        for file in [
+            "learning_curve.png",
+            "learning_curve.svg",
+            "tests.png",
+            "activations.png",
+        ] {
             let bytes = std::fs::read(dir.path().join(file)).unwrap();
             assert!(bytes.len() > 1000, "{file} is {} bytes", bytes.len());
         }

@@ -130,7 +130,8 @@ impl ActivationsWriter {
         self.row.push(run.to_string());
         self.row.push(episode.to_string());
         self.row.extend(activations.iter().map(ToString::to_string));
-        self.row.extend(probabilities.iter().map(ToString::to_string));
+        self.row
+            .extend(probabilities.iter().map(ToString::to_string));
         self.row.extend(selected.iter().map(ToString::to_string));
         self.csv
             .write_record(&self.row)

@@ -148,7 +148,8 @@ mod tests {
         let (tx, rx) = mpsc::channel();
         let mut control = Control::new(&rx, false);
         tx.send(Command::Trace(true)).unwrap();
-        tx.send(Command::Throttle(Duration::from_millis(2))).unwrap();
+        tx.send(Command::Throttle(Duration::from_millis(2)))
+            .unwrap();
         assert_eq!(control.before_step(), Next::Step);
         assert!(control.trace());
         assert!(control.is_slow());

@@ -104,11 +104,8 @@ pub fn train_transfer(
     let started = Instant::now();
     let streams = Streams::new(spec.seed);
     let mut env = env::make(&spec.env);
-    let descriptions: Vec<PolicyDescription> = spec
-        .sources
-        .iter()
-        .map(|s| s.description.clone())
-        .collect();
+    let descriptions: Vec<PolicyDescription> =
+        spec.sources.iter().map(|s| s.description.clone()).collect();
     let mut sapnet = SapNet::from_policies(&descriptions, spec.sapnet.clone())?;
     let n = spec.sources.len();
     let mut agents = spec

@@ -1,0 +1,220 @@
+//! `sapnet --headless` with SAP-Net in the protocol: the library is trained when missing,
+//! reused when present, refused with the file named when it does not fit; every result
+//! file is written.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use sapnet::policy_store::{self, PolicyInfo, TrainingBudget};
+
+fn config(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/configs")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn sapnet(args: &[&str], library: &Path, out: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args(args)
+        .arg("--library")
+        .arg(library)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .expect("the binary runs")
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+fn transfer(library: &Path, out: &Path) -> Output {
+    sapnet(
+        &[
+            "--headless",
+            "--config",
+            &config("tiny_transfer.ron"),
+            "--jobs",
+            "2",
+        ],
+        library,
+        out,
+    )
+}
+
+/// Trains the tiny library once for a test and returns its task directory.
+fn train_library(library: &Path) -> PathBuf {
+    let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args([
+            "sources",
+            "--config",
+            &config("tiny_sources.ron"),
+            "--library",
+        ])
+        .arg(library)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    library.join("cartpole")
+}
+
+#[test]
+fn a_missing_library_is_trained_then_every_result_is_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (library, out) = (tmp.path().join("lib"), tmp.path().join("out"));
+    let output = transfer(&library, &out);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let message = stderr(&output);
+    assert!(message.contains("no source library in"), "{message}");
+    assert!(message.contains("chosen policy source-"), "{message}");
+    assert_eq!(
+        policy_store::list(&library.join("cartpole")).unwrap().len(),
+        3
+    );
+
+    // 2 methods × 2 runs × 12 episodes, SAP-Net's rows naming a policy.
+    let episodes = std::fs::read_to_string(out.join("episodes.csv")).unwrap();
+    let rows: Vec<&str> = episodes.lines().skip(1).collect();
+    assert_eq!(rows.len(), 48);
+    assert!(episodes.starts_with(
+        "run,method,episode,reward,steps,loss,statistic_loss,epsilon,policy,wall_s\n"
+    ));
+    assert!(rows
+        .iter()
+        .filter(|r| r.contains(",dqn[8],"))
+        .all(|r| r.split(',').nth(8) == Some("")));
+
+    let tests = std::fs::read_to_string(out.join("tests.csv")).unwrap();
+    assert_eq!(tests.lines().next(), Some("run,method,test,return,policy"));
+    assert_eq!(tests.lines().count(), 1 + 2 * 2 * 2);
+    assert!(tests
+        .lines()
+        .filter(|l| l.contains(",sapnet,"))
+        .all(|l| l.ends_with(|c: char| c.is_ascii_digit()) && l.contains("source-")));
+
+    let activations = std::fs::read_to_string(out.join("activations.csv")).unwrap();
+    assert!(activations.starts_with("run,episode,A_source-0,A_source-1,A_source-2,P_source-0"));
+    assert_eq!(activations.lines().count(), 1 + 2 * 12);
+
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["library"].as_array().unwrap().len(), 3);
+    let runs = summary["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 4);
+    let chosen = runs
+        .iter()
+        .find(|r| r["method"] == "sapnet")
+        .map(|r| r["chosen"]["name"].as_str().unwrap().to_string())
+        .unwrap();
+
+    let policy = policy_store::load(&out.join("policies"), "sapnet-run0").unwrap();
+    assert_eq!(
+        policy.metadata.reused.as_deref(),
+        Some(format!("cartpole/{chosen}").as_str())
+    );
+    for plot in [
+        "learning_curve.png",
+        "learning_curve.svg",
+        "tests.png",
+        "activations.png",
+    ] {
+        assert!(out.join(plot).metadata().unwrap().len() > 1000, "{plot}");
+    }
+}
+
+#[test]
+fn a_present_library_is_reused_unchanged() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    let dir = train_library(&library);
+    let before = std::fs::read(dir.join("source-1.safetensors")).unwrap();
+    let output = transfer(&library, &tmp.path().join("out"));
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(!stderr(&output).contains("no source library"));
+    assert_eq!(
+        std::fs::read(dir.join("source-1.safetensors")).unwrap(),
+        before
+    );
+}
+
+#[test]
+fn a_corrupted_policy_is_refused_by_name() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    let dir = train_library(&library);
+    let weights = dir.join("source-2.safetensors");
+    let mut bytes = std::fs::read(&weights).unwrap();
+    let last = bytes.len() - 1;
+    bytes[last] ^= 0xff;
+    std::fs::write(&weights, &bytes).unwrap();
+
+    let output = transfer(&library, &tmp.path().join("out"));
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(message.contains("source-2.safetensors"), "{message}");
+    assert!(message.contains("SHA-256"), "{message}");
+    // Nothing in the library was touched.
+    assert_eq!(std::fs::read(&weights).unwrap(), bytes);
+}
+
+#[test]
+fn a_policy_that_does_not_fit_the_task_is_refused_by_name() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    let dir = train_library(&library);
+    // A MountainCar-sized network (2 inputs, 3 actions) among the CartPole sources.
+    let net = sapnet::dqn::QNet::new(
+        sapnet::dqn::Architecture::new(2, &[4], 3),
+        &mut <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(0),
+    )
+    .unwrap();
+    let info = PolicyInfo {
+        source_task: sapnet::env::EnvConfig::CartPole(Default::default()),
+        training: TrainingBudget {
+            episodes: 1,
+            steps: 1,
+        },
+        seed: 0,
+        final_score: None,
+        reused: None,
+    };
+    policy_store::save(&dir, "stray", &net, &info).unwrap();
+
+    let output = transfer(&library, &tmp.path().join("out"));
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(message.contains("stray.ron"), "{message}");
+    assert!(message.contains("does not fit"), "{message}");
+    assert!(
+        message.contains("takes 2 observation values, the task gives 4"),
+        "{message}"
+    );
+}
+
+#[test]
+fn a_library_of_another_source_task_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    train_library(&library);
+    // The same config with a heavier pole as the source task: the library on disk was
+    // trained on the default pole.
+    let text = std::fs::read_to_string(config("tiny_transfer.ron"))
+        .unwrap()
+        .replace(
+            "training_episodes: 3)",
+            "training_episodes: 3, env: Some(CartPole(masspole: 0.2)))",
+        );
+    let heavier = tmp.path().join("heavier.ron");
+    std::fs::write(&heavier, text).unwrap();
+    let output = sapnet(
+        &["--headless", "--config", heavier.to_str().unwrap()],
+        &library,
+        &tmp.path().join("out"),
+    );
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(message.contains("source-0.ron was trained on"), "{message}");
+    assert!(message.contains("--retrain"), "{message}");
+}
