@@ -57,7 +57,7 @@ fn the_same_seed_gives_the_same_episodes() {
     let first = episodes_without_time(&a);
     assert_eq!(
         first[0],
-        "run,method,episode,reward,steps,loss,statistic_loss,epsilon"
+        "run,method,episode,reward,steps,loss,statistic_loss,epsilon,policy"
     );
     assert_eq!(first.len(), 1 + 2 * 30, "two runs of 30 episodes");
     assert_eq!(first, episodes_without_time(&b));

@@ -1,0 +1,118 @@
+//! What SAP-Net costs on top of the DQN it drives: training steps of the transfer loop
+//! (Algorithm 3: selection by eq. 6, one update, judgment, activation and spreading, the
+//! tallies and events) against a single DQN of the same architecture, over the same number
+//! of CartPole steps. All ten sources are 4-100-2, so both sides make one update of the same
+//! network per step and the difference is SAP-Net's.
+//!
+//! `cargo bench --bench transfer_overhead`. Three transfer variants: results-only events
+//! (headless), every step streamed as the TUI asks (`StreamOptions::live()`, drained by a
+//! thread), and with every positive activation traced as well.
+
+use std::sync::mpsc;
+use std::sync::Arc;
+use std::thread;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use rand::rngs::StdRng;
+use rand::SeedableRng;
+use sapnet::config::Config;
+use sapnet::dqn::{Architecture, QNet};
+use sapnet::sapnet::PolicyDescription;
+use sapnet::trainer::{
+    self, DqnRunSpec, Event, SourcePolicy, StreamOptions, TransferRunSpec,
+};
+
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+/// Learning steps per measured run. Before them, the transfer loop acts 10 × 50 warm-up
+/// steps and the DQN 50 (`replay_start_size`), neither learning.
+const STEPS: u64 = 3_000;
+
+fn sources() -> Arc<Vec<SourcePolicy>> {
+    Arc::new(
+        (0..10)
+            .map(|i| SourcePolicy {
+                name: format!("source-{i}"),
+                net: QNet::new(
+                    Architecture::new(4, &[100], 2),
+                    &mut StdRng::seed_from_u64(i),
+                )
+                .expect("network"),
+                description: PolicyDescription::new(vec![100], "cartpole"),
+                final_score: None,
+            })
+            .collect(),
+    )
+}
+
+/// Runs `train` with its events drained on another thread, as a front end would.
+fn drained(train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Command>)) {
+    let (events, received) = mpsc::channel();
+    let drain = thread::spawn(move || received.into_iter().count());
+    let (_commands, commands) = mpsc::channel();
+    train(&events, &commands);
+    drop(events);
+    drain.join().expect("drain thread");
+}
+
+fn overhead(c: &mut Criterion) {
+    if std::env::var_os("RAYON_NUM_THREADS").is_none() {
+        std::env::set_var("RAYON_NUM_THREADS", "1");
+    }
+    let config = Config::default();
+    let start = config.dqn.replay_start_size as u64;
+    let dqn = DqnRunSpec {
+        run: 0,
+        method: "dqn[100]".into(),
+        env: config.env.clone(),
+        dqn: config.dqn.clone(),
+        hidden: vec![100],
+        episodes: u32::MAX,
+        max_steps: Some(STEPS + start),
+        test_episodes: 0,
+        seed: 1,
+        stream: StreamOptions::episodes(),
+    };
+    let transfer = |stream: StreamOptions| TransferRunSpec {
+        run: 0,
+        method: "sapnet".into(),
+        env: config.env.clone(),
+        dqn: config.dqn.clone(),
+        sapnet: config.sapnet.clone(),
+        sources: sources(),
+        episodes: u32::MAX,
+        max_steps: Some(STEPS + 10 * start),
+        test_episodes: 0,
+        seed: 1,
+        stream,
+    };
+
+    let mut group = c.benchmark_group("transfer_overhead");
+    group.sample_size(20);
+    group.measurement_time(Duration::from_secs(20));
+    group.bench_function("dqn[100]", |b| {
+        b.iter(|| drained(|e, c| drop(trainer::train(&dqn, e, c).expect("run"))))
+    });
+    for (name, stream) in [
+        ("sapnet 10x[100] results only", StreamOptions::episodes()),
+        ("sapnet 10x[100] live", StreamOptions::live()),
+        (
+            "sapnet 10x[100] live+trace",
+            StreamOptions {
+                trace: true,
+                ..StreamOptions::live()
+            },
+        ),
+    ] {
+        let spec = transfer(stream);
+        group.bench_function(name, |b| {
+            b.iter(|| drained(|e, c| drop(trainer::train_transfer(&spec, e, c).expect("run"))))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, overhead);
+criterion_main!(benches);
