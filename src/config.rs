@@ -299,7 +299,6 @@ impl Config {
         Ok(config)
     }
 
-    /// Checks the values serde cannot: ranges and relations between fields.
     /// Cuts the protocol for a smoke run: 1/20 of the episodes, at most 2 runs per method.
     /// The source library is the real one (a library trained on a cut budget would be
     /// reused by later full runs).
@@ -309,6 +308,7 @@ impl Config {
         self.protocol.runs = self.protocol.runs.min(2);
     }
 
+    /// Checks the values serde cannot: ranges and relations between fields.
     pub fn validate(&self) -> Result<(), String> {
         check_dqn(&self.dqn, "dqn")?;
         if let Some(sources) = &self.sources.dqn {

@@ -20,6 +20,8 @@ pub mod spreading;
 
 use rand::Rng;
 
+use selection::SelectionTerms;
+
 pub use config::{BaseGraph, Paths, Prototype, SapNetParams, WeightedPrototype};
 pub use error::SapNetError;
 pub use graph::Graph;
@@ -70,6 +72,8 @@ pub struct SapNet {
     graph: Graph,
     params: SapNetParams,
     activations: Vec<f64>,
+    /// Eq. 6's terms for `activations`, updated whenever they change.
+    selection: SelectionTerms,
 }
 
 impl SapNet {
@@ -97,10 +101,12 @@ impl SapNet {
         params.validate()?;
         check_spreading_bound(&graph, params.threshold)?;
         check_activations(graph.len(), &activations)?;
+        let selection = SelectionTerms::new(&activations, params.temperature);
         Ok(Self {
             graph,
             params,
             activations,
+            selection,
         })
     }
 
@@ -145,12 +151,12 @@ impl SapNet {
 
     /// The selection probabilities of eq. 6.
     pub fn probabilities(&self) -> Vec<f64> {
-        selection::probabilities(&self.activations, self.params.temperature)
+        self.selection.probabilities()
     }
 
     /// Draws the policy that acts next with the probabilities of eq. 6.
     pub fn select(&self, rng: &mut impl Rng) -> usize {
-        selection::select(&self.activations, self.params.temperature, rng)
+        self.selection.draw(rng)
     }
 
     /// The chosen policy after training: the highest activation, the lowest index on a tie.
@@ -202,12 +208,16 @@ impl SapNet {
             &mut self.activations,
             sink,
         );
+        self.selection
+            .update(&self.activations, self.params.temperature);
     }
 
     /// Replaces the activations, e.g. with a state a front end stepped back to.
     pub fn set_activations(&mut self, activations: Vec<f64>) -> Result<(), SapNetError> {
         check_activations(self.len(), &activations)?;
         self.activations = activations;
+        self.selection
+            .update(&self.activations, self.params.temperature);
         Ok(())
     }
 }

@@ -38,11 +38,58 @@ pub fn select(activations: &[f64], tau: f64, rng: &mut impl Rng) -> usize {
     let max = max(activations);
     let term = |a: f64| ((a - max) / tau).exp();
     let total: f64 = activations.iter().map(|&a| term(a)).sum();
+    draw(activations.iter().map(|&a| term(a)), total, rng)
+}
+
+/// Eq. 6's unnormalised terms `exp((A_i − max_j A_j)/τ)` and their sum, kept between
+/// activations: the transfer loop selects at every step but activates only after a
+/// positive transition, so this saves N `exp` calls on most steps. Draws and
+/// probabilities are bit-identical to [`select`] and [`probabilities`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelectionTerms {
+    terms: Vec<f64>,
+    total: f64,
+}
+
+impl SelectionTerms {
+    pub fn new(activations: &[f64], tau: f64) -> Self {
+        let mut terms = Self {
+            terms: Vec::with_capacity(activations.len()),
+            total: 0.0,
+        };
+        terms.update(activations, tau);
+        terms
+    }
+
+    /// Recomputes the terms after the activations changed.
+    pub fn update(&mut self, activations: &[f64], tau: f64) {
+        let max = max(activations);
+        self.terms.clear();
+        self.terms
+            .extend(activations.iter().map(|&a| ((a - max) / tau).exp()));
+        self.total = self.terms.iter().sum();
+    }
+
+    /// As [`select`] on the activations of the last update.
+    ///
+    /// # Panics
+    /// If there are no policies.
+    pub fn draw(&self, rng: &mut impl Rng) -> usize {
+        assert!(!self.terms.is_empty(), "selecting from no policies");
+        draw(self.terms.iter().copied(), self.total, rng)
+    }
+
+    /// As [`probabilities`] on the activations of the last update.
+    pub fn probabilities(&self) -> Vec<f64> {
+        self.terms.iter().map(|t| t / self.total).collect()
+    }
+}
+
+fn draw(terms: impl Iterator<Item = f64>, total: f64, rng: &mut impl Rng) -> usize {
     let target = rng.random::<f64>() * total;
     let mut running = 0.0;
     let mut last_possible = 0;
-    for (i, &a) in activations.iter().enumerate() {
-        let t = term(a);
+    for (i, t) in terms.enumerate() {
         running += t;
         if target < running {
             return i;
@@ -92,5 +139,19 @@ mod tests {
         let a = [0.0, 800.0];
         let mut rng = StdRng::seed_from_u64(1);
         assert!((0..1000).all(|_| select(&a, 1.0, &mut rng) == 1));
+    }
+
+    #[test]
+    fn kept_terms_draw_and_weigh_exactly_as_the_formula() {
+        let mut rng_formula = StdRng::seed_from_u64(3);
+        let mut rng_kept = StdRng::seed_from_u64(3);
+        let mut terms = SelectionTerms::new(&[0.0; 4], 0.5);
+        for a in [[0.0, 0.3, 2.5, 1e-9], [5e5, 5e5 + 0.25, 4e5, 5e5 - 1.0]] {
+            terms.update(&a, 0.5);
+            assert_eq!(terms.probabilities(), probabilities(&a, 0.5));
+            for _ in 0..1000 {
+                assert_eq!(terms.draw(&mut rng_kept), select(&a, 0.5, &mut rng_formula));
+            }
+        }
     }
 }
