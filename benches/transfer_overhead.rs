@@ -19,20 +19,19 @@ use rand::SeedableRng;
 use sapnet::config::Config;
 use sapnet::dqn::{Architecture, QNet};
 use sapnet::sapnet::PolicyDescription;
-use sapnet::trainer::{
-    self, DqnRunSpec, Event, SourcePolicy, StreamOptions, TransferRunSpec,
-};
+use sapnet::trainer::{self, DqnRunSpec, Event, SourcePolicy, StreamOptions, TransferRunSpec};
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-/// Learning steps per measured run. Before them, the transfer loop acts 10 × 50 warm-up
-/// steps and the DQN 50 (`replay_start_size`), neither learning.
+/// Learning steps per measured run. Before them both sides act the same number of
+/// warm-up steps without learning: the transfer loop 10 × 50 (N × `replay_start_size`),
+/// the DQN 500 (its `replay_start_size` raised to match).
 const STEPS: u64 = 3_000;
 
-fn sources() -> Arc<Vec<SourcePolicy>> {
+fn sources(n: u64) -> Arc<Vec<SourcePolicy>> {
     Arc::new(
-        (0..10)
+        (0..n)
             .map(|i| SourcePolicy {
                 name: format!("source-{i}"),
                 net: QNet::new(
@@ -47,10 +46,23 @@ fn sources() -> Arc<Vec<SourcePolicy>> {
     )
 }
 
-/// Runs `train` with its events drained on another thread, as a front end would.
+/// Runs `train` with its events drained on another thread every 10 ms, as both front ends
+/// drain them (headless between progress updates, the TUI once per frame): never parked
+/// on the channel, so that no send has to wake a thread.
 fn drained(train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Command>)) {
-    let (events, received) = mpsc::channel();
-    let drain = thread::spawn(move || received.into_iter().count());
+    let (events, received) = mpsc::channel::<Event>();
+    let drain = thread::spawn(move || {
+        let mut count = 0;
+        loop {
+            thread::sleep(Duration::from_millis(10));
+            count += received.try_iter().count();
+            match received.try_recv() {
+                Ok(_) => count += 1,
+                Err(mpsc::TryRecvError::Empty) => {}
+                Err(mpsc::TryRecvError::Disconnected) => return count,
+            }
+        }
+    });
     let (_commands, commands) = mpsc::channel();
     train(&events, &commands);
     drop(events);
@@ -63,14 +75,18 @@ fn overhead(c: &mut Criterion) {
     }
     let config = Config::default();
     let start = config.dqn.replay_start_size as u64;
+    let warm_up = 10 * start;
     let dqn = DqnRunSpec {
         run: 0,
         method: "dqn[100]".into(),
         env: config.env.clone(),
-        dqn: config.dqn.clone(),
+        dqn: sapnet::config::DqnConfig {
+            replay_start_size: config.dqn.replay_start_size * 10,
+            ..config.dqn.clone()
+        },
         hidden: vec![100],
         episodes: u32::MAX,
-        max_steps: Some(STEPS + start),
+        max_steps: Some(STEPS + warm_up),
         test_episodes: 0,
         seed: 1,
         stream: StreamOptions::episodes(),
@@ -81,9 +97,9 @@ fn overhead(c: &mut Criterion) {
         env: config.env.clone(),
         dqn: config.dqn.clone(),
         sapnet: config.sapnet.clone(),
-        sources: sources(),
+        sources: sources(10),
         episodes: u32::MAX,
-        max_steps: Some(STEPS + 10 * start),
+        max_steps: Some(STEPS + warm_up),
         test_episodes: 0,
         seed: 1,
         stream,
@@ -111,6 +127,19 @@ fn overhead(c: &mut Criterion) {
             b.iter(|| drained(|e, c| drop(trainer::train_transfer(&spec, e, c).expect("run"))))
         });
     }
+    // One source, warming up as long as the others: SAP-Net's bookkeeping without the
+    // cost of keeping ten networks warm in the caches.
+    let single = TransferRunSpec {
+        dqn: sapnet::config::DqnConfig {
+            replay_start_size: config.dqn.replay_start_size * 10,
+            ..config.dqn.clone()
+        },
+        sources: sources(1),
+        ..transfer(StreamOptions::episodes())
+    };
+    group.bench_function("sapnet 1x[100] results only", |b| {
+        b.iter(|| drained(|e, c| drop(trainer::train_transfer(&single, e, c).expect("run"))))
+    });
     group.finish();
 }
 
