@@ -3,15 +3,18 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc;
+use std::sync::{mpsc, Arc};
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use anyhow::{Context, Result};
 
 use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, TeachArgs};
-use crate::config::Config;
+use crate::config::{Config, Method};
 use crate::headless::{self, OutputOptions, RunOptions};
-use crate::{assets, env, random_episodes, trainer};
+use crate::teach::config::TeachConfig;
+use crate::trainer::{RunSpec, StreamOptions, TransferRunSpec};
+use crate::tui::{self, teach::Teach};
+use crate::{assets, env, random_episodes, sources, trainer};
 
 pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
@@ -47,10 +50,21 @@ fn run_env(cli: &Cli, args: &EnvArgs) -> Result<()> {
 
 fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
     if !args.headless {
-        anyhow::bail!(
-            "the interactive teach view comes with the TUI; for now use \
-             `sapnet teach --headless --activate I`"
-        );
+        let lesson = TeachConfig::load(cli.run.config.as_deref())?;
+        let n = lesson.net.len();
+        if let Some(&i) = args.activate.iter().find(|&&i| i >= n) {
+            anyhow::bail!(
+                "--activate {i}: there is no policy {i}; the lesson has {n}, numbered 0 to {}",
+                n.saturating_sub(1)
+            );
+        }
+        let mut teach = Teach::new(lesson.names, lesson.net);
+        for &i in &args.activate {
+            teach.move_cursor(i as isize - teach.cursor() as isize);
+            teach.activate();
+            teach.run_to_end();
+        }
+        return tui::run_teach(teach);
     }
     crate::teach::headless::run(
         cli.run.config.as_deref(),
@@ -60,12 +74,12 @@ fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
 }
 
 fn run_experiment(cli: &Cli) -> Result<()> {
-    if !cli.run.headless {
-        eprintln!("note: the live dashboard is not built yet; running headless (--headless).");
-    }
     let mut config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
     if cli.run.quick {
         config.quick();
+    }
+    if !cli.run.headless {
+        return run_dashboard(cli, &config);
     }
     let dir = match &cli.run.out {
         Some(dir) => dir.clone(),
@@ -113,6 +127,46 @@ fn run_experiment(cli: &Cli) -> Result<()> {
             );
         }
     }
+    Ok(())
+}
+
+/// The dashboard follows the first run of SAP-Net, step by step, beside the first run of
+/// the first baseline, episode by episode; the library is loaded (or trained, with a
+/// progress bar) before the screen switches.
+fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
+    let sources = if config.protocol.methods.contains(&Method::SapNet) {
+        let (sources, _) = sources::ensure_library(config, &cli.run.library, on_interrupt()?)?;
+        Some(Arc::new(sources))
+    } else {
+        None
+    };
+    let specs = headless::run_specs(config, sources.as_ref())?;
+    let transfer = specs.iter().find_map(|s| match s {
+        RunSpec::Transfer(t) if t.run == 0 => Some(RunSpec::Transfer(TransferRunSpec {
+            stream: StreamOptions::live(),
+            ..t.clone()
+        })),
+        _ => None,
+    });
+    let baseline = specs
+        .iter()
+        .find(|s| matches!(s, RunSpec::Dqn(d) if d.run == 0))
+        .cloned();
+    let (events_tx, events) = mpsc::channel();
+    let mut runs = Vec::new();
+    for spec in transfer.into_iter().chain(baseline) {
+        let leads = runs.is_empty();
+        let handle =
+            trainer::spawn(spec, events_tx.clone()).context("starting a trainer thread")?;
+        runs.push(tui::Driven { handle, leads });
+    }
+    drop(events_tx);
+    let task = env::make(&config.env).id().to_string();
+    tui::run_dashboard(&task, runs, events)?;
+    eprintln!(
+        "the dashboard keeps no files: `sapnet --headless --out DIR` writes the whole \
+         protocol's results"
+    );
     Ok(())
 }
 

@@ -10,6 +10,7 @@
 //! - [`trainer`]: training runs on their own thread, reporting through events;
 //!   [`headless`]: the scripted front end over those events.
 //! - [`teach`]: stepping activation and spreading by hand on a small graph.
+//! - [`tui`]: the terminal dashboard over the trainer's events, and interactive teach mode.
 //! - [`config`]: the RON run configuration, with the paper's values as defaults.
 
 pub mod app;
@@ -26,3 +27,4 @@ pub mod seeds;
 pub mod sources;
 pub mod teach;
 pub mod trainer;
+pub mod tui;

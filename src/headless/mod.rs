@@ -448,7 +448,10 @@ fn method_labels(config: &Config) -> Vec<String> {
 }
 
 /// One spec per (method, run), each with its own seed derived from the run seed.
-fn run_specs(config: &Config, sources: Option<&Arc<Vec<SourcePolicy>>>) -> Result<Vec<RunSpec>> {
+pub(crate) fn run_specs(
+    config: &Config,
+    sources: Option<&Arc<Vec<SourcePolicy>>>,
+) -> Result<Vec<RunSpec>> {
     let labels = method_labels(config);
     if let Some(twice) = labels
         .iter()

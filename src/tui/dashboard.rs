@@ -1,0 +1,464 @@
+//! The dashboard's state: what the UI keeps of the trainer's event stream, and what the
+//! keys do to it. No drawing here (see `view`), so scripted events and keys can be checked
+//! without a terminal.
+//!
+//! Memory stays bounded over any run: steps are folded into counters as they arrive, and
+//! the curves keep one point per episode, thinned by half whenever they pass
+//! [`CURVE_POINTS`].
+
+use std::collections::VecDeque;
+use std::time::{Duration, Instant};
+
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+
+use crate::sapnet::{PolicyDescription, Prototype, SapNet};
+use crate::trainer::{ActivationSnapshot, Command, Event, RunRecord};
+
+use super::teach::Teach;
+
+/// Points kept per curve; beyond it every other point is dropped and the stride doubles.
+pub const CURVE_POINTS: usize = 4096;
+
+/// The delays between trainer steps that `+` and `-` move through; the first is full
+/// speed.
+pub const SPEEDS: [Duration; 6] = [
+    Duration::ZERO,
+    Duration::from_millis(1),
+    Duration::from_millis(10),
+    Duration::from_millis(50),
+    Duration::from_millis(200),
+    Duration::from_millis(1000),
+];
+
+/// Steps a policy's edges stay highlighted after it spread activation.
+const SPREAD_GLOW_STEPS: u64 = 8;
+
+/// Episodes averaged by the reward chart's moving average (the paper's 10).
+const WINDOW: usize = 10;
+
+/// What the user is doing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    Running,
+    Paused,
+    Teach,
+}
+
+/// Which panel the arrows move in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Focus {
+    Table,
+    Graph,
+}
+
+/// What the UI loop must do after a key.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    None,
+    /// Send this to the SAP-Net run (or the only run).
+    Send(Command),
+    /// Pause or resume every run.
+    SendAll(Command),
+    Quit,
+}
+
+/// One learning curve: episode returns, their moving average, thinned as it grows.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Curve {
+    /// `(episode, return)` of the kept episodes.
+    pub returns: Vec<(f64, f64)>,
+    /// `(episode, MA10)`.
+    pub average: Vec<(f64, f64)>,
+    window: VecDeque<f64>,
+    stride: u32,
+    seen: u32,
+}
+
+impl Curve {
+    fn push(&mut self, episode: u32, reward: f64) {
+        self.window.push_back(reward);
+        if self.window.len() > WINDOW {
+            self.window.pop_front();
+        }
+        self.seen += 1;
+        if self.stride == 0 {
+            self.stride = 1;
+        }
+        if self.seen % self.stride != 0 {
+            return;
+        }
+        let mean = self.window.iter().sum::<f64>() / self.window.len() as f64;
+        self.returns.push((f64::from(episode), reward));
+        self.average.push((f64::from(episode), mean));
+        if self.returns.len() > CURVE_POINTS {
+            thin(&mut self.returns);
+            thin(&mut self.average);
+            self.stride *= 2;
+        }
+    }
+
+    /// The latest moving average.
+    pub fn last_average(&self) -> Option<f64> {
+        (!self.window.is_empty())
+            .then(|| self.window.iter().sum::<f64>() / self.window.len() as f64)
+    }
+}
+
+fn thin(points: &mut Vec<(f64, f64)>) {
+    let mut i = 0;
+    points.retain(|_| {
+        i += 1;
+        i % 2 == 0
+    });
+}
+
+/// A source policy as the table shows it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PolicyRow {
+    pub name: String,
+    pub description: PolicyDescription,
+    pub final_score: Option<f64>,
+}
+
+/// The SAP-Net run's live state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SapNetView {
+    pub policies: Vec<PolicyRow>,
+    /// The graph and parameters, with the activations of the latest snapshot.
+    pub net: SapNet,
+    pub probabilities: Vec<f64>,
+    pub selections: Vec<u64>,
+    pub positive: Vec<u64>,
+    pub negative: Vec<u64>,
+    /// The policy that acted at the latest step.
+    pub acting: Option<usize>,
+    /// The last policy that activated and spread, and the step it did.
+    pub spread: Option<(usize, u64)>,
+}
+
+impl SapNetView {
+    /// The category of each policy under the config's first prototype, numbered in order
+    /// of appearance.
+    pub fn categories(&self) -> Vec<usize> {
+        let prototype = self
+            .net
+            .params()
+            .prototypes
+            .first()
+            .map_or(Prototype::HiddenLayers, |p| p.prototype.clone());
+        let mut keys = Vec::new();
+        self.policies
+            .iter()
+            .map(|p| {
+                let key = prototype.category(&p.description);
+                keys.iter().position(|k| *k == key).unwrap_or_else(|| {
+                    keys.push(key);
+                    keys.len() - 1
+                })
+            })
+            .collect()
+    }
+
+    /// Whether `policy`'s edges are still lit from a recent spread.
+    pub fn glows(&self, policy: usize, step: u64) -> bool {
+        matches!(self.spread, Some((p, at)) if p == policy && step.saturating_sub(at) < SPREAD_GLOW_STEPS)
+    }
+}
+
+/// One training run as the dashboard follows it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunView {
+    pub method: String,
+    pub planned_episodes: u32,
+    pub episode: u32,
+    pub curve: Curve,
+    pub epsilon: f64,
+    pub statistic_loss: Vec<f64>,
+    pub ended: Option<RunRecord>,
+}
+
+/// Everything the dashboard draws.
+#[derive(Debug, Clone)]
+pub struct Dashboard {
+    pub task: String,
+    pub mode: Mode,
+    pub focus: Focus,
+    pub help: bool,
+    /// The policy the arrows point at.
+    pub cursor: usize,
+    pub speed: usize,
+    /// The SAP-Net run (first) and the baselines, in the order they started.
+    pub runs: Vec<RunView>,
+    pub sapnet: Option<SapNetView>,
+    /// Steps of the followed run (SAP-Net if any).
+    pub step: u64,
+    /// Measured training speed, once there is enough to measure.
+    pub steps_per_second: Option<f64>,
+    speedometer: VecDeque<(Instant, u64)>,
+    pub teach: Option<Teach>,
+}
+
+impl Dashboard {
+    pub fn new(task: impl Into<String>) -> Self {
+        Self {
+            task: task.into(),
+            mode: Mode::Running,
+            focus: Focus::Table,
+            help: false,
+            cursor: 0,
+            speed: 0,
+            runs: Vec::new(),
+            sapnet: None,
+            step: 0,
+            steps_per_second: None,
+            speedometer: VecDeque::new(),
+            teach: None,
+        }
+    }
+
+    /// The run the status bar follows: SAP-Net's if there is one, else the first.
+    pub fn main_run(&self) -> Option<&RunView> {
+        self.runs.first()
+    }
+
+    /// Folds one trainer event into the state.
+    pub fn on_event(&mut self, event: Event) {
+        match event {
+            Event::RunStarted {
+                method,
+                planned_episodes,
+                sapnet,
+                ..
+            } => {
+                let run = RunView {
+                    method,
+                    planned_episodes,
+                    episode: 0,
+                    curve: Curve::default(),
+                    epsilon: 0.0,
+                    statistic_loss: Vec::new(),
+                    ended: None,
+                };
+                if let Some(start) = sapnet {
+                    let n = start.net.len();
+                    self.sapnet = Some(SapNetView {
+                        policies: start
+                            .policies
+                            .into_iter()
+                            .map(|p| PolicyRow {
+                                name: p.name,
+                                description: p.description,
+                                final_score: p.final_score,
+                            })
+                            .collect(),
+                        probabilities: start.net.probabilities(),
+                        net: start.net,
+                        selections: vec![0; n],
+                        positive: vec![0; n],
+                        negative: vec![0; n],
+                        acting: None,
+                        spread: None,
+                    });
+                    self.runs.insert(0, run);
+                } else {
+                    self.runs.push(run);
+                }
+            }
+            Event::Step(step) => {
+                if let Some(view) = &mut self.sapnet {
+                    view.acting = Some(step.policy);
+                    if step.transition.is_some_and(|t| t <= 0.0) {
+                        view.spread = Some((step.policy, step.step));
+                    }
+                }
+                self.step = step.step;
+            }
+            Event::Activations(snapshot) => self.on_snapshot(snapshot),
+            Event::Trace(_) => {}
+            Event::EpisodeEnded(record) => {
+                let follows_steps = self.sapnet.is_some();
+                if let Some(run) = self.runs.iter_mut().find(|r| r.method == record.method) {
+                    run.episode = record.episode;
+                    run.epsilon = record.epsilon;
+                    run.curve.push(record.episode, record.reward);
+                    run.statistic_loss.push(record.statistic_loss);
+                    if run.statistic_loss.len() > CURVE_POINTS {
+                        run.statistic_loss.drain(..CURVE_POINTS / 2);
+                    }
+                }
+                if !follows_steps && self.runs.first().is_some_and(|r| r.method == record.method) {
+                    self.step += u64::from(record.steps);
+                }
+            }
+            Event::RunEnded(record) => {
+                if let Some(run) = self.runs.iter_mut().find(|r| r.method == record.method) {
+                    run.ended = Some(record);
+                }
+            }
+        }
+    }
+
+    fn on_snapshot(&mut self, snapshot: ActivationSnapshot) {
+        let Some(view) = &mut self.sapnet else {
+            return;
+        };
+        // A snapshot always comes from the net announced at the start, so the counts agree.
+        if view.net.set_activations(snapshot.activations).is_ok() {
+            view.probabilities = snapshot.probabilities;
+            view.selections = snapshot.selections;
+            view.positive = snapshot.positive;
+            view.negative = snapshot.negative;
+        }
+        self.step = self.step.max(snapshot.step);
+    }
+
+    /// Records the step count at `now` for the steps/s figure (over the last 2 s).
+    pub fn tick(&mut self, now: Instant) {
+        self.speedometer.push_back((now, self.step));
+        while self
+            .speedometer
+            .front()
+            .is_some_and(|(t, _)| now.duration_since(*t) > Duration::from_secs(2))
+        {
+            self.speedometer.pop_front();
+        }
+        if let (Some((t0, s0)), Some((t1, s1))) =
+            (self.speedometer.front(), self.speedometer.back())
+        {
+            let seconds = t1.duration_since(*t0).as_secs_f64();
+            if seconds >= 0.5 {
+                self.steps_per_second = Some((s1 - s0) as f64 / seconds);
+            }
+        }
+    }
+
+    /// The number of policies the arrows move over.
+    fn policy_count(&self) -> usize {
+        self.sapnet.as_ref().map_or(0, |v| v.policies.len())
+    }
+
+    /// What `key` does. Keys in teach mode go to [`Teach`]; `t` or Esc leaves it.
+    pub fn on_key(&mut self, key: KeyEvent) -> Action {
+        let ctrl_c =
+            key.code == KeyCode::Char('c') && key.modifiers.contains(KeyModifiers::CONTROL);
+        if ctrl_c || key.code == KeyCode::Char('q') {
+            return Action::Quit;
+        }
+        if self.help {
+            // Any key closes the help overlay.
+            self.help = false;
+            return Action::None;
+        }
+        if self.mode == Mode::Teach {
+            return self.on_teach_key(key);
+        }
+        match key.code {
+            KeyCode::Esc => Action::Quit,
+            KeyCode::Char('?') => {
+                self.help = true;
+                Action::None
+            }
+            KeyCode::Char(' ') => match self.mode {
+                Mode::Running => {
+                    self.mode = Mode::Paused;
+                    Action::SendAll(Command::Pause)
+                }
+                _ => {
+                    self.mode = Mode::Running;
+                    Action::SendAll(Command::Resume)
+                }
+            },
+            KeyCode::Char('n') if self.mode == Mode::Paused => Action::Send(Command::Step),
+            KeyCode::Char('+') | KeyCode::Char('=') => self.set_speed(self.speed.saturating_sub(1)),
+            KeyCode::Char('-') => self.set_speed((self.speed + 1).min(SPEEDS.len() - 1)),
+            KeyCode::Tab => {
+                self.focus = match self.focus {
+                    Focus::Table => Focus::Graph,
+                    Focus::Graph => Focus::Table,
+                };
+                Action::None
+            }
+            KeyCode::Up | KeyCode::Char('k') | KeyCode::Left | KeyCode::Char('h') => {
+                self.move_cursor(-1);
+                Action::None
+            }
+            KeyCode::Down | KeyCode::Char('j') | KeyCode::Right | KeyCode::Char('l') => {
+                self.move_cursor(1);
+                Action::None
+            }
+            KeyCode::Char('t') => self.enter_teach(),
+            _ => Action::None,
+        }
+    }
+
+    fn set_speed(&mut self, speed: usize) -> Action {
+        self.speed = speed;
+        Action::Send(Command::Throttle(SPEEDS[speed]))
+    }
+
+    fn move_cursor(&mut self, delta: isize) {
+        let n = self.policy_count() as isize;
+        if n > 0 {
+            self.cursor = (self.cursor as isize + delta).rem_euclid(n) as usize;
+        }
+    }
+
+    /// `t`: pauses training and steps spreading by hand on a copy of the live net.
+    fn enter_teach(&mut self) -> Action {
+        let Some(view) = &self.sapnet else {
+            return Action::None;
+        };
+        let names = view.policies.iter().map(|p| p.name.clone()).collect();
+        let mut teach = Teach::new(names, view.net.clone()).with_groups(view.categories());
+        teach.move_cursor(self.cursor as isize);
+        self.teach = Some(teach);
+        let was_running = self.mode == Mode::Running;
+        self.mode = Mode::Teach;
+        if was_running {
+            Action::SendAll(Command::Pause)
+        } else {
+            Action::None
+        }
+    }
+
+    fn on_teach_key(&mut self, key: KeyEvent) -> Action {
+        let Some(teach) = &mut self.teach else {
+            self.mode = Mode::Paused;
+            return Action::None;
+        };
+        if !apply_teach_key(teach, key) {
+            match key.code {
+                KeyCode::Char('t') | KeyCode::Esc => {
+                    // Back to the paused dashboard: the copy's activations are discarded,
+                    // training resumes from its own on space.
+                    self.teach = None;
+                    self.mode = Mode::Paused;
+                }
+                KeyCode::Char('?') => self.help = true,
+                _ => {}
+            }
+        }
+        Action::None
+    }
+}
+
+/// Applies a teach-mode key (arrows, `a`, `s`, `r`, `u`, `c`); `false` if it is not one.
+pub fn apply_teach_key(teach: &mut Teach, key: KeyEvent) -> bool {
+    match key.code {
+        KeyCode::Up | KeyCode::Char('k') | KeyCode::Left | KeyCode::Char('h') => {
+            teach.move_cursor(-1)
+        }
+        KeyCode::Down | KeyCode::Char('j') | KeyCode::Right | KeyCode::Char('l') => {
+            teach.move_cursor(1)
+        }
+        KeyCode::Char('a') => teach.activate(),
+        KeyCode::Char('s') => {
+            teach.step();
+        }
+        KeyCode::Char('r') => teach.run_to_end(),
+        KeyCode::Char('u') => teach.undo(),
+        KeyCode::Char('c') => teach.reset(),
+        _ => return false,
+    }
+    true
+}

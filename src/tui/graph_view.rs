@@ -1,0 +1,185 @@
+//! The SAP-Net graph on a ratatui `Canvas`: policies around a circle, grouped by category
+//! with a gap between groups; edges dotted by weight (denser is closer, as M is a
+//! distance), solid where activation just travelled; nodes coloured (or, without colour,
+//! shaped) by their share of the highest activation.
+
+use std::f64::consts::{FRAC_PI_2, TAU};
+
+use ratatui::layout::Rect;
+use ratatui::style::{Color, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::canvas::{Canvas, Context, Line as Segment, Points};
+use ratatui::widgets::Block;
+use ratatui::Frame;
+
+use super::theme::{heat_symbol, Theme};
+use crate::sapnet::SapNet;
+
+/// What to draw of a graph.
+#[derive(Debug, Clone, Copy)]
+pub struct Scene<'a> {
+    pub net: &'a SapNet,
+    pub names: &'a [String],
+    /// Category of each policy, for grouping; `None` keeps index order in one group.
+    pub groups: Option<&'a [usize]>,
+    pub cursor: Option<usize>,
+    /// The policy acting now (dashboard) or the activated one (teach).
+    pub active: Option<usize>,
+    /// Edges activation just travelled along.
+    pub lit: &'a [(usize, usize)],
+    /// The edge of the call about to be made (teach).
+    pub walking: Option<(usize, usize)>,
+}
+
+/// Draws `scene` in `block` over `area`.
+pub fn draw(frame: &mut Frame, area: Rect, block: Block, scene: Scene, theme: Theme) {
+    let positions = positions(scene.net.len(), scene.groups);
+    let top = scene
+        .net
+        .activations()
+        .iter()
+        .copied()
+        .fold(0.0_f64, f64::max);
+    let labels: Vec<String> = scene.names.iter().map(|n| short_label(n)).collect();
+    let show_weights = scene.net.len() <= 6;
+    let canvas = Canvas::default()
+        .block(block)
+        .x_bounds([-1.35, 1.35])
+        .y_bounds([-1.3, 1.3])
+        .paint(|ctx| {
+            for (i, j, w) in scene.net.graph().edges() {
+                let (a, b) = (positions[i], positions[j]);
+                let lit = scene.lit.iter().any(|&e| e == (i, j) || e == (j, i));
+                let walking = scene.walking.is_some_and(|e| e == (i, j) || e == (j, i));
+                if walking {
+                    solid(ctx, a, b, color(theme, Color::Green));
+                } else if lit {
+                    solid(ctx, a, b, color(theme, Color::Yellow));
+                } else {
+                    dotted(ctx, a, b, w, color(theme, Color::DarkGray));
+                }
+                if show_weights {
+                    let (x, y) = ((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0);
+                    ctx.print(x, y, Span::styled(format!("{w:.2}"), theme.dim()));
+                }
+            }
+            ctx.layer();
+            for (i, &(x, y)) in positions.iter().enumerate() {
+                let activation = scene.net.activations()[i];
+                let level = if top > 0.0 { activation / top } else { 0.0 };
+                let mut style = theme.heat(level);
+                if scene.active == Some(i) {
+                    style = theme.active();
+                }
+                if scene.cursor == Some(i) {
+                    style = style.patch(theme.cursor());
+                }
+                let text = format!("{}{}", heat_symbol(level), labels[i]);
+                // Centre the label on the node: a cell is about 2.7/width units wide.
+                ctx.print(
+                    x - 0.04 * text.chars().count() as f64 / 2.0,
+                    y,
+                    Line::styled(text, style),
+                );
+            }
+        });
+    frame.render_widget(canvas, area);
+}
+
+fn color(theme: Theme, color: Color) -> Color {
+    if theme.color {
+        color
+    } else {
+        Color::Reset
+    }
+}
+
+fn solid(ctx: &mut Context, a: (f64, f64), b: (f64, f64), color: Color) {
+    ctx.draw(&Segment::new(a.0, a.1, b.0, b.1, color));
+}
+
+/// A dotted edge whose dots are closer the lighter (closer) the weight.
+fn dotted(ctx: &mut Context, a: (f64, f64), b: (f64, f64), weight: f64, color: Color) {
+    let length = ((b.0 - a.0).powi(2) + (b.1 - a.1).powi(2)).sqrt();
+    let gap = (0.03 + 0.05 * weight.clamp(0.0, 2.0)).max(0.02);
+    let dots = (length / gap).ceil().max(1.0) as usize;
+    let coords: Vec<(f64, f64)> = (1..dots)
+        .map(|k| {
+            let t = k as f64 / dots as f64;
+            (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1))
+        })
+        .collect();
+    ctx.draw(&Points {
+        coords: &coords,
+        color,
+    });
+}
+
+/// Node positions on the unit circle, clockwise from the top, in group order with one
+/// empty slot between groups.
+pub fn positions(n: usize, groups: Option<&[usize]>) -> Vec<(f64, f64)> {
+    let mut order: Vec<usize> = (0..n).collect();
+    if let Some(groups) = groups {
+        order.sort_by_key(|&i| (groups[i], i));
+    }
+    let gaps = groups.map_or(0, |g| {
+        let mut keys: Vec<usize> = g.to_vec();
+        keys.sort_unstable();
+        keys.dedup();
+        if keys.len() > 1 {
+            keys.len()
+        } else {
+            0
+        }
+    });
+    let slots = (n + gaps).max(1) as f64;
+    let mut positions = vec![(0.0, 0.0); n];
+    let mut slot = 0;
+    for (k, &i) in order.iter().enumerate() {
+        if k > 0 && groups.is_some_and(|g| g[order[k - 1]] != g[i]) && gaps > 0 {
+            slot += 1;
+        }
+        let angle = FRAC_PI_2 - TAU * slot as f64 / slots;
+        positions[i] = (angle.cos(), angle.sin());
+        slot += 1;
+    }
+    positions
+}
+
+/// `source-12` → `12`; short names stay as they are.
+pub fn short_label(name: &str) -> String {
+    let digits = name.len() - name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+    if digits > 0 && name.len() - digits > 2 {
+        name[name.len() - digits..].to_string()
+    } else {
+        name.to_string()
+    }
+}
+
+/// The style of a table row's name: the same heat as its node.
+pub fn node_style(theme: Theme, activation: f64, top: f64) -> Style {
+    theme.heat(if top > 0.0 { activation / top } else { 0.0 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn groups_sit_together_with_a_gap_between() {
+        let p = positions(4, Some(&[1, 0, 1, 0]));
+        // Order 1, 3 (group 0), gap, 0, 2 (group 1), gap: six slots, 1 at the top.
+        assert!((p[1].0).abs() < 1e-12 && (p[1].1 - 1.0).abs() < 1e-12);
+        let angle = |(x, y): (f64, f64)| y.atan2(x);
+        let step = TAU / 6.0;
+        assert!((angle(p[3]) - (FRAC_PI_2 - step)).abs() < 1e-12);
+        assert!((angle(p[0]) - (FRAC_PI_2 - 3.0 * step)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn labels_keep_the_number_of_long_names() {
+        assert_eq!(short_label("source-12"), "12");
+        assert_eq!(short_label("π3"), "π3");
+        assert_eq!(short_label("cartpole"), "cartpole");
+    }
+}

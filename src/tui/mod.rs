@@ -1,0 +1,138 @@
+//! The terminal UI: the live dashboard over the trainer's event stream, and teach mode.
+//!
+//! The UI thread only reads keys, drains events and draws; training runs on the trainer's
+//! threads and never waits for the screen. Each frame drains the whole channel (never
+//! parking on it, so a send never has to wake this thread) and draws at most
+//! [`FRAME`]ly.
+//!
+//! - [`dashboard`]: what the UI keeps of the stream, and what keys do.
+//! - [`teach`]: one activation's spreading, a call at a time, with undo.
+//! - [`view`], [`graph_view`]: drawing, as pure functions of that state.
+
+pub mod dashboard;
+pub mod graph_view;
+pub mod teach;
+pub mod theme;
+pub mod view;
+
+use std::sync::mpsc::Receiver;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use crossterm::event::{self as term, KeyEventKind};
+
+use crate::trainer::{Command, Event, RunHandle};
+use dashboard::{apply_teach_key, Action, Dashboard};
+use teach::Teach;
+use theme::Theme;
+
+/// The time between frames: about 30 per second.
+pub const FRAME: Duration = Duration::from_millis(33);
+
+/// Leaves the alternate screen and raw mode however the UI ends; ratatui's panic hook does
+/// the same for panics.
+struct TerminalGuard;
+
+impl Drop for TerminalGuard {
+    fn drop(&mut self) {
+        ratatui::restore();
+    }
+}
+
+/// A run the dashboard drives: its commands, and the thread to join at the end.
+pub struct Driven {
+    pub handle: RunHandle,
+    /// Whether pause, step and speed go to this run (the SAP-Net run, or the only one).
+    pub leads: bool,
+}
+
+/// Runs the dashboard until the user quits, then stops and joins the runs.
+pub fn run_dashboard(task: &str, runs: Vec<Driven>, events: Receiver<Event>) -> Result<()> {
+    let theme = Theme::from_env();
+    let mut dashboard = Dashboard::new(task);
+    let mut terminal = ratatui::try_init().context("opening the terminal UI")?;
+    let guard = TerminalGuard;
+    let result = (|| -> Result<()> {
+        loop {
+            for event in events.try_iter() {
+                dashboard.on_event(event);
+            }
+            dashboard.tick(Instant::now());
+            terminal
+                .draw(|frame| view::draw_dashboard(frame, &dashboard, theme))
+                .context("drawing the dashboard")?;
+            if !term::poll(FRAME).context("reading the keyboard")? {
+                continue;
+            }
+            let term::Event::Key(key) = term::read().context("reading the keyboard")? else {
+                continue; // a resize redraws on the next frame
+            };
+            if key.kind != KeyEventKind::Press {
+                continue;
+            }
+            match dashboard.on_key(key) {
+                Action::None => {}
+                Action::Quit => return Ok(()),
+                Action::Send(command) => {
+                    for run in runs.iter().filter(|r| r.leads) {
+                        let _ = run.handle.commands.send(command);
+                    }
+                }
+                Action::SendAll(command) => {
+                    for run in &runs {
+                        let _ = run.handle.commands.send(command);
+                    }
+                }
+            }
+        }
+    })();
+    drop(guard);
+    for run in &runs {
+        let _ = run.handle.commands.send(Command::Stop);
+    }
+    for run in runs {
+        match run.handle.thread.join() {
+            Ok(Ok(_)) => {}
+            Ok(Err(err)) => eprintln!("a training run failed: {err}"),
+            Err(_) => eprintln!("a training thread panicked"),
+        }
+    }
+    result
+}
+
+/// Runs stand-alone teach mode until the user quits.
+pub fn run_teach(mut teach: Teach) -> Result<()> {
+    let theme = Theme::from_env();
+    let mut terminal = ratatui::try_init().context("opening the terminal UI")?;
+    let _guard = TerminalGuard;
+    let mut help = false;
+    loop {
+        terminal
+            .draw(|frame| view::draw_teach(frame, &teach, help, theme))
+            .context("drawing teach mode")?;
+        let term::Event::Key(key) = term::read().context("reading the keyboard")? else {
+            continue;
+        };
+        if key.kind != KeyEventKind::Press {
+            continue;
+        }
+        if is_quit(key) {
+            return Ok(());
+        }
+        if help {
+            help = false;
+        } else if key.code == term::KeyCode::Char('?') {
+            help = true;
+        } else if key.code == term::KeyCode::Esc {
+            return Ok(());
+        } else {
+            apply_teach_key(&mut teach, key);
+        }
+    }
+}
+
+fn is_quit(key: term::KeyEvent) -> bool {
+    key.code == term::KeyCode::Char('q')
+        || (key.code == term::KeyCode::Char('c')
+            && key.modifiers.contains(term::KeyModifiers::CONTROL))
+}

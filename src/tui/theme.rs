@@ -1,0 +1,100 @@
+//! Colours, or none: `NO_COLOR` (no-color.org) turns every colour off and the views fall
+//! back on symbols and bold/reverse, which read on any terminal.
+
+use ratatui::style::{Color, Modifier, Style};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Theme {
+    pub color: bool,
+}
+
+impl Theme {
+    /// Colour unless `NO_COLOR` is set to anything but the empty string.
+    pub fn from_env() -> Self {
+        let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
+        Self { color: !no_color }
+    }
+
+    pub fn plain() -> Self {
+        Self { color: false }
+    }
+
+    fn fg(self, color: Color) -> Style {
+        if self.color {
+            Style::new().fg(color)
+        } else {
+            Style::new()
+        }
+    }
+
+    pub fn title(self) -> Style {
+        self.fg(Color::Cyan).add_modifier(Modifier::BOLD)
+    }
+
+    pub fn dim(self) -> Style {
+        if self.color {
+            Style::new().fg(Color::DarkGray)
+        } else {
+            Style::new().add_modifier(Modifier::DIM)
+        }
+    }
+
+    /// The policy under the cursor.
+    pub fn cursor(self) -> Style {
+        Style::new().add_modifier(Modifier::REVERSED)
+    }
+
+    /// The policy acting now, or the call being made.
+    pub fn active(self) -> Style {
+        self.fg(Color::Green).add_modifier(Modifier::BOLD)
+    }
+
+    /// Edges that just carried activation.
+    pub fn spreading(self) -> Style {
+        self.fg(Color::Yellow).add_modifier(Modifier::BOLD)
+    }
+
+    pub fn stopped(self) -> Style {
+        self.fg(Color::Red)
+    }
+
+    /// A curve's colour: SAP-Net red, then the paper's blue, orange and green.
+    pub fn series(self, i: usize) -> Style {
+        const COLORS: [Color; 4] = [
+            Color::Red,
+            Color::Blue,
+            Color::Rgb(255, 127, 14),
+            Color::Green,
+        ];
+        self.fg(COLORS[i % COLORS.len()])
+    }
+
+    /// A node's colour by its share `level` (0 to 1) of the highest activation: cold blue
+    /// to hot red.
+    pub fn heat(self, level: f64) -> Style {
+        let level = if level.is_finite() {
+            level.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        if !self.color {
+            return if level > 0.5 {
+                Style::new().add_modifier(Modifier::BOLD)
+            } else {
+                Style::new()
+            };
+        }
+        let red = (70.0 + 185.0 * level) as u8;
+        let blue = (230.0 - 180.0 * level) as u8;
+        Style::new().fg(Color::Rgb(red, 90, blue))
+    }
+}
+
+/// A node's symbol by its share of the highest activation, for reading without colour.
+pub fn heat_symbol(level: f64) -> &'static str {
+    match level {
+        l if l >= 0.75 => "●",
+        l if l >= 0.25 => "◐",
+        _ => "○",
+    }
+}

@@ -1,0 +1,655 @@
+//! Drawing the dashboard and teach mode: pure functions of the state, so the snapshot
+//! tests draw exactly what a user sees.
+
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::style::{Modifier, Style};
+use ratatui::symbols::Marker;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{
+    Axis, Block, Cell, Chart, Clear, Dataset, GraphType, Paragraph, Row, Table, Wrap,
+};
+use ratatui::Frame;
+
+use super::dashboard::{Dashboard, Focus, Mode, RunView, SapNetView, SPEEDS};
+use super::graph_view::{self, node_style, Scene};
+use super::teach::Teach;
+use super::theme::Theme;
+use crate::sapnet::TraceStep;
+
+/// The smallest terminal the layouts fit.
+pub const MIN_WIDTH: u16 = 80;
+pub const MIN_HEIGHT: u16 = 24;
+
+/// Draws the whole dashboard (or teach mode on the live graph, or the help overlay).
+pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
+    let area = frame.area();
+    if too_small(frame, area) {
+        return;
+    }
+    let [main, status] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
+    match (&dashboard.teach, dashboard.mode) {
+        (Some(teach), Mode::Teach) => draw_teach_body(frame, main, teach, theme),
+        _ => draw_training(frame, main, dashboard, theme),
+    }
+    draw_status(frame, status, dashboard, theme);
+    if dashboard.help {
+        draw_help(frame, area, theme);
+    }
+}
+
+/// Draws stand-alone teach mode (`sapnet teach`).
+pub fn draw_teach(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {
+    let area = frame.area();
+    if too_small(frame, area) {
+        return;
+    }
+    let [main, status] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
+    draw_teach_body(frame, main, teach, theme);
+    let line = Line::from(vec![
+        Span::styled(" teach ", theme.title().add_modifier(Modifier::REVERSED)),
+        Span::raw(" "),
+        Span::styled(TEACH_HINTS, theme.dim()),
+    ]);
+    frame.render_widget(Paragraph::new(line), status);
+    if help {
+        draw_help(frame, area, theme);
+    }
+}
+
+const TEACH_HINTS: &str =
+    "↑↓ pick · a activate · s step · r run · u undo · c reset · ? help · q quit";
+
+fn too_small(frame: &mut Frame, area: Rect) -> bool {
+    if area.width >= MIN_WIDTH && area.height >= MIN_HEIGHT {
+        return false;
+    }
+    let text = format!(
+        "This terminal is {}×{}; sapnet needs at least {MIN_WIDTH}×{MIN_HEIGHT}. Enlarge it, or press q to quit.",
+        area.width, area.height
+    );
+    let [middle] = Layout::vertical([Constraint::Length(3)])
+        .flex(ratatui::layout::Flex::Center)
+        .areas(area);
+    frame.render_widget(
+        Paragraph::new(text)
+            .wrap(Wrap { trim: true })
+            .alignment(ratatui::layout::Alignment::Center),
+        middle,
+    );
+    true
+}
+
+fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Theme) {
+    let [top, bottom] =
+        Layout::vertical([Constraint::Percentage(55), Constraint::Percentage(45)]).areas(area);
+    let [graph, table] =
+        Layout::horizontal([Constraint::Percentage(40), Constraint::Percentage(60)]).areas(top);
+    let [rewards, loss] =
+        Layout::horizontal([Constraint::Percentage(68), Constraint::Percentage(32)]).areas(bottom);
+
+    let focus_block = |title: &str, focused: bool| {
+        let block = Block::bordered().title(Span::styled(format!(" {title} "), theme.title()));
+        if focused {
+            block.border_style(theme.title())
+        } else {
+            block.border_style(theme.dim())
+        }
+    };
+    match &dashboard.sapnet {
+        Some(view) => {
+            let names: Vec<String> = view.policies.iter().map(|p| p.name.clone()).collect();
+            let groups = view.categories();
+            let lit: Vec<(usize, usize)> = view
+                .spread
+                .filter(|&(p, _)| view.glows(p, dashboard.step))
+                .map(|(p, _)| {
+                    view.net
+                        .graph()
+                        .neighbours(p)
+                        .map(|(j, _)| (p, j))
+                        .collect()
+                })
+                .unwrap_or_default();
+            let scene = Scene {
+                net: &view.net,
+                names: &names,
+                groups: Some(&groups),
+                cursor: Some(dashboard.cursor),
+                active: view.acting,
+                lit: &lit,
+                walking: None,
+            };
+            graph_view::draw(
+                frame,
+                graph,
+                focus_block("SAP-Net graph", dashboard.focus == Focus::Graph),
+                scene,
+                theme,
+            );
+            draw_policy_table(
+                frame,
+                table,
+                focus_block("policies", dashboard.focus == Focus::Table),
+                view,
+                dashboard.cursor,
+                theme,
+            );
+        }
+        None => {
+            let note = Paragraph::new("This config runs no SAP-Net: only its baselines train.")
+                .block(focus_block("SAP-Net graph", false))
+                .wrap(Wrap { trim: true });
+            frame.render_widget(note, top);
+        }
+    }
+    draw_rewards(frame, rewards, &dashboard.runs, theme);
+    draw_loss(frame, loss, dashboard.main_run(), theme);
+}
+
+fn draw_policy_table(
+    frame: &mut Frame,
+    area: Rect,
+    block: Block,
+    view: &SapNetView,
+    cursor: usize,
+    theme: Theme,
+) {
+    let top = view
+        .net
+        .activations()
+        .iter()
+        .copied()
+        .fold(0.0_f64, f64::max);
+    // Columns give way from the right of the wish list as the panel narrows: the graph
+    // already shows categories, the counts matter least.
+    let full = area.width >= 72;
+    let bar_width = 8;
+    let rows = view.policies.iter().enumerate().map(|(i, p)| {
+        let a = view.net.activations()[i];
+        let probability = view.probabilities.get(i).copied().unwrap_or(0.0);
+        let mut name = Span::styled(p.name.clone(), node_style(theme, a, top));
+        if view.acting == Some(i) {
+            name = name.patch_style(theme.active());
+        }
+        let mut cells = vec![Cell::from(name)];
+        if full {
+            cells.push(Cell::from(format!("{:?}", p.description.hidden)));
+            cells.push(Cell::from(p.description.hidden.len().to_string()));
+        }
+        cells.push(Cell::from(format_activation(a)));
+        cells.push(Cell::from(probability_bar(probability, bar_width)));
+        cells.push(Cell::from(view.selections[i].to_string()));
+        if full {
+            cells.push(Cell::from(format!(
+                "{}/{}",
+                view.positive[i], view.negative[i]
+            )));
+        }
+        let row = Row::new(cells);
+        if i == cursor {
+            row.style(theme.cursor())
+        } else {
+            row
+        }
+    });
+    let (header, widths) = if full {
+        (
+            vec!["policy", "hidden", "cat", "A", "P(π)", "chosen", "+/−"],
+            vec![
+                Constraint::Length(9),
+                Constraint::Length(14),
+                Constraint::Length(3),
+                Constraint::Length(9),
+                Constraint::Length(bar_width as u16 + 5),
+                Constraint::Length(6),
+                Constraint::Min(9),
+            ],
+        )
+    } else {
+        (
+            vec!["policy", "A", "P(π)", "chosen"],
+            vec![
+                Constraint::Length(9),
+                Constraint::Length(9),
+                Constraint::Length(bar_width as u16 + 5),
+                Constraint::Min(6),
+            ],
+        )
+    };
+    let table = Table::new(rows, widths)
+        .header(Row::new(header).style(theme.title()))
+        .block(block);
+    frame.render_widget(table, area);
+}
+
+fn format_activation(a: f64) -> String {
+    if a.abs() >= 1e5 {
+        format!("{a:.3e}")
+    } else {
+        format!("{a:.3}")
+    }
+}
+
+/// `P` as a bar of `width` cells and its value, e.g. `██████░░░░ 0.61`.
+fn probability_bar(p: f64, width: usize) -> String {
+    let filled = ((p.clamp(0.0, 1.0) * width as f64).round() as usize).min(width);
+    format!(
+        "{}{} {p:.2}",
+        "█".repeat(filled),
+        "░".repeat(width - filled)
+    )
+}
+
+fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], theme: Theme) {
+    let x_max = runs
+        .iter()
+        .map(|r| f64::from(r.episode.max(1)))
+        .fold(10.0, f64::max);
+    let (y_min, y_max) = runs
+        .iter()
+        .flat_map(|r| r.curve.returns.iter().map(|&(_, y)| y))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
+            (lo.min(y), hi.max(y))
+        });
+    let (y_min, y_max) = if y_min.is_finite() {
+        (y_min.min(0.0), y_max.max(y_min + 1.0))
+    } else {
+        (0.0, 1.0)
+    };
+    let mut datasets = Vec::new();
+    for (i, run) in runs.iter().enumerate() {
+        if i == 0 {
+            datasets.push(
+                Dataset::default()
+                    .marker(Marker::Braille)
+                    .graph_type(GraphType::Scatter)
+                    .style(theme.dim())
+                    .data(&run.curve.returns),
+            );
+        }
+        datasets.push(
+            Dataset::default()
+                .name(format!("{} MA10", run.method))
+                .marker(Marker::Braille)
+                .graph_type(GraphType::Line)
+                .style(theme.series(i))
+                .data(&run.curve.average),
+        );
+    }
+    let title = match runs.first().and_then(|r| r.curve.last_average()) {
+        Some(ma) => format!(" episode reward · {} MA10 {ma:.1} ", runs[0].method),
+        None => " episode reward ".to_string(),
+    };
+    let chart = Chart::new(datasets)
+        .block(Block::bordered().title(Span::styled(title, theme.title())))
+        .x_axis(
+            Axis::default()
+                .bounds([0.0, x_max])
+                .labels([Line::from("0"), Line::from(format!("{x_max:.0}"))])
+                .style(theme.dim()),
+        )
+        .y_axis(
+            Axis::default()
+                .bounds([y_min, y_max])
+                .labels([
+                    Line::from(format!("{y_min:.0}")),
+                    Line::from(format!("{y_max:.0}")),
+                ])
+                .style(theme.dim()),
+        );
+    frame.render_widget(chart, area);
+}
+
+fn draw_loss(frame: &mut Frame, area: Rect, run: Option<&RunView>, theme: Theme) {
+    let points: Vec<(f64, f64)> = run
+        .map(|r| {
+            let first = r.episode as usize + 1 - r.statistic_loss.len().min(r.episode as usize + 1);
+            r.statistic_loss
+                .iter()
+                .enumerate()
+                .map(|(k, &e)| ((first + k) as f64, e))
+                .collect()
+        })
+        .unwrap_or_default();
+    let (x_min, x_max) = match (points.first(), points.last()) {
+        (Some(a), Some(b)) => (a.0, b.0.max(a.0 + 1.0)),
+        _ => (0.0, 1.0),
+    };
+    let y_max = points.iter().map(|p| p.1).fold(1e-9, f64::max);
+    let title = match points.last() {
+        Some(&(_, e)) => format!(" statistic loss E {e:.4} "),
+        None => " statistic loss E ".to_string(),
+    };
+    let data = [Dataset::default()
+        .marker(Marker::Braille)
+        .graph_type(GraphType::Line)
+        .style(theme.series(0))
+        .data(&points)];
+    let chart = Chart::new(data.to_vec())
+        .block(Block::bordered().title(Span::styled(title, theme.title())))
+        .x_axis(Axis::default().bounds([x_min, x_max]).style(theme.dim()))
+        .y_axis(
+            Axis::default()
+                .bounds([0.0, y_max])
+                .labels([Line::from("0"), Line::from(format!("{y_max:.3}"))])
+                .style(theme.dim()),
+        );
+    frame.render_widget(chart, area);
+}
+
+/// The bottom line: mode and figures on the left, the keys of the mode on the right
+/// (the figures give way first on a narrow terminal).
+fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Theme) {
+    let (mode, hints) = match dashboard.mode {
+        Mode::Running => ("RUNNING", "space pause · t teach · ? keys · q quit"),
+        Mode::Paused => ("PAUSED", "space resume · n step · t teach · ? keys"),
+        Mode::Teach => ("TEACH", "a · s · r · u · c · t back · ? keys"),
+    };
+    let hints = if area.width < 100 {
+        "? keys · q quit"
+    } else {
+        hints
+    };
+    let run = dashboard.main_run();
+    let finished = run.is_some_and(|r| r.ended.is_some());
+    let episode = run.map_or("-".to_string(), |r| {
+        format!("{} ep {}/{}", r.method, r.episode, r.planned_episodes)
+    });
+    let speed = match dashboard.steps_per_second {
+        Some(s) => format!("{s:.0} steps/s"),
+        None => "- steps/s".to_string(),
+    };
+    let throttle = match SPEEDS[dashboard.speed] {
+        d if d.is_zero() => "full speed".to_string(),
+        d => format!("{} ms/step", d.as_millis()),
+    };
+    let epsilon = run.map_or(0.0, |r| r.epsilon);
+    let figures = Line::from(vec![
+        Span::styled(
+            format!(" {} ", if finished { "DONE" } else { mode }),
+            theme.title().add_modifier(Modifier::REVERSED),
+        ),
+        Span::raw(format!(
+            " {} · {episode} · step {} · {speed} · ε {epsilon:.2} · {throttle}",
+            dashboard.task, dashboard.step
+        )),
+    ]);
+    let [left, right] = Layout::horizontal([
+        Constraint::Min(0),
+        Constraint::Length(hints.chars().count() as u16 + 1),
+    ])
+    .areas(area);
+    frame.render_widget(Paragraph::new(figures), left);
+    frame.render_widget(
+        Paragraph::new(Span::styled(hints, theme.dim())).right_aligned(),
+        right,
+    );
+}
+
+const HELP: &[(&str, &str)] = &[
+    ("space", "pause / resume training"),
+    ("n", "one training step while paused"),
+    (
+        "+ / -",
+        "faster / slower (delays training, never the screen)",
+    ),
+    ("tab", "move focus between the graph and the table"),
+    ("↑↓←→ hjkl", "pick a policy"),
+    ("t", "teach mode on the live graph (pauses training)"),
+    ("t / Esc", "teach: back to the paused dashboard"),
+    ("a", "teach: activate the picked policy (A += 𝒜, eq. 8)"),
+    ("s", "teach: make the next spread call (eq. 9–11)"),
+    ("r", "teach: run the spreading to the end"),
+    ("u", "teach: undo the last call"),
+    ("c", "teach: back to the starting activations"),
+    ("?", "this help (any key closes it)"),
+    ("q / Esc / Ctrl-C", "quit"),
+];
+
+fn draw_help(frame: &mut Frame, area: Rect, theme: Theme) {
+    let width = 76.min(area.width);
+    let height = (HELP.len() as u16 + 4).min(area.height);
+    let [row] = Layout::vertical([Constraint::Length(height)])
+        .flex(ratatui::layout::Flex::Center)
+        .areas(area);
+    let [popup] = Layout::horizontal([Constraint::Length(width)])
+        .flex(ratatui::layout::Flex::Center)
+        .areas(row);
+    let lines: Vec<Line> = HELP
+        .iter()
+        .map(|(key, what)| {
+            Line::from(vec![
+                Span::styled(format!("{key:>18}  "), theme.title()),
+                Span::raw(*what),
+            ])
+        })
+        .collect();
+    frame.render_widget(Clear, popup);
+    frame.render_widget(
+        Paragraph::new(lines).block(
+            Block::bordered()
+                .title(Span::styled(" keys ", theme.title()))
+                .border_style(theme.title()),
+        ),
+        popup,
+    );
+}
+
+fn draw_teach_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+    let [left, right] =
+        Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)]).areas(area);
+    let [graph, call] = Layout::vertical([Constraint::Min(8), Constraint::Length(8)]).areas(left);
+    let n = teach.net().len() as u16;
+    let [values, stack, trace] = Layout::vertical([
+        Constraint::Length((n + 3).min(right.height / 2)),
+        Constraint::Length(7),
+        Constraint::Min(3),
+    ])
+    .areas(right);
+
+    let walk = teach.walk();
+    let next = walk.as_ref().and_then(|w| w.pending.last().copied());
+    let lit: Vec<(usize, usize)> = walk
+        .as_ref()
+        .map(|w| w.path.windows(2).map(|e| (e[0], e[1])).collect())
+        .unwrap_or_default();
+    let scene = Scene {
+        net: teach.net(),
+        names: teach.names(),
+        groups: teach.groups(),
+        cursor: Some(teach.cursor()),
+        active: walk.as_ref().map(|w| w.policy),
+        lit: &lit,
+        walking: next.map(|c| (c.from, c.to)),
+    };
+    let params = teach.net().params();
+    let title = format!(
+        "SAP-Net · T_ω {} · 𝒜 {} · τ {}",
+        params.threshold, params.coefficient, params.temperature
+    );
+    graph_view::draw(
+        frame,
+        graph,
+        Block::bordered().title(Span::styled(format!(" {title} "), theme.title())),
+        scene,
+        theme,
+    );
+
+    // The call about to be made, with eq. 10's test, or the last one made.
+    let names = teach.names();
+    let threshold = params.threshold;
+    let mut lines = Vec::new();
+    match (&walk, next) {
+        (None, _) => lines.push(Line::from(
+            "Pick a policy with ↑↓ and press a to activate it: A[i] += 𝒜 (eq. 8).",
+        )),
+        (Some(w), Some(call)) => {
+            lines.push(Line::from(format!(
+                "next: spread({}, h = {}, Ω = {:.4}, η = {:.6}, from {})",
+                names[call.to], call.h, call.omega, call.eta, names[call.from]
+            )));
+            let passes = call.omega < threshold;
+            lines.push(Line::from(vec![
+                Span::raw(format!("Ω < T_ω: {:.4} < {threshold} is ", call.omega)),
+                if passes {
+                    Span::styled("true", theme.active())
+                } else {
+                    Span::styled("false: the call stops (eq. 10)", theme.stopped())
+                },
+            ]));
+            if passes {
+                lines.push(Line::from(format!(
+                    "ΔA[{}] = η/(h·Ω) = {:.6}/({}·{:.4}) = {:.6}",
+                    names[call.to],
+                    call.eta,
+                    call.h,
+                    call.omega,
+                    call.eta / (call.h as f64 * call.omega)
+                )));
+                lines.push(Line::from(format!(
+                    "then η/k = {:.6}/{} to each neighbour of {}",
+                    call.eta,
+                    teach.net().graph().degree(call.to),
+                    names[call.to]
+                )));
+            }
+            lines.push(Line::styled(
+                format!(
+                    "activated {} (k = {}), {} calls made, {} pending",
+                    names[w.policy],
+                    teach.net().graph().degree(w.policy),
+                    w.trace.len(),
+                    w.pending.len()
+                ),
+                theme.dim(),
+            ));
+        }
+        (Some(w), None) => lines.push(Line::from(format!(
+            "spreading from {} is done: {} calls. a activates again, u undoes, c resets.",
+            names[w.policy],
+            w.trace.len()
+        ))),
+    }
+    frame.render_widget(
+        Paragraph::new(lines)
+            .wrap(Wrap { trim: false })
+            .block(Block::bordered().title(Span::styled(" the call ", theme.title()))),
+        call,
+    );
+
+    // A and P of every policy.
+    let probabilities = teach.net().probabilities();
+    let top = teach
+        .net()
+        .activations()
+        .iter()
+        .copied()
+        .fold(0.0_f64, f64::max);
+    let rows = names.iter().enumerate().map(|(i, name)| {
+        let a = teach.net().activations()[i];
+        let row = Row::new(vec![
+            Cell::from(Span::styled(name.clone(), node_style(theme, a, top))),
+            Cell::from(format!("{a:.6}")),
+            Cell::from(probability_bar(probabilities[i], 10)),
+        ]);
+        if i == teach.cursor() {
+            row.style(theme.cursor())
+        } else {
+            row
+        }
+    });
+    frame.render_widget(
+        Table::new(
+            rows,
+            [
+                Constraint::Length(10),
+                Constraint::Length(12),
+                Constraint::Min(16),
+            ],
+        )
+        .header(Row::new(["policy", "A", "P(π) (eq. 6)"]).style(theme.title()))
+        .block(Block::bordered().title(Span::styled(" activations ", theme.title()))),
+        values,
+    );
+
+    // The recursion's stack: pending calls, the next on top.
+    let stack_lines: Vec<Line> = walk
+        .as_ref()
+        .map(|w| {
+            w.pending
+                .iter()
+                .rev()
+                .enumerate()
+                .map(|(k, c)| {
+                    let text = format!(
+                        "{} → {}  h {}  Ω {:.2}  η {:.4}",
+                        names[c.from], names[c.to], c.h, c.omega, c.eta
+                    );
+                    if k == 0 {
+                        Line::styled(format!("▶ {text}"), theme.active())
+                    } else {
+                        Line::from(format!("  {text}"))
+                    }
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    frame.render_widget(
+        Paragraph::new(stack_lines).block(Block::bordered().title(Span::styled(
+            " pending spread calls (next on top) ",
+            theme.title(),
+        ))),
+        stack,
+    );
+
+    // The trace: the calls made so far, the latest last.
+    let trace_steps = walk.as_ref().map_or(&[][..], |w| &w.trace[..]);
+    let visible = trace.height.saturating_sub(3) as usize;
+    let skip = trace_steps.len().saturating_sub(visible);
+    let rows = trace_steps
+        .iter()
+        .enumerate()
+        .skip(skip)
+        .map(|(k, s)| trace_row(k + 1, s, names, theme));
+    let name_width = names
+        .iter()
+        .map(|n| n.chars().count())
+        .max()
+        .unwrap_or(2)
+        .clamp(4, 9) as u16;
+    frame.render_widget(
+        Table::new(
+            rows,
+            [
+                Constraint::Length(4),
+                Constraint::Length(name_width),
+                Constraint::Length(name_width),
+                Constraint::Length(2),
+                Constraint::Length(5),
+                Constraint::Length(7),
+                Constraint::Min(10),
+            ],
+        )
+        .header(Row::new(["#", "from", "to", "h", "Ω", "η", "ΔA"]).style(theme.title()))
+        .block(Block::bordered().title(Span::styled(" trace ", theme.title()))),
+        trace,
+    );
+}
+
+fn trace_row(k: usize, s: &TraceStep, names: &[String], theme: Theme) -> Row<'static> {
+    let delta = if s.stopped {
+        Span::styled("stop: Ω≥T_ω", theme.stopped())
+    } else {
+        Span::raw(format!("{:.6}", s.delta))
+    };
+    Row::new(vec![
+        Cell::from(k.to_string()),
+        Cell::from(names[s.from].clone()),
+        Cell::from(names[s.to].clone()),
+        Cell::from(s.h.to_string()),
+        Cell::from(format!("{:.2}", s.omega)),
+        Cell::from(format!("{:.4}", s.eta)),
+        Cell::from(delta),
+    ])
+    .style(Style::new())
+}

@@ -1,0 +1,128 @@
+//! A scripted SAP-Net run for the TUI's tests and render bench: the shipped CartPole
+//! library's ten architectures, with made-up but plausible numbers, so that what is drawn
+//! does not depend on timing.
+
+use sapnet::config::Config;
+use sapnet::sapnet::{PolicyDescription, SapNet};
+use sapnet::trainer::{
+    ActivationSnapshot, EpisodeRecord, Event, SapNetStart, SourceSummary, StepRecord,
+};
+
+/// The shipped CartPole library's hidden layers.
+pub const HIDDEN: [&[usize]; 10] = [
+    &[113],
+    &[64, 114, 149],
+    &[144, 54],
+    &[97, 142],
+    &[142],
+    &[58, 129],
+    &[82, 82, 55],
+    &[105, 67],
+    &[139, 103, 58],
+    &[144],
+];
+
+pub fn sapnet_start() -> Event {
+    let descriptions: Vec<PolicyDescription> = HIDDEN
+        .iter()
+        .map(|h| PolicyDescription::new(h.to_vec(), "cartpole"))
+        .collect();
+    let net = SapNet::from_policies(&descriptions, Config::default().sapnet).expect("Table II net");
+    Event::RunStarted {
+        run: 0,
+        method: "sapnet".into(),
+        planned_episodes: 5000,
+        sapnet: Some(Box::new(SapNetStart {
+            policies: descriptions
+                .into_iter()
+                .enumerate()
+                .map(|(i, description)| SourceSummary {
+                    name: format!("source-{i}"),
+                    description,
+                    final_score: Some(100.0 + 40.0 * i as f64),
+                })
+                .collect(),
+            net,
+        })),
+    }
+}
+
+pub fn baseline_start() -> Event {
+    Event::RunStarted {
+        run: 0,
+        method: "dqn[100]".into(),
+        planned_episodes: 5000,
+        sapnet: None,
+    }
+}
+
+/// `episodes` episodes of both runs, SAP-Net settling on source-6 as it did in the
+/// measured runs, with a step and a snapshot before each SAP-Net episode's end.
+pub fn episodes(episodes: u32) -> Vec<Event> {
+    let mut events = Vec::new();
+    let mut step = 0u64;
+    let mut activations = vec![0.0; 10];
+    let mut selections = vec![0u64; 10];
+    let mut positive = vec![0u64; 10];
+    let mut negative = vec![0u64; 10];
+    for episode in 1..=episodes {
+        let length = 20 + (episode * 37 % 180);
+        step += u64::from(length);
+        let policy = if episode < 4 {
+            (episode as usize * 3) % 10
+        } else {
+            6
+        };
+        selections[policy] += u64::from(length);
+        positive[policy] += u64::from(length / 2);
+        negative[policy] += u64::from(length - length / 2);
+        activations[policy] += f64::from(length / 2);
+        for neighbour in [1, 8] {
+            if policy == 6 {
+                activations[neighbour] += f64::from(length / 2) * 0.526;
+            }
+        }
+        let top = activations.iter().copied().fold(f64::MIN, f64::max);
+        let terms: Vec<f64> = activations.iter().map(|a: &f64| (a - top).exp()).collect();
+        let total: f64 = terms.iter().sum();
+        events.push(Event::Step(StepRecord {
+            run: 0,
+            step,
+            episode,
+            policy,
+            action: 1,
+            reward: 1.0,
+            loss: Some(0.05),
+            transition: Some(-0.001),
+            warm_up: false,
+        }));
+        events.push(Event::Activations(ActivationSnapshot {
+            run: 0,
+            step,
+            episode,
+            activations: activations.clone(),
+            probabilities: terms.iter().map(|t| t / total).collect(),
+            selections: selections.clone(),
+            positive: positive.clone(),
+            negative: negative.clone(),
+        }));
+        events.push(episode_end("sapnet", episode, f64::from(length)));
+        events.push(episode_end("dqn[100]", episode, f64::from(9 + episode % 3)));
+    }
+    events
+}
+
+fn episode_end(method: &str, episode: u32, reward: f64) -> Event {
+    Event::EpisodeEnded(EpisodeRecord {
+        run: 0,
+        method: method.into(),
+        episode,
+        reward,
+        steps: reward as u32,
+        loss: Some(0.05),
+        statistic_loss: 0.02 + 0.1 / f64::from(episode),
+        epsilon: 0.03,
+        policy: Some(6),
+        wall_s: f64::from(episode) * 0.01,
+    })
+}

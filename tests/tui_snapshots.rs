@@ -1,0 +1,104 @@
+//! What each view draws, at 120×40 and 80×24, from scripted state (ratatui's TestBackend,
+//! insta snapshots in tests/snapshots/). Colours are off (`NO_COLOR`'s theme), so the
+//! snapshots show the symbols a user without colour reads.
+
+mod common;
+
+use common::tui_script;
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use ratatui::backend::TestBackend;
+use ratatui::Terminal;
+use sapnet::teach::config::TeachConfig;
+use sapnet::tui::dashboard::Dashboard;
+use sapnet::tui::teach::Teach;
+use sapnet::tui::theme::Theme;
+use sapnet::tui::view;
+
+const SIZES: [(u16, u16); 2] = [(120, 40), (80, 24)];
+
+fn key(c: char) -> KeyEvent {
+    KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
+}
+
+fn dashboard() -> Dashboard {
+    let mut d = Dashboard::new("CartPole-v1");
+    d.on_event(tui_script::sapnet_start());
+    d.on_event(tui_script::baseline_start());
+    for event in tui_script::episodes(60) {
+        d.on_event(event);
+    }
+    d
+}
+
+fn draw_dashboard(d: &Dashboard, (w, h): (u16, u16)) -> Terminal<TestBackend> {
+    let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
+    terminal
+        .draw(|f| view::draw_dashboard(f, d, Theme::plain()))
+        .unwrap();
+    terminal
+}
+
+#[test]
+fn dashboard_running() {
+    let d = dashboard();
+    for size in SIZES {
+        insta::assert_snapshot!(
+            format!("dashboard_{}x{}", size.0, size.1),
+            draw_dashboard(&d, size).backend()
+        );
+    }
+}
+
+#[test]
+fn dashboard_help_overlay() {
+    let mut d = dashboard();
+    d.on_key(key('?'));
+    for size in SIZES {
+        insta::assert_snapshot!(
+            format!("help_{}x{}", size.0, size.1),
+            draw_dashboard(&d, size).backend()
+        );
+    }
+}
+
+#[test]
+fn teach_on_the_live_graph() {
+    let mut d = dashboard();
+    d.on_key(key(' '));
+    d.on_key(key('t'));
+    d.on_key(key('a'));
+    d.on_key(key('s'));
+    for size in SIZES {
+        insta::assert_snapshot!(
+            format!("live_teach_{}x{}", size.0, size.1),
+            draw_dashboard(&d, size).backend()
+        );
+    }
+}
+
+#[test]
+fn teach_fig2_mid_walk() {
+    let lesson = TeachConfig::load(None).unwrap();
+    let mut teach = Teach::new(lesson.names, lesson.net);
+    teach.move_cursor(1);
+    teach.activate();
+    for _ in 0..4 {
+        teach.step();
+    }
+    for (w, h) in SIZES {
+        let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
+        terminal
+            .draw(|f| view::draw_teach(f, &teach, false, Theme::plain()))
+            .unwrap();
+        insta::assert_snapshot!(format!("teach_fig2_{w}x{h}"), terminal.backend());
+    }
+}
+
+#[test]
+fn a_small_terminal_is_told_the_size_needed() {
+    let terminal = draw_dashboard(&dashboard(), (60, 20));
+    let text = format!("{}", terminal.backend());
+    assert!(text.contains("60×20"), "{text}");
+    assert!(text.contains("80×24"), "{text}");
+    insta::assert_snapshot!("too_small_60x20", terminal.backend());
+}

@@ -1,0 +1,151 @@
+//! The dashboard's state under scripted events and key presses, without a terminal.
+
+mod common;
+
+use std::time::Duration;
+
+use common::tui_script;
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use sapnet::trainer::Command;
+use sapnet::tui::dashboard::{Action, Dashboard, Focus, Mode, CURVE_POINTS, SPEEDS};
+
+fn key(c: char) -> KeyEvent {
+    KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
+}
+
+fn scripted(episodes: u32) -> Dashboard {
+    let mut dashboard = Dashboard::new("CartPole-v1");
+    // The baseline may announce itself first: SAP-Net still leads the display.
+    dashboard.on_event(tui_script::baseline_start());
+    dashboard.on_event(tui_script::sapnet_start());
+    for event in tui_script::episodes(episodes) {
+        dashboard.on_event(event);
+    }
+    dashboard
+}
+
+#[test]
+fn events_fill_the_table_the_curves_and_the_status() {
+    let d = scripted(30);
+    let methods: Vec<&str> = d.runs.iter().map(|r| r.method.as_str()).collect();
+    assert_eq!(methods, ["sapnet", "dqn[100]"]);
+    let view = d.sapnet.as_ref().unwrap();
+    assert_eq!(view.acting, Some(6));
+    assert_eq!(view.net.chosen(), 6);
+    assert!((view.probabilities.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+    assert_eq!(d.runs[0].episode, 30);
+    assert_eq!(d.runs[0].curve.returns.len(), 30);
+    assert_eq!(d.runs[1].curve.average.len(), 30);
+    let expected_steps: u64 = (1..=30u32).map(|e| u64::from(20 + (e * 37 % 180))).sum();
+    assert_eq!(d.step, expected_steps);
+    assert!(view.glows(6, d.step), "source-6 just spread");
+    assert!(!view.glows(6, d.step + 100), "the glow fades");
+}
+
+#[test]
+fn memory_stays_bounded_over_a_long_run() {
+    let d = scripted(20_000);
+    for run in &d.runs {
+        assert!(
+            run.curve.returns.len() <= CURVE_POINTS,
+            "{}",
+            run.curve.returns.len()
+        );
+        assert!(run.statistic_loss.len() <= CURVE_POINTS);
+        assert_eq!(run.episode, 20_000);
+    }
+    // Thinning keeps the last episodes' moving average exact.
+    let last = d.runs[1].curve.last_average().unwrap();
+    let expected = (19_991..=20_000).map(|e| f64::from(9 + e % 3)).sum::<f64>() / 10.0;
+    assert!((last - expected).abs() < 1e-12);
+}
+
+#[test]
+fn space_pauses_and_resumes_every_run_and_n_steps_only_while_paused() {
+    let mut d = scripted(3);
+    assert_eq!(
+        d.on_key(key('n')),
+        Action::None,
+        "n does nothing while running"
+    );
+    assert_eq!(d.on_key(key(' ')), Action::SendAll(Command::Pause));
+    assert_eq!(d.mode, Mode::Paused);
+    assert_eq!(d.on_key(key('n')), Action::Send(Command::Step));
+    assert_eq!(d.on_key(key(' ')), Action::SendAll(Command::Resume));
+    assert_eq!(d.mode, Mode::Running);
+}
+
+#[test]
+fn plus_and_minus_throttle_the_trainer_within_bounds() {
+    let mut d = scripted(1);
+    assert_eq!(
+        d.on_key(key('+')),
+        Action::Send(Command::Throttle(Duration::ZERO))
+    );
+    for _ in 0..10 {
+        d.on_key(key('-'));
+    }
+    assert_eq!(d.speed, SPEEDS.len() - 1);
+    assert_eq!(
+        d.on_key(key('+')),
+        Action::Send(Command::Throttle(SPEEDS[SPEEDS.len() - 2]))
+    );
+}
+
+#[test]
+fn arrows_and_hjkl_move_the_cursor_around_and_tab_the_focus() {
+    let mut d = scripted(1);
+    d.on_key(KeyEvent::new(KeyCode::Up, KeyModifiers::NONE));
+    assert_eq!(d.cursor, 9, "up from the first wraps to the last");
+    d.on_key(key('j'));
+    d.on_key(key('l'));
+    assert_eq!(d.cursor, 1);
+    d.on_key(KeyEvent::new(KeyCode::Tab, KeyModifiers::NONE));
+    assert_eq!(d.focus, Focus::Graph);
+}
+
+#[test]
+fn teach_mode_pauses_steps_a_copy_and_leaves_training_untouched() {
+    let mut d = scripted(10);
+    let live = d.sapnet.as_ref().unwrap().net.activations().to_vec();
+    d.on_key(key('j'));
+    assert_eq!(d.on_key(key('t')), Action::SendAll(Command::Pause));
+    assert_eq!(d.mode, Mode::Teach);
+    let teach = d.teach.as_ref().unwrap();
+    assert_eq!(teach.cursor(), 1, "teach starts on the dashboard's pick");
+    d.on_key(key('a'));
+    d.on_key(key('s'));
+    let teach = d.teach.as_ref().unwrap();
+    assert_eq!(teach.walk().unwrap().trace.len(), 1);
+    assert_eq!(teach.net().activations()[1], live[1] + 1.0);
+    assert_eq!(d.on_key(key(' ')), Action::None, "space is not a teach key");
+    d.on_key(key('t'));
+    assert_eq!(d.mode, Mode::Paused);
+    assert!(d.teach.is_none());
+    assert_eq!(
+        d.sapnet.as_ref().unwrap().net.activations(),
+        live.as_slice()
+    );
+}
+
+#[test]
+fn help_opens_on_question_mark_and_any_key_closes_it_but_q_quits_always() {
+    let mut d = scripted(1);
+    d.on_key(key('?'));
+    assert!(d.help);
+    assert_eq!(
+        d.on_key(key(' ')),
+        Action::None,
+        "closing the help is all it does"
+    );
+    assert!(!d.help);
+    assert_eq!(d.mode, Mode::Running);
+    d.on_key(key('?'));
+    assert_eq!(d.on_key(key('q')), Action::Quit);
+    let ctrl_c = KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL);
+    assert_eq!(scripted(1).on_key(ctrl_c), Action::Quit);
+    assert_eq!(
+        scripted(1).on_key(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE)),
+        Action::Quit
+    );
+}

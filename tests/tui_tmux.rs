@@ -1,0 +1,105 @@
+//! The real thing, once: the binary in a tmux pane, driven by keys as a user would drive it
+//! (`send-keys`), read back from the screen (`capture-pane`). `.ci/run` installs tmux; on
+//! a machine without it this test says so and passes.
+
+use std::path::Path;
+use std::process::Command;
+use std::thread::sleep;
+use std::time::{Duration, Instant};
+
+struct Session(String);
+
+impl Session {
+    fn start(width: u16, height: u16, command: &str) -> Self {
+        let name = format!("sapnet-e2e-{}", std::process::id());
+        let status = Command::new("tmux")
+            .args(["new-session", "-d", "-s", &name])
+            .args(["-x", &width.to_string(), "-y", &height.to_string()])
+            .arg(command)
+            .status()
+            .expect("running tmux");
+        assert!(status.success(), "tmux new-session failed");
+        Session(name)
+    }
+
+    fn keys(&self, keys: &str) {
+        let status = Command::new("tmux")
+            .args(["send-keys", "-t", &self.0, keys])
+            .status()
+            .expect("running tmux");
+        assert!(status.success());
+    }
+
+    fn screen(&self) -> String {
+        let out = Command::new("tmux")
+            .args(["capture-pane", "-p", "-t", &self.0])
+            .output()
+            .expect("running tmux");
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    }
+
+    /// Waits until every one of `needles` is on the screen.
+    fn wait_for(&self, needles: &[&str]) -> String {
+        let deadline = Instant::now() + Duration::from_secs(120);
+        loop {
+            let screen = self.screen();
+            if needles.iter().all(|n| screen.contains(n)) {
+                return screen;
+            }
+            assert!(
+                Instant::now() < deadline,
+                "waited 120 s for {needles:?}; the screen:\n{screen}"
+            );
+            sleep(Duration::from_millis(200));
+        }
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        let _ = Command::new("tmux")
+            .args(["kill-session", "-t", &self.0])
+            .status();
+    }
+}
+
+#[test]
+fn a_user_pauses_steps_teaches_and_quits() {
+    if Command::new("tmux").arg("-V").output().is_err() {
+        eprintln!(
+            "tmux is not installed: the end-to-end TUI test is skipped (.ci/run installs it)"
+        );
+        return;
+    }
+    let library = Path::new(env!("CARGO_MANIFEST_DIR")).join("saved_policies");
+    let command = format!(
+        "{} --library {}; echo SAPNET-EXITED $?; sleep 60",
+        env!("CARGO_BIN_EXE_sapnet"),
+        library.display()
+    );
+    let session = Session::start(120, 40, &command);
+
+    session.wait_for(&[
+        "SAP-Net graph",
+        "policies",
+        "source-9",
+        "RUNNING",
+        "episode reward",
+    ]);
+    session.keys("Space");
+    session.wait_for(&["PAUSED"]);
+    session.keys("n");
+    session.keys("t");
+    session.wait_for(&["TEACH", "pending spread calls", "the call"]);
+    session.keys("a");
+    session.wait_for(&["next: spread("]);
+    session.keys("s");
+    let screen = session.wait_for(&["1 calls made"]);
+    assert!(screen.contains("Ω < T_ω"), "{screen}");
+    session.keys("q");
+    let screen = session.wait_for(&["SAPNET-EXITED 0"]);
+    assert!(
+        !screen.contains("SAP-Net graph"),
+        "the alternate screen was left:\n{screen}"
+    );
+}
