@@ -638,7 +638,7 @@ fn draw_teach_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
 
 fn trace_row(k: usize, s: &TraceStep, names: &[String], theme: Theme) -> Row<'static> {
     let delta = if s.stopped {
-        Span::styled("stop: Ω≥T_ω", theme.stopped())
+        Span::styled("stopped", theme.stopped())
     } else {
         Span::raw(format!("{:.6}", s.delta))
     };
