@@ -16,10 +16,15 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::rngs::StdRng;
 use rand::SeedableRng;
+use ratatui::backend::TestBackend;
+use ratatui::Terminal;
 use sapnet::config::Config;
 use sapnet::dqn::{Architecture, QNet};
 use sapnet::sapnet::PolicyDescription;
 use sapnet::trainer::{self, DqnRunSpec, Event, SourcePolicy, StreamOptions, TransferRunSpec};
+use sapnet::tui::dashboard::Dashboard;
+use sapnet::tui::theme::Theme;
+use sapnet::tui::view;
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
@@ -67,6 +72,42 @@ fn drained(train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Com
     train(&events, &commands);
     drop(events);
     drain.join().expect("drain thread");
+}
+
+/// As [`drained`], but the thread is the dashboard's: every frame (33 ms) it folds the
+/// events into a [`Dashboard`] and draws it at 200×60, so that training competes with
+/// the UI's work as it does with the TUI open.
+fn watched(train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Command>)) {
+    let (events, received) = mpsc::channel::<Event>();
+    let ui = thread::spawn(move || {
+        let mut dashboard = Dashboard::new("CartPole-v1");
+        let mut terminal = Terminal::new(TestBackend::new(200, 60)).expect("test terminal");
+        let theme = Theme { color: true };
+        loop {
+            thread::sleep(sapnet::tui::FRAME);
+            let mut open = true;
+            loop {
+                match received.try_recv() {
+                    Ok(event) => dashboard.on_event(event),
+                    Err(mpsc::TryRecvError::Empty) => break,
+                    Err(mpsc::TryRecvError::Disconnected) => {
+                        open = false;
+                        break;
+                    }
+                }
+            }
+            terminal
+                .draw(|f| view::draw_dashboard(f, &dashboard, theme))
+                .expect("draw");
+            if !open {
+                return dashboard.step;
+            }
+        }
+    });
+    let (_commands, commands) = mpsc::channel();
+    train(&events, &commands);
+    drop(events);
+    ui.join().expect("UI thread");
 }
 
 fn overhead(c: &mut Criterion) {
@@ -127,6 +168,10 @@ fn overhead(c: &mut Criterion) {
             b.iter(|| drained(|e, c| drop(trainer::train_transfer(&spec, e, c).expect("run"))))
         });
     }
+    let live = transfer(StreamOptions::live());
+    group.bench_function("sapnet 10x[100] live, dashboard drawn at 30 fps", |b| {
+        b.iter(|| watched(|e, c| drop(trainer::train_transfer(&live, e, c).expect("run"))))
+    });
     // One source, warming up as long as the others: SAP-Net's bookkeeping without the
     // cost of keeping ten networks warm in the caches.
     let single = TransferRunSpec {

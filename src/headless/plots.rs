@@ -69,8 +69,9 @@ fn register_font() -> Result<()> {
     result
 }
 
-/// SAP-Net red, then the paper's blue, orange and green for the baselines.
-fn method_colour(i: usize, label: &str) -> RGBColor {
+/// SAP-Net red, then the paper's blue, orange and green for the baselines in the order
+/// they are listed.
+fn method_colour(curves: &[Curve], i: usize) -> RGBColor {
     const BASELINES: [RGBColor; 6] = [
         RGBColor(31, 119, 180),
         RGBColor(255, 127, 14),
@@ -79,10 +80,12 @@ fn method_colour(i: usize, label: &str) -> RGBColor {
         RGBColor(140, 86, 75),
         RGBColor(127, 127, 127),
     ];
-    if label == crate::trainer::SAPNET_LABEL {
+    let is_sapnet = |c: &Curve| c.label == crate::trainer::SAPNET_LABEL;
+    if is_sapnet(&curves[i]) {
         RGBColor(214, 39, 40)
     } else {
-        BASELINES[i % BASELINES.len()]
+        let baseline = curves[..i].iter().filter(|c| !is_sapnet(c)).count();
+        BASELINES[baseline % BASELINES.len()]
     }
 }
 
@@ -140,7 +143,7 @@ fn learning_curve<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotD
         .label_style((FAMILY, 15))
         .draw()?;
     for (i, curve, line) in &lines {
-        let colour = method_colour(*i, &curve.label);
+        let colour = method_colour(&data.curves, *i);
         let runs = curve.returns.len();
         chart
             .draw_series(LineSeries::new(
@@ -209,7 +212,7 @@ fn test_bars<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotData) 
     let group = 0.8;
     let width = group / tested.len().max(1) as f64;
     for (k, (i, curve, means)) in tested.iter().enumerate() {
-        let colour = method_colour(*i, &curve.label);
+        let colour = method_colour(&data.curves, *i);
         let left = |t: usize| t as f64 + 1.0 - group / 2.0 + k as f64 * width;
         chart
             .draw_series(means.iter().enumerate().map(|(t, &v)| {
