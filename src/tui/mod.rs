@@ -39,6 +39,20 @@ impl Drop for TerminalGuard {
     }
 }
 
+/// Raw mode and the alternate screen, with the guard that leaves them. If opening fails
+/// half-way, raw mode is undone here (nothing else was changed yet).
+fn open_terminal() -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
+    match ratatui::try_init() {
+        Ok(terminal) => Ok((terminal, TerminalGuard)),
+        Err(err) => {
+            let _ = crossterm::terminal::disable_raw_mode();
+            Err(err).context(
+                "opening the terminal UI (without a terminal, use --headless, or teach --headless)",
+            )
+        }
+    }
+}
+
 /// A run the dashboard drives: its commands, and the thread to join at the end.
 pub struct Driven {
     pub handle: RunHandle,
@@ -50,8 +64,7 @@ pub struct Driven {
 pub fn run_dashboard(task: &str, runs: Vec<Driven>, events: Receiver<Event>) -> Result<()> {
     let theme = Theme::from_env();
     let mut dashboard = Dashboard::new(task);
-    let mut terminal = ratatui::try_init().context("opening the terminal UI")?;
-    let guard = TerminalGuard;
+    let (mut terminal, guard) = open_terminal()?;
     let result = (|| -> Result<()> {
         loop {
             for event in events.try_iter() {
@@ -103,8 +116,7 @@ pub fn run_dashboard(task: &str, runs: Vec<Driven>, events: Receiver<Event>) -> 
 /// Runs stand-alone teach mode until the user quits.
 pub fn run_teach(mut teach: Teach) -> Result<()> {
     let theme = Theme::from_env();
-    let mut terminal = ratatui::try_init().context("opening the terminal UI")?;
-    let _guard = TerminalGuard;
+    let (mut terminal, _guard) = open_terminal()?;
     let mut help = false;
     loop {
         terminal
