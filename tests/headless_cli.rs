@@ -22,12 +22,17 @@ fn stderr(output: &Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()
 }
 
-/// `episodes.csv` without its `wall_s` column, which measures the machine, not the run.
+/// `episodes.csv` without its `wall_s` column, which measures the machine, not the run,
+/// and with its rows sorted: runs trained side by side interleave their rows as the
+/// threads happen to finish episodes.
 fn episodes_without_time(dir: &Path) -> Vec<String> {
     let text = std::fs::read_to_string(dir.join("episodes.csv")).unwrap();
-    text.lines()
+    let mut lines: Vec<String> = text
+        .lines()
         .map(|line| line.rsplit_once(',').unwrap().0.to_string())
-        .collect()
+        .collect();
+    lines[1..].sort();
+    lines
 }
 
 fn run_short(out: &Path, seed: &str) -> Output {
