@@ -79,6 +79,11 @@ fn run_experiment(cli: &Cli) -> Result<()> {
         config.quick();
     }
     if !cli.run.headless {
+        if cli.run.out.is_some() || cli.run.force || cli.run.jobs.is_some() {
+            anyhow::bail!(
+                "--out, --force and --jobs are for --headless runs: the dashboard writes no files"
+            );
+        }
         return run_dashboard(cli, &config);
     }
     let dir = match &cli.run.out {

@@ -202,3 +202,15 @@ fn a_diverging_run_stops_with_an_error_and_keeps_its_last_good_weights() {
         assert!(values.iter().all(|v| v.is_finite()), "{name} is not finite");
     }
 }
+
+#[test]
+fn output_flags_without_headless_are_refused_before_the_dashboard_opens() {
+    let output = sapnet(&["--out", "somewhere"]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output).contains("--out, --force and --jobs are for --headless runs"),
+        "{}",
+        stderr(&output)
+    );
+    assert!(!Path::new("somewhere").exists());
+}
