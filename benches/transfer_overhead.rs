@@ -13,7 +13,7 @@ use std::sync::Arc;
 use std::thread;
 use std::time::Duration;
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::{criterion_group, Criterion};
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use ratatui::backend::TestBackend;
@@ -110,13 +110,10 @@ fn watched(train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Com
     ui.join().expect("UI thread");
 }
 
-fn overhead(c: &mut Criterion) {
-    if std::env::var_os("RAYON_NUM_THREADS").is_none() {
-        std::env::set_var("RAYON_NUM_THREADS", "1");
-    }
+/// The DQN and the transfer run (with `stream`) over the same steps.
+fn specs(stream: StreamOptions) -> (DqnRunSpec, TransferRunSpec) {
     let config = Config::default();
-    let start = config.dqn.replay_start_size as u64;
-    let warm_up = 10 * start;
+    let warm_up = 10 * config.dqn.replay_start_size as u64;
     let dqn = DqnRunSpec {
         run: 0,
         method: "dqn[100]".into(),
@@ -132,7 +129,7 @@ fn overhead(c: &mut Criterion) {
         seed: 1,
         stream: StreamOptions::episodes(),
     };
-    let transfer = |stream: StreamOptions| TransferRunSpec {
+    let transfer = TransferRunSpec {
         run: 0,
         method: "sapnet".into(),
         env: config.env.clone(),
@@ -145,6 +142,20 @@ fn overhead(c: &mut Criterion) {
         seed: 1,
         stream,
     };
+    (dqn, transfer)
+}
+
+fn one_thread() {
+    if std::env::var_os("RAYON_NUM_THREADS").is_none() {
+        std::env::set_var("RAYON_NUM_THREADS", "1");
+    }
+}
+
+fn overhead(c: &mut Criterion) {
+    one_thread();
+    let (dqn, _) = specs(StreamOptions::episodes());
+    let transfer = |stream| specs(stream).1;
+    let config = Config::default();
 
     let mut group = c.benchmark_group("transfer_overhead");
     group.sample_size(20);
@@ -189,4 +200,25 @@ fn overhead(c: &mut Criterion) {
 }
 
 criterion_group!(benches, overhead);
-criterion_main!(benches);
+
+/// `SAPNET_RUN_ONCE=dqn|sapnet|live cargo bench --bench transfer_overhead` runs that case
+/// once, on this thread, without criterion: for counting its instructions under
+/// `valgrind --tool=callgrind --separate-threads=yes`, which is repeatable where the
+/// machine's timings are not.
+fn main() {
+    if let Ok(case) = std::env::var("SAPNET_RUN_ONCE") {
+        one_thread();
+        let stream = match case.as_str() {
+            "live" => StreamOptions::live(),
+            _ => StreamOptions::episodes(),
+        };
+        let (dqn, transfer) = specs(stream);
+        drained(|e, c| match case.as_str() {
+            "dqn" => drop(trainer::train(&dqn, e, c).expect("run")),
+            _ => drop(trainer::train_transfer(&transfer, e, c).expect("run")),
+        });
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}
