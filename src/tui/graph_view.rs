@@ -75,7 +75,8 @@ pub fn draw(frame: &mut Frame, area: Rect, block: Block, scene: Scene, theme: Th
                     style = style.patch(theme.cursor());
                 }
                 let text = format!("{}{}", heat_symbol(level), labels[i]);
-                // Centre the label on the node: a cell is about 2.7/width units wide.
+                // Roughly centre the label on the node (0.04 units is about a cell of a
+                // panel 60 cells wide; exact centring would need the panel's width).
                 ctx.print(
                     x - 0.04 * text.chars().count() as f64 / 2.0,
                     y,
