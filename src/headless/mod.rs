@@ -39,10 +39,10 @@ use crate::trainer::{
 pub(crate) use progress::Progress;
 pub use results::{RunSummary, Summary};
 
-/// Entries that mark a directory as holding results already.
 /// How often the scheduler drains the runs' events and checks for Ctrl-C.
 const POLL_INTERVAL: Duration = Duration::from_millis(10);
 
+/// Entries that mark a directory as holding results already.
 const RESULT_FILES: [&str; 5] = [
     "episodes.csv",
     "tests.csv",
@@ -156,9 +156,9 @@ fn schedule(
             break;
         }
         // Poll rather than wait on the channel: a send that finds its receiver parked
-        // must wake it (a futex call per event, measured at up to a tenth of a CartPole
-        // step), while a receiver that drains every few milliseconds costs the trainer
-        // nothing but the enqueue.
+        // must wake it (in a profile of the transfer loop, the kernel's task switching
+        // took 11% of the samples), while a receiver that drains every few milliseconds
+        // costs the trainer nothing but the enqueue.
         thread::sleep(POLL_INTERVAL);
         for event in events.try_iter() {
             sink.on_event(event)?;
