@@ -35,7 +35,8 @@ fn events_fill_the_table_the_curves_and_the_status() {
     assert!((view.probabilities.iter().sum::<f64>() - 1.0).abs() < 1e-9);
     assert_eq!(d.runs[0].episode, 30);
     assert_eq!(d.runs[0].curve.returns.len(), 30);
-    assert_eq!(d.runs[1].curve.average.len(), 30);
+    assert_eq!(d.runs[1].episode, 90, "the baseline runs three episodes to one");
+    assert_eq!(d.runs[1].curve.average.len(), 90);
     let expected_steps: u64 = (1..=30u32).map(|e| u64::from(20 + (e * 37 % 180))).sum();
     assert_eq!(d.step, expected_steps);
     assert!(view.glows(6, d.step), "source-6 just spread");
@@ -52,11 +53,12 @@ fn memory_stays_bounded_over_a_long_run() {
             run.curve.returns.len()
         );
         assert!(run.statistic_loss.len() <= CURVE_POINTS);
-        assert_eq!(run.episode, 20_000);
     }
+    assert_eq!(d.runs[0].episode, 20_000);
+    assert_eq!(d.runs[1].episode, 60_000);
     // Thinning keeps the last episodes' moving average exact.
     let last = d.runs[1].curve.last_average().unwrap();
-    let expected = (19_991..=20_000).map(|e| f64::from(9 + e % 3)).sum::<f64>() / 10.0;
+    let expected = (59_991..=60_000).map(|e| f64::from(9 + e % 3)).sum::<f64>() / 10.0;
     assert!((last - expected).abs() < 1e-12);
 }
 

@@ -94,7 +94,7 @@ fn a_user_pauses_steps_teaches_and_quits() {
     session.keys("a");
     session.wait_for(&["next: spread("]);
     session.keys("s");
-    let screen = session.wait_for(&["1 calls made"]);
+    let screen = session.wait_for(&["calls: 1 made"]);
     assert!(screen.contains("Ω < T_ω"), "{screen}");
     session.keys("q");
     let screen = session.wait_for(&["SAPNET-EXITED 0"]);

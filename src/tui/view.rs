@@ -240,11 +240,13 @@ fn probability_bar(p: f64, width: usize) -> String {
     )
 }
 
+/// The episode axis follows the first (leading) run, so that its curve fills the chart
+/// however far ahead a baseline of short episodes has raced; the others are drawn over the
+/// same episodes, and the title says where they are.
 fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], theme: Theme) {
     let x_max = runs
-        .iter()
-        .map(|r| f64::from(r.episode.max(1)))
-        .fold(10.0, f64::max);
+        .first()
+        .map_or(10.0, |r| f64::from(r.episode).max(10.0));
     let (y_min, y_max) = runs
         .iter()
         .flat_map(|r| r.curve.returns.iter().map(|&(_, y)| y))
@@ -276,10 +278,16 @@ fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], theme: Theme) {
                 .data(&run.curve.average),
         );
     }
-    let title = match runs.first().and_then(|r| r.curve.last_average()) {
+    let mut title = match runs.first().and_then(|r| r.curve.last_average()) {
         Some(ma) => format!(" episode reward · {} MA10 {ma:.1} ", runs[0].method),
         None => " episode reward ".to_string(),
     };
+    for run in runs.iter().skip(1).filter(|r| f64::from(r.episode) > x_max) {
+        title.push_str(&format!("· {} ep {} ", run.method, run.episode));
+    }
+    if title.chars().count() + 2 > usize::from(area.width) {
+        title = title.replacen("episode reward", "reward", 1);
+    }
     let chart = Chart::new(datasets)
         .block(Block::bordered().title(Span::styled(title, theme.title())))
         .x_axis(
@@ -515,7 +523,7 @@ fn draw_teach_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
             }
             lines.push(Line::styled(
                 format!(
-                    "activated {} (k = {}), {} calls made, {} pending",
+                    "activated {}, k = {} · calls: {} made, {} pending",
                     names[w.policy],
                     teach.net().graph().degree(w.policy),
                     w.trace.len(),
