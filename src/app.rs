@@ -131,6 +131,9 @@ fn run_experiment(cli: &Cli) -> Result<()> {
                 chosen.name, chosen.hidden, chosen.activation
             );
         }
+        if let Some(copy) = &run.library_copy {
+            eprintln!("  added to the policy library as {}", copy.display());
+        }
     }
     Ok(())
 }

@@ -114,6 +114,28 @@ fn a_missing_library_is_trained_then_every_result_is_written() {
         policy.metadata.reused.as_deref(),
         Some(format!("cartpole/{chosen}").as_str())
     );
+    // Algorithm 3's last step: each run's chosen policy joins the library, beside the
+    // sources, as the results hold it.
+    let chosen_dir = library.join("cartpole/chosen");
+    assert_eq!(
+        policy_store::list(&chosen_dir).unwrap(),
+        ["out-sapnet-run0", "out-sapnet-run1"]
+    );
+    let added = policy_store::load(&chosen_dir, "out-sapnet-run0").unwrap();
+    assert_eq!(added.metadata, policy.metadata);
+    assert_eq!(
+        std::fs::read(chosen_dir.join("out-sapnet-run0.safetensors")).unwrap(),
+        std::fs::read(out.join("policies/sapnet-run0.safetensors")).unwrap()
+    );
+    let sapnet_run = runs.iter().find(|r| r["method"] == "sapnet").unwrap();
+    assert!(sapnet_run["library_copy"]
+        .as_str()
+        .unwrap()
+        .ends_with("out-sapnet-run0.ron"));
+    assert!(
+        message.contains("added to the policy library as"),
+        "{message}"
+    );
     for plot in [
         "learning_curve.png",
         "learning_curve.svg",
@@ -136,6 +158,51 @@ fn a_present_library_is_reused_unchanged() {
     assert_eq!(
         std::fs::read(dir.join("source-1.safetensors")).unwrap(),
         before
+    );
+}
+
+#[test]
+fn a_chosen_policy_never_replaces_one_in_the_library() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    train_library(&library);
+    let out = tmp.path().join("out");
+    assert!(transfer(&library, &out).status.success());
+    let chosen_dir = library.join("cartpole/chosen");
+    let first = std::fs::read(chosen_dir.join("out-sapnet-run0.ron")).unwrap();
+
+    // The same --out again (--force replaces the results, not the library), then another
+    // seed: both runs' choices are added under new names.
+    let again = sapnet(
+        &[
+            "--headless",
+            "--config",
+            &config("tiny_transfer.ron"),
+            "--force",
+            "--seed",
+            "7",
+        ],
+        &library,
+        &out,
+    );
+    assert!(again.status.success(), "{}", stderr(&again));
+    assert_eq!(
+        policy_store::list(&chosen_dir).unwrap(),
+        [
+            "out-sapnet-run0",
+            "out-sapnet-run0-2",
+            "out-sapnet-run1",
+            "out-sapnet-run1-2"
+        ]
+    );
+    assert_eq!(
+        std::fs::read(chosen_dir.join("out-sapnet-run0.ron")).unwrap(),
+        first
+    );
+    // The sources are what they were: the next run reuses the same library.
+    assert_eq!(
+        policy_store::list(&library.join("cartpole")).unwrap().len(),
+        3
     );
 }
 

@@ -35,7 +35,10 @@ fn events_fill_the_table_the_curves_and_the_status() {
     assert!((view.probabilities.iter().sum::<f64>() - 1.0).abs() < 1e-9);
     assert_eq!(d.runs[0].episode, 30);
     assert_eq!(d.runs[0].curve.returns.len(), 30);
-    assert_eq!(d.runs[1].episode, 90, "the baseline runs three episodes to one");
+    assert_eq!(
+        d.runs[1].episode, 90,
+        "the baseline runs three episodes to one"
+    );
     assert_eq!(d.runs[1].curve.average.len(), 90);
     let expected_steps: u64 = (1..=30u32).map(|e| u64::from(20 + (e * 37 % 180))).sum();
     assert_eq!(d.step, expected_steps);

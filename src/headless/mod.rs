@@ -13,6 +13,10 @@
 //!   each trained network — SAP-Net's chosen policy after training — in the policy
 //!   library's format;
 //! - `learning_curve.png`/`.svg`, `tests.png`, `activations.png`: the paper's Fig. 5–8.
+//!
+//! Each SAP-Net run that finishes also adds its chosen policy to the policy library, as
+//! `<library>/<target task>/chosen/<out dir>-sapnet-run<r>` (Algorithm 3's last step); the
+//! sources beside it are never touched, and no policy already there is replaced.
 
 mod plots;
 mod progress;
@@ -28,6 +32,7 @@ use std::time::{Duration, Instant};
 use anyhow::{bail, Context, Result};
 
 use crate::config::{Config, Method};
+use crate::dqn::QNet;
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::seeds;
 use crate::sources;
@@ -97,7 +102,8 @@ pub fn run(
         (None, commands)
     };
     let specs = run_specs(config, sources.as_ref())?;
-    let mut sink = Sink::create(config, &output.dir, sources.as_deref(), &specs)?;
+    let chosen = ChosenCopies::new(config, output, &options.library);
+    let mut sink = Sink::create(config, &output.dir, sources.as_deref(), &specs, chosen)?;
     let started = Instant::now();
 
     let outcome = schedule(specs, options.jobs, &commands, &mut sink, config, output);
@@ -230,6 +236,49 @@ struct Sink {
     finished: BTreeMap<usize, RunSummary>,
     tested: BTreeMap<String, Vec<Vec<f64>>>,
     window: usize,
+    /// Where SAP-Net's chosen policies join the library.
+    chosen: ChosenCopies,
+}
+
+/// The library directory that receives SAP-Net's chosen policies, and the prefix that tells
+/// one experiment's from another's.
+struct ChosenCopies {
+    dir: PathBuf,
+    prefix: String,
+}
+
+impl ChosenCopies {
+    fn new(config: &Config, output: &OutputOptions, library: &Path) -> Self {
+        // A policy's name may not start with a dot (hidden files are the store's temporaries).
+        let prefix = output
+            .dir
+            .file_name()
+            .map(|n| n.to_string_lossy().trim_start_matches('.').to_string())
+            .filter(|n| !n.is_empty())
+            .unwrap_or_else(|| "results".into());
+        Self {
+            dir: library.join(config.env.task_name()).join("chosen"),
+            prefix,
+        }
+    }
+
+    /// Writes `net` under a name no policy in the directory has yet (`…-2`, `…-3` after
+    /// the first), and returns the path of its metadata file.
+    fn add(&self, file_name: &str, net: &QNet, info: &PolicyInfo) -> Result<PathBuf> {
+        let base = format!("{}-{file_name}", self.prefix);
+        let taken = |name: &str| {
+            let (weights, metadata) = policy_store::paths(&self.dir, name);
+            weights.exists() || metadata.exists()
+        };
+        let mut name = base.clone();
+        let mut k = 1;
+        while taken(&name) {
+            k += 1;
+            name = format!("{base}-{k}");
+        }
+        policy_store::save(&self.dir, &name, net, info)?;
+        Ok(policy_store::paths(&self.dir, &name).1)
+    }
 }
 
 impl Sink {
@@ -238,6 +287,7 @@ impl Sink {
         dir: &Path,
         sources: Option<&Vec<SourcePolicy>>,
         specs: &[RunSpec],
+        chosen: ChosenCopies,
     ) -> Result<Self> {
         let names: Vec<String> = sources
             .map(|s| s.iter().map(|p| p.name.clone()).collect())
@@ -262,6 +312,7 @@ impl Sink {
             finished: BTreeMap::new(),
             tested: BTreeMap::new(),
             window: config.protocol.moving_average,
+            chosen,
         })
     }
 
@@ -329,12 +380,28 @@ impl Sink {
         output: &OutputOptions,
     ) -> Result<()> {
         let record = outcome.record;
+        let mut library_copy = None;
         // A run stopped before its first step trained nothing worth keeping.
         if record.steps > 0 {
             let name = policy_file_name(&record.method, record.run);
             let info = policy_info(config, &record, spec);
             policy_store::save(&output.dir.join("policies"), &name, &outcome.net, &info)
                 .with_context(|| format!("saving the trained {}", record.method))?;
+            // Only a finished transfer's choice, tested, is worth reusing.
+            // The results hold it already: a library that cannot take it costs a warning.
+            if matches!(spec, RunSpec::Transfer(_)) && !record.stopped {
+                match self.chosen.add(&name, &outcome.net, &info) {
+                    Ok(path) => library_copy = Some(path),
+                    Err(err) => self.progress.warn(&format!(
+                        "the chosen policy of {} run {} could not be added to the library in \
+                         {}: {err:#}; it is in {}",
+                        record.method,
+                        record.run + 1,
+                        self.chosen.dir.display(),
+                        output.dir.join("policies").display()
+                    )),
+                }
+            }
         }
         self.tests.write(&record)?;
         if !record.test_returns.is_empty() {
@@ -347,8 +414,9 @@ impl Sink {
             .rewards
             .get(&(record.method.clone(), record.run))
             .map_or(&[][..], Vec::as_slice);
-        self.finished
-            .insert(order, RunSummary::new(record, rewards, self.window));
+        let mut summary = RunSummary::new(record, rewards, self.window);
+        summary.library_copy = library_copy;
+        self.finished.insert(order, summary);
         Ok(())
     }
 

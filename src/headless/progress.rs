@@ -83,6 +83,14 @@ impl Progress {
         }
     }
 
+    /// A line above the bar (or a plain line), for what the user should know at once.
+    pub fn warn(&self, message: &str) {
+        match &self.bar {
+            Some(bar) => bar.println(format!("warning: {message}")),
+            None => eprintln!("warning: {message}"),
+        }
+    }
+
     /// Ends the bar; `complete` false leaves it where it stopped.
     pub fn finish(&mut self, complete: bool) {
         if let Some(bar) = self.bar.take() {

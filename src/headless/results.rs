@@ -174,6 +174,9 @@ pub struct RunSummary {
     pub best_moving_average: Option<f64>,
     /// First episode (1-based) whose moving average reached the best value.
     pub best_moving_average_episode: Option<u32>,
+    /// SAP-Net: where the chosen policy was added to the policy library (its metadata file).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub library_copy: Option<std::path::PathBuf>,
 }
 
 impl Summary {
@@ -216,6 +219,7 @@ impl RunSummary {
             final_moving_average: averages.last().copied(),
             best_moving_average: best.map(|(_, a)| a),
             best_moving_average_episode: best.map(|(i, _)| (i + window) as u32),
+            library_copy: None,
         }
     }
 }
