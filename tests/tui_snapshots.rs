@@ -50,6 +50,18 @@ fn dashboard_running() {
 }
 
 #[test]
+fn dashboard_after_the_run_names_the_chosen_policy_and_its_tests() {
+    let mut d = dashboard();
+    d.on_event(tui_script::sapnet_end(60));
+    for size in SIZES {
+        insta::assert_snapshot!(
+            format!("dashboard_done_{}x{}", size.0, size.1),
+            draw_dashboard(&d, size).backend()
+        );
+    }
+}
+
+#[test]
 fn dashboard_help_overlay() {
     let mut d = dashboard();
     d.on_key(key('?'));

@@ -129,7 +129,10 @@ fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Th
             draw_policy_table(
                 frame,
                 table,
-                focus_block("policies", dashboard.focus == Focus::Table),
+                focus_block(
+                    &policies_title(dashboard, table.width),
+                    dashboard.focus == Focus::Table,
+                ),
                 view,
                 dashboard.cursor,
                 theme,
@@ -144,6 +147,36 @@ fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Th
     }
     draw_rewards(frame, rewards, &dashboard.runs, theme);
     draw_loss(frame, loss, dashboard.main_run(), theme);
+}
+
+/// "policies", and once SAP-Net's run has ended, the policy it chose (Algorithm 3: the
+/// highest activation) and that policy's greedy test returns (their mean, if the list does
+/// not fit in `width`).
+fn policies_title(dashboard: &Dashboard, width: u16) -> String {
+    let ended = dashboard.main_run().and_then(|r| r.ended.as_ref());
+    match ended.and_then(|record| Some((record, record.chosen.as_ref()?))) {
+        Some((record, chosen)) if record.test_returns.is_empty() => {
+            format!("policies · chosen {} (stopped, not tested)", chosen.name)
+        }
+        Some((record, chosen)) => {
+            let tests: Vec<String> = record
+                .test_returns
+                .iter()
+                .map(|r| format!("{r:.0}"))
+                .collect();
+            let all = format!(
+                "policies · chosen {} · greedy tests {}",
+                chosen.name,
+                tests.join(" ")
+            );
+            if all.chars().count() + 4 <= usize::from(width) {
+                return all;
+            }
+            let mean = record.test_returns.iter().sum::<f64>() / record.test_returns.len() as f64;
+            format!("policies · chosen {} · test mean {mean:.1}", chosen.name)
+        }
+        None => "policies".to_string(),
+    }
 }
 
 fn draw_policy_table(
@@ -194,7 +227,7 @@ fn draw_policy_table(
     });
     let (header, widths) = if full {
         (
-            vec!["policy", "hidden", "cat", "A", "P(π)", "chosen", "+/−"],
+            vec!["policy", "hidden", "cat", "A", "P(π)", "acted", "+/−"],
             vec![
                 Constraint::Length(9),
                 Constraint::Length(14),
@@ -207,7 +240,7 @@ fn draw_policy_table(
         )
     } else {
         (
-            vec!["policy", "A", "P(π)", "chosen"],
+            vec!["policy", "A", "P(π)", "acted"],
             vec![
                 Constraint::Length(9),
                 Constraint::Length(9),

@@ -5,7 +5,8 @@
 use sapnet::config::Config;
 use sapnet::sapnet::{PolicyDescription, SapNet};
 use sapnet::trainer::{
-    ActivationSnapshot, EpisodeRecord, Event, SapNetStart, SourceSummary, StepRecord,
+    ActivationSnapshot, ChosenPolicy, EpisodeRecord, Event, RunRecord, SapNetStart, SourceSummary,
+    StepRecord,
 };
 
 /// The shipped CartPole library's hidden layers.
@@ -127,5 +128,26 @@ fn episode_end(method: &str, episode: u32, reward: f64) -> Event {
         epsilon: 0.03,
         policy: Some(6),
         wall_s: f64::from(episode) * 0.01,
+    })
+}
+
+/// The end of SAP-Net's run after `episodes` episodes: source-6 chosen and tested.
+pub fn sapnet_end(episodes: u32) -> Event {
+    Event::RunEnded(RunRecord {
+        run: 0,
+        method: "sapnet".into(),
+        seed: 1,
+        episodes,
+        steps: 6450,
+        updates: 5950,
+        chosen: Some(ChosenPolicy {
+            index: 6,
+            name: "source-6".into(),
+            hidden: HIDDEN[6].to_vec(),
+            activation: 3117.0,
+        }),
+        test_returns: vec![500.0, 500.0, 487.0, 500.0, 500.0],
+        stopped: false,
+        wall_s: 12.5,
     })
 }
