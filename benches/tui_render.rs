@@ -3,6 +3,7 @@
 //!
 //! `cargo bench --bench tui_render`
 
+#[allow(dead_code)] // the tests use more of the script than the bench
 #[path = "../tests/common/tui_script.rs"]
 mod tui_script;
 

@@ -1,1 +1,3 @@
+// Each test binary (and the render bench) uses a part of the script.
+#[allow(dead_code)]
 pub mod tui_script;
