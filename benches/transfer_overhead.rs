@@ -11,7 +11,7 @@
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::thread;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, Criterion};
 use rand::rngs::StdRng;
@@ -34,6 +34,10 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 /// the DQN 500 (its `replay_start_size` raised to match).
 const STEPS: u64 = 3_000;
 
+/// Learning steps of each run in `SAPNET_AB_PAIRS` mode: long enough (~0.5 s) that the
+/// dashboard draws a dozen frames while the trainer works.
+const AB_STEPS: u64 = 40_000;
+
 fn sources(n: u64) -> Arc<Vec<SourcePolicy>> {
     Arc::new(
         (0..n)
@@ -53,8 +57,11 @@ fn sources(n: u64) -> Arc<Vec<SourcePolicy>> {
 
 /// Runs `train` with its events drained on another thread every 10 ms, as both front ends
 /// drain them (headless between progress updates, the TUI once per frame): never parked
-/// on the channel, so that no send has to wake a thread.
-fn drained(train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Command>)) {
+/// on the channel, so that no send has to wake a thread. Returns the time `train` took:
+/// the front end's shutdown (waiting out the sleep it is in) is not training time.
+fn drained(
+    train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Command>),
+) -> Duration {
     let (events, received) = mpsc::channel::<Event>();
     let drain = thread::spawn(move || {
         let mut count = 0;
@@ -69,15 +76,20 @@ fn drained(train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Com
         }
     });
     let (_commands, commands) = mpsc::channel();
+    let started = Instant::now();
     train(&events, &commands);
+    let took = started.elapsed();
     drop(events);
     drain.join().expect("drain thread");
+    took
 }
 
 /// As [`drained`], but the thread is the dashboard's: every frame (33 ms) it folds the
 /// events into a [`Dashboard`] and draws it at 200×60, so that training competes with
 /// the UI's work as it does with the TUI open.
-fn watched(train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Command>)) {
+fn watched(
+    train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Command>),
+) -> Duration {
     let (events, received) = mpsc::channel::<Event>();
     let ui = thread::spawn(move || {
         let mut dashboard = Dashboard::new("CartPole-v1");
@@ -105,13 +117,16 @@ fn watched(train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Com
         }
     });
     let (_commands, commands) = mpsc::channel();
+    let started = Instant::now();
     train(&events, &commands);
+    let took = started.elapsed();
     drop(events);
     ui.join().expect("UI thread");
+    took
 }
 
-/// The DQN and the transfer run (with `stream`) over the same steps.
-fn specs(stream: StreamOptions) -> (DqnRunSpec, TransferRunSpec) {
+/// The DQN and the transfer run (with `stream`) over the same `steps` learning steps.
+fn specs(stream: StreamOptions, steps: u64) -> (DqnRunSpec, TransferRunSpec) {
     let config = Config::default();
     let warm_up = 10 * config.dqn.replay_start_size as u64;
     let dqn = DqnRunSpec {
@@ -124,7 +139,7 @@ fn specs(stream: StreamOptions) -> (DqnRunSpec, TransferRunSpec) {
         },
         hidden: vec![100],
         episodes: u32::MAX,
-        max_steps: Some(STEPS + warm_up),
+        max_steps: Some(steps + warm_up),
         test_episodes: 0,
         seed: 1,
         stream: StreamOptions::episodes(),
@@ -137,7 +152,7 @@ fn specs(stream: StreamOptions) -> (DqnRunSpec, TransferRunSpec) {
         sapnet: config.sapnet.clone(),
         sources: sources(10),
         episodes: u32::MAX,
-        max_steps: Some(STEPS + warm_up),
+        max_steps: Some(steps + warm_up),
         test_episodes: 0,
         seed: 1,
         stream,
@@ -153,15 +168,19 @@ fn one_thread() {
 
 fn overhead(c: &mut Criterion) {
     one_thread();
-    let (dqn, _) = specs(StreamOptions::episodes());
-    let transfer = |stream| specs(stream).1;
+    let (dqn, _) = specs(StreamOptions::episodes(), STEPS);
+    let transfer = |stream| specs(stream, STEPS).1;
     let config = Config::default();
 
     let mut group = c.benchmark_group("transfer_overhead");
     group.sample_size(20);
     group.measurement_time(Duration::from_secs(20));
     group.bench_function("dqn[100]", |b| {
-        b.iter(|| drained(|e, c| drop(trainer::train(&dqn, e, c).expect("run"))))
+        b.iter_custom(|n| {
+            (0..n)
+                .map(|_| drained(|e, c| drop(trainer::train(&dqn, e, c).expect("run"))))
+                .sum()
+        })
     });
     for (name, stream) in [
         ("sapnet 10x[100] results only", StreamOptions::episodes()),
@@ -176,12 +195,22 @@ fn overhead(c: &mut Criterion) {
     ] {
         let spec = transfer(stream);
         group.bench_function(name, |b| {
-            b.iter(|| drained(|e, c| drop(trainer::train_transfer(&spec, e, c).expect("run"))))
+            b.iter_custom(|n| {
+                (0..n)
+                    .map(|_| {
+                        drained(|e, c| drop(trainer::train_transfer(&spec, e, c).expect("run")))
+                    })
+                    .sum()
+            })
         });
     }
     let live = transfer(StreamOptions::live());
     group.bench_function("sapnet 10x[100] live, dashboard drawn at 30 fps", |b| {
-        b.iter(|| watched(|e, c| drop(trainer::train_transfer(&live, e, c).expect("run"))))
+        b.iter_custom(|n| {
+            (0..n)
+                .map(|_| watched(|e, c| drop(trainer::train_transfer(&live, e, c).expect("run"))))
+                .sum()
+        })
     });
     // One source, warming up as long as the others: SAP-Net's bookkeeping without the
     // cost of keeping ten networks warm in the caches.
@@ -194,7 +223,11 @@ fn overhead(c: &mut Criterion) {
         ..transfer(StreamOptions::episodes())
     };
     group.bench_function("sapnet 1x[100] results only", |b| {
-        b.iter(|| drained(|e, c| drop(trainer::train_transfer(&single, e, c).expect("run"))))
+        b.iter_custom(|n| {
+            (0..n)
+                .map(|_| drained(|e, c| drop(trainer::train_transfer(&single, e, c).expect("run"))))
+                .sum()
+        })
     });
     group.finish();
 }
@@ -205,14 +238,27 @@ criterion_group!(benches, overhead);
 /// once, on this thread, without criterion: for counting its instructions under
 /// `valgrind --tool=callgrind --separate-threads=yes`, which is repeatable where the
 /// machine's timings are not.
+///
+/// `SAPNET_AB_PAIRS=N cargo bench --bench transfer_overhead` times N pairs, in turn, of the
+/// headless run (results-only events, drained every 10 ms) and the TUI's (every step
+/// streamed, the dashboard drawn at 30 fps): pairs taken back to back see the same machine,
+/// so the median of their ratios is steadier than two criterion figures taken minutes apart.
 fn main() {
+    if let Some(pairs) = std::env::var("SAPNET_AB_PAIRS")
+        .ok()
+        .and_then(|n| n.parse::<usize>().ok())
+    {
+        one_thread();
+        headless_against_dashboard(pairs);
+        return;
+    }
     if let Ok(case) = std::env::var("SAPNET_RUN_ONCE") {
         one_thread();
         let stream = match case.as_str() {
             "live" => StreamOptions::live(),
             _ => StreamOptions::episodes(),
         };
-        let (dqn, transfer) = specs(stream);
+        let (dqn, transfer) = specs(stream, STEPS);
         drained(|e, c| match case.as_str() {
             "dqn" => drop(trainer::train(&dqn, e, c).expect("run")),
             _ => drop(trainer::train_transfer(&transfer, e, c).expect("run")),
@@ -221,4 +267,58 @@ fn main() {
     }
     benches();
     Criterion::default().configure_from_args().final_summary();
+}
+
+/// Prints the TUI's training speed as a share of headless's, over `pairs` alternating runs.
+fn headless_against_dashboard(pairs: usize) {
+    let headless = specs(StreamOptions::episodes(), AB_STEPS).1;
+    let live = specs(StreamOptions::live(), AB_STEPS).1;
+    let run_headless = || {
+        drained(|e, c| drop(trainer::train_transfer(&headless, e, c).expect("run"))).as_secs_f64()
+    };
+    let run_watched =
+        || watched(|e, c| drop(trainer::train_transfer(&live, e, c).expect("run"))).as_secs_f64();
+    // One of each first, unmeasured: caches, allocator and page tables warm.
+    run_headless();
+    run_watched();
+    let mut shares = Vec::with_capacity(pairs);
+    let (mut headless_s, mut watched_s) = (Vec::new(), Vec::new());
+    for k in 0..pairs {
+        // Alternate which goes first, so neither always follows the other.
+        let (h, w) = if k % 2 == 0 {
+            let h = run_headless();
+            (h, run_watched())
+        } else {
+            let w = run_watched();
+            (run_headless(), w)
+        };
+        headless_s.push(h);
+        watched_s.push(w);
+        // Speed is steps per second over the same steps: the TUI's share is h / w.
+        shares.push(h / w);
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let quartiles = |v: &[f64]| (v[v.len() / 4], v[3 * v.len() / 4]);
+    let h = median(&mut headless_s);
+    let w = median(&mut watched_s);
+    let share = median(&mut shares);
+    let (q1, q3) = quartiles(&shares);
+    println!("{pairs} pairs of {AB_STEPS} learning steps (+ warm-up), 10 sources 4-100-2");
+    println!(
+        "headless (results only, drained every 10 ms): median {:.1} ms",
+        h * 1e3
+    );
+    println!(
+        "TUI (every step streamed, dashboard drawn at 30 fps): median {:.1} ms",
+        w * 1e3
+    );
+    println!(
+        "TUI speed / headless speed, per pair: median {:.1}%, quartiles {:.1}% to {:.1}%",
+        share * 100.0,
+        q1 * 100.0,
+        q3 * 100.0
+    );
 }
