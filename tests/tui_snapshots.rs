@@ -62,6 +62,28 @@ fn dashboard_after_the_run_names_the_chosen_policy_and_its_tests() {
 }
 
 #[test]
+fn a_failed_run_takes_the_status_bar() {
+    let mut d = dashboard();
+    d.on_event(sapnet::trainer::Event::RunFailed {
+        run: 0,
+        method: "dqn[100]".into(),
+        error: "policy dqn[100] (run 0) diverged: the loss is NaN at step 5120".into(),
+    });
+    assert!(d.runs[1].failed.is_some());
+    let terminal = draw_dashboard(&d, (120, 40));
+    insta::assert_snapshot!("failed_status_120x40", status_line(&terminal));
+}
+
+/// The bottom row of the screen.
+fn status_line(terminal: &Terminal<TestBackend>) -> String {
+    let buffer = terminal.backend().buffer();
+    let y = buffer.area.height - 1;
+    (0..buffer.area.width)
+        .map(|x| buffer[(x, y)].symbol())
+        .collect()
+}
+
+#[test]
 fn dashboard_help_overlay() {
     let mut d = dashboard();
     d.on_key(key('?'));

@@ -337,7 +337,8 @@ impl Sink {
                     self.write_activations(record.run, record.episode)?;
                 }
             }
-            Event::Step(_) | Event::Trace(_) | Event::RunEnded(_) => {}
+            // A failure is reported from the run's thread when it is joined.
+            Event::Step(_) | Event::Trace(_) | Event::RunEnded(_) | Event::RunFailed { .. } => {}
         }
         Ok(())
     }

@@ -154,6 +154,14 @@ pub enum Event {
     Trace(TraceRecord),
     EpisodeEnded(EpisodeRecord),
     RunEnded(RunRecord),
+    /// The run could not go on (a diverged loss, a network that would not build): sent
+    /// instead of `RunEnded` by a run on its own thread ([`super::spawn`]), so that a
+    /// front end can say so at once; the thread's result carries the error itself.
+    RunFailed {
+        run: u32,
+        method: MethodLabel,
+        error: String,
+    },
 }
 
 /// What a front end can ask of the trainer.

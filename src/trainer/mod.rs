@@ -116,7 +116,17 @@ pub fn spawn(spec: RunSpec, events: Sender<Event>) -> std::io::Result<RunHandle>
     let (commands, receiver) = mpsc::channel();
     let thread = thread::Builder::new()
         .name(format!("trainer {} run {}", spec.method(), spec.run()))
-        .spawn(move || spec.train(&events, &receiver))?;
+        .spawn(move || {
+            let outcome = spec.train(&events, &receiver);
+            if let Err(err) = &outcome {
+                let _ = events.send(Event::RunFailed {
+                    run: spec.run(),
+                    method: spec.method().to_string(),
+                    error: err.to_string(),
+                });
+            }
+            outcome
+        })?;
     Ok(RunHandle { commands, thread })
 }
 

@@ -175,6 +175,8 @@ pub struct RunView {
     pub epsilon: f64,
     pub statistic_loss: Vec<f64>,
     pub ended: Option<RunRecord>,
+    /// Why the run stopped with an error, if it did.
+    pub failed: Option<String>,
 }
 
 /// Everything the dashboard draws.
@@ -238,6 +240,7 @@ impl Dashboard {
                     epsilon: 0.0,
                     statistic_loss: Vec::new(),
                     ended: None,
+                    failed: None,
                 };
                 if let Some(start) = sapnet {
                     let n = start.net.len();
@@ -293,6 +296,11 @@ impl Dashboard {
             Event::RunEnded(record) => {
                 if let Some(run) = self.runs.iter_mut().find(|r| r.method == record.method) {
                     run.ended = Some(record);
+                }
+            }
+            Event::RunFailed { method, error, .. } => {
+                if let Some(run) = self.runs.iter_mut().find(|r| r.method == method) {
+                    run.failed = Some(error);
                 }
             }
         }

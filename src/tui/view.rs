@@ -386,7 +386,10 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
         Mode::Paused => ("PAUSED", "space resume · n step · t teach · ? keys"),
         Mode::Teach => ("TEACH", "a · s · r · u · c · t back · ? keys"),
     };
-    let hints = if area.width < 100 {
+    let failed = dashboard.runs.iter().any(|r| r.failed.is_some());
+    let hints = if failed {
+        "q quit"
+    } else if area.width < 100 {
         "? keys · q quit"
     } else {
         hints
@@ -405,16 +408,31 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
         d => format!("{} ms/step", d.as_millis()),
     };
     let epsilon = run.map_or(0.0, |r| r.epsilon);
-    let figures = Line::from(vec![
-        Span::styled(
-            format!(" {} ", if finished { "DONE" } else { mode }),
-            theme.title().add_modifier(Modifier::REVERSED),
-        ),
-        Span::raw(format!(
-            " {} · {episode} · step {} · {speed} · ε {epsilon:.2} · {throttle}",
-            dashboard.task, dashboard.step
-        )),
-    ]);
+    // A failed run is the one thing worth the whole line: training went no further.
+    let failure = dashboard
+        .runs
+        .iter()
+        .find_map(|r| Some((&r.method, r.failed.as_ref()?)));
+    let figures = match failure {
+        Some((method, error)) => Line::from(vec![
+            Span::styled(" FAILED ", theme.stopped().add_modifier(Modifier::REVERSED)),
+            Span::raw(if error.contains(method.as_str()) {
+                format!(" {error}")
+            } else {
+                format!(" {method}: {error}")
+            }),
+        ]),
+        None => Line::from(vec![
+            Span::styled(
+                format!(" {} ", if finished { "DONE" } else { mode }),
+                theme.title().add_modifier(Modifier::REVERSED),
+            ),
+            Span::raw(format!(
+                " {} · {episode} · step {} · {speed} · ε {epsilon:.2} · {throttle}",
+                dashboard.task, dashboard.step
+            )),
+        ]),
+    };
     let [left, right] = Layout::horizontal([
         Constraint::Min(0),
         Constraint::Length(hints.chars().count() as u16 + 1),
