@@ -79,9 +79,10 @@ fn run_experiment(cli: &Cli) -> Result<()> {
         config.quick();
     }
     if !cli.run.headless {
-        if cli.run.out.is_some() || cli.run.force || cli.run.jobs.is_some() {
+        if cli.run.out.is_some() || cli.run.force || cli.run.jobs.is_some() || cli.run.trace {
             anyhow::bail!(
-                "--out, --force and --jobs are for --headless runs: the dashboard writes no files"
+                "--out, --force, --jobs and --trace are for --headless runs: the dashboard \
+                 writes no files (its teach mode, `t`, steps the spreading by hand)"
             );
         }
         return run_dashboard(cli, &config);
@@ -100,6 +101,7 @@ fn run_experiment(cli: &Cli) -> Result<()> {
             std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
         }),
         library: cli.run.library.clone(),
+        trace: cli.run.trace,
     };
     let summary = headless::run(&config, &output, &options, on_interrupt()?)?;
     let dir = output.dir.display();

@@ -49,6 +49,12 @@ pub struct RunArgs {
     #[arg(long)]
     pub quick: bool,
 
+    /// With --headless: also write trace.csv, every spread call (eq. 9-11) of every
+    /// positive activation of SAP-Net's runs, as teach mode shows them. One row per call:
+    /// millions over a full protocol, so best with --quick or a small config.
+    #[arg(long)]
+    pub trace: bool,
+
     /// Runs trained at the same time. Default: one per core.
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,

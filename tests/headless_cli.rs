@@ -205,12 +205,14 @@ fn a_diverging_run_stops_with_an_error_and_keeps_its_last_good_weights() {
 
 #[test]
 fn output_flags_without_headless_are_refused_before_the_dashboard_opens() {
-    let output = sapnet(&["--out", "somewhere"]);
-    assert_eq!(output.status.code(), Some(2));
-    assert!(
-        stderr(&output).contains("--out, --force and --jobs are for --headless runs"),
-        "{}",
-        stderr(&output)
-    );
+    for flag in [&["--out", "somewhere"][..], &["--trace"]] {
+        let output = sapnet(flag);
+        assert_eq!(output.status.code(), Some(2));
+        assert!(
+            stderr(&output).contains("--out, --force, --jobs and --trace are for --headless runs"),
+            "{}",
+            stderr(&output)
+        );
+    }
     assert!(!Path::new("somewhere").exists());
 }

@@ -162,6 +162,92 @@ fn a_present_library_is_reused_unchanged() {
 }
 
 #[test]
+fn trace_csv_holds_every_spread_call_and_adds_up_to_the_activations() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    train_library(&library);
+    // SAP-Net alone, long enough for positive transitions (12 episodes have none).
+    let text = std::fs::read_to_string(config("tiny_transfer.ron"))
+        .unwrap()
+        .replace("episodes: 12,", "episodes: 80,")
+        .replace("runs: 2,", "runs: 1,")
+        .replace("methods: [SapNet, Dqn(hidden: [8])]", "methods: [SapNet]");
+    let longer = tmp.path().join("longer.ron");
+    std::fs::write(&longer, text).unwrap();
+    let out = tmp.path().join("out");
+    let output = sapnet(
+        &[
+            "--headless",
+            "--config",
+            longer.to_str().unwrap(),
+            "--trace",
+        ],
+        &library,
+        &out,
+    );
+    assert!(output.status.success(), "{}", stderr(&output));
+
+    let mut trace = csv::Reader::from_path(out.join("trace.csv")).unwrap();
+    assert_eq!(
+        trace.headers().unwrap(),
+        vec![
+            "run", "step", "policy", "call", "from", "to", "h", "omega", "eta", "delta", "stopped"
+        ]
+    );
+    // Deposits per (run, policy), and activations per (run, policy): a call numbered 1 opens
+    // an activation.
+    let mut deposits = std::collections::HashMap::<(String, String), f64>::new();
+    let mut rows = 0;
+    for row in trace.records() {
+        let row = row.unwrap();
+        rows += 1;
+        let num = |i: usize| row[i].parse::<f64>().unwrap();
+        let (h, omega, eta, delta) = (num(6), num(7), num(8), num(9));
+        let stopped = &row[10] == "true";
+        // Eq. 10 with Table II's T_ω = 1: stopped exactly when Ω ≥ T_ω, else η/(h·Ω).
+        assert_eq!(stopped, omega >= 1.0, "{row:?}");
+        if stopped {
+            assert_eq!(delta, 0.0);
+        } else {
+            assert!((delta - eta / (h * omega)).abs() < 1e-12, "{row:?}");
+        }
+        if h == 1.0 {
+            assert_eq!(row[4], row[2], "a first hop leaves the activated policy");
+        }
+        *deposits
+            .entry((row[0].to_string(), row[5].to_string()))
+            .or_default() += delta;
+    }
+    assert!(rows > 0, "the tiny run spreads at least once");
+
+    // Each policy's final activation is 𝒜 = 1 per activation of its own plus what spread to
+    // it: whatever the trace deposited leaves a whole number.
+    let mut activations = csv::Reader::from_path(out.join("activations.csv")).unwrap();
+    let headers = activations.headers().unwrap().clone();
+    let mut last_rows = std::collections::HashMap::new();
+    for row in activations.records() {
+        let row = row.unwrap();
+        last_rows.insert(row[0].to_string(), row);
+    }
+    for (run, row) in &last_rows {
+        for (column, value) in headers.iter().zip(row.iter()) {
+            let Some(policy) = column.strip_prefix("A_") else {
+                continue;
+            };
+            let spread = deposits
+                .get(&(run.clone(), policy.to_string()))
+                .copied()
+                .unwrap_or(0.0);
+            let own = value.parse::<f64>().unwrap() - spread;
+            assert!(
+                own > -1e-6 && (own - own.round()).abs() < 1e-6,
+                "run {run} {policy}: A − deposits = {own}"
+            );
+        }
+    }
+}
+
+#[test]
 fn a_chosen_policy_never_replaces_one_in_the_library() {
     let tmp = tempfile::tempdir().unwrap();
     let library = tmp.path().join("lib");

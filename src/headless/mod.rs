@@ -8,6 +8,7 @@
 //!   selected most in the episode);
 //! - `tests.csv`: the greedy test returns of each run (`run, method, test, return, policy`);
 //! - `activations.csv`: SAP-Net's activations, probabilities and selections per episode;
+//! - `trace.csv` (with `--trace`): every `spread` call of SAP-Net's activations;
 //! - `summary.json`: the config, the source library, each run's totals and test returns;
 //! - `policies/<method>-run<r>.{safetensors,ron}` (e.g. `dqn-100-100-run0`, `sapnet-run0`):
 //!   each trained network — SAP-Net's chosen policy after training — in the policy
@@ -48,10 +49,11 @@ pub use results::{RunSummary, Summary};
 const POLL_INTERVAL: Duration = Duration::from_millis(10);
 
 /// Entries that mark a directory as holding results already.
-const RESULT_FILES: [&str; 5] = [
+const RESULT_FILES: [&str; 6] = [
     "episodes.csv",
     "tests.csv",
     "activations.csv",
+    "trace.csv",
     "summary.json",
     "policies",
 ];
@@ -71,6 +73,8 @@ pub struct RunOptions {
     pub jobs: usize,
     /// Root of the policy library SAP-Net reuses (`<library>/<task>/`).
     pub library: PathBuf,
+    /// Write every spread call of SAP-Net's runs to `trace.csv`.
+    pub trace: bool,
 }
 
 /// Runs the protocol of `config`: trains the source library if SAP-Net needs one that is
@@ -101,12 +105,27 @@ pub fn run(
     } else {
         (None, commands)
     };
-    let specs = run_specs(config, sources.as_ref())?;
+    let mut specs = run_specs(config, sources.as_ref())?;
+    for spec in &mut specs {
+        if let RunSpec::Transfer(transfer) = spec {
+            transfer.stream.trace = options.trace;
+        }
+    }
     let chosen = ChosenCopies::new(config, output, &options.library);
     let mut sink = Sink::create(config, &output.dir, sources.as_deref(), &specs, chosen)?;
+    if options.trace && sources.is_some() {
+        sink.trace = Some(results::TraceWriter::create(
+            &output.dir.join("trace.csv"),
+            &sink.names,
+        )?);
+    }
     let started = Instant::now();
 
     let outcome = schedule(specs, options.jobs, &commands, &mut sink, config, output);
+    let trace_flushed = sink
+        .trace
+        .as_mut()
+        .map_or(Ok(()), results::TraceWriter::flush);
     sink.progress.finish(matches!(outcome, Ok(false)));
     if let Err(err) = outcome {
         summary.error = Some(format!("{err:#}"));
@@ -114,6 +133,7 @@ pub fn run(
     summary.runs = std::mem::take(&mut sink.finished).into_values().collect();
     summary.wall_s = started.elapsed().as_secs_f64();
     results::write_summary(&output.dir.join("summary.json"), &summary)?;
+    trace_flushed?;
     if let Some(error) = &summary.error {
         bail!("{error}");
     }
@@ -224,6 +244,7 @@ struct Sink {
     episodes: results::EpisodeWriter,
     tests: results::TestsWriter,
     activations: Option<results::ActivationsWriter>,
+    trace: Option<results::TraceWriter>,
     progress: Progress,
     /// Training returns per (method, run).
     rewards: BTreeMap<(String, u32), Vec<f64>>,
@@ -304,6 +325,7 @@ impl Sink {
             episodes: results::EpisodeWriter::create(&dir.join("episodes.csv"))?,
             tests: results::TestsWriter::create(&dir.join("tests.csv"))?,
             activations,
+            trace: None,
             progress: Progress::new(planned),
             rewards: BTreeMap::new(),
             snapshots: BTreeMap::new(),
@@ -335,10 +357,18 @@ impl Sink {
                     .push(record.reward);
                 if record.method == SAPNET_LABEL {
                     self.write_activations(record.run, record.episode)?;
+                    if let Some(trace) = &mut self.trace {
+                        trace.flush()?;
+                    }
+                }
+            }
+            Event::Trace(record) => {
+                if let Some(trace) = &mut self.trace {
+                    trace.write(&record)?;
                 }
             }
             // A failure is reported from the run's thread when it is joined.
-            Event::Step(_) | Event::Trace(_) | Event::RunEnded(_) | Event::RunFailed { .. } => {}
+            Event::Step(_) | Event::RunEnded(_) | Event::RunFailed { .. } => {}
         }
         Ok(())
     }

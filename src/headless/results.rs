@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 
 use crate::config::Config;
-use crate::trainer::{EpisodeRecord, RunRecord};
+use crate::trainer::{EpisodeRecord, RunRecord, TraceRecord};
 
 /// `episodes.csv`, one row per episode, flushed row by row so that an interrupted run
 /// keeps every finished episode.
@@ -129,15 +129,76 @@ impl ActivationsWriter {
         self.row.clear();
         self.row.push(run.to_string());
         self.row.push(episode.to_string());
-        self.row.extend(activations.iter().map(ToString::to_string));
-        self.row
-            .extend(probabilities.iter().map(ToString::to_string));
+        self.row.extend(activations.iter().map(number));
+        self.row.extend(probabilities.iter().map(number));
         self.row.extend(selected.iter().map(ToString::to_string));
         self.csv
             .write_record(&self.row)
             .and_then(|()| self.csv.flush().map_err(Into::into))
             .with_context(|| format!("writing {}", self.path))
     }
+}
+
+/// `trace.csv` (`--trace`): every `spread` call of every positive activation of SAP-Net's
+/// runs, as teach mode shows them: `run, step, policy, call, from, to, h, omega, eta, delta,
+/// stopped` (`policy` the activated one, `call` numbering the calls of one activation from
+/// 1, `delta` = η/(h·Ω) or 0 when `Ω ≥ T_ω` stopped the call).
+pub struct TraceWriter {
+    csv: csv::Writer<File>,
+    path: String,
+    names: Vec<String>,
+}
+
+impl TraceWriter {
+    pub fn create(path: &Path, names: &[String]) -> Result<Self> {
+        let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
+        let mut csv = csv::Writer::from_writer(file);
+        csv.write_record([
+            "run", "step", "policy", "call", "from", "to", "h", "omega", "eta", "delta", "stopped",
+        ])
+        .with_context(|| format!("writing {}", path.display()))?;
+        Ok(Self {
+            csv,
+            path: path.display().to_string(),
+            names: names.to_vec(),
+        })
+    }
+
+    /// One activation's calls; buffered (a long run makes millions), see [`Self::flush`].
+    pub fn write(&mut self, record: &TraceRecord) -> Result<()> {
+        let Self { csv, path, names } = self;
+        let name = |i: usize| names.get(i).map_or("?", String::as_str);
+        for (k, call) in record.calls.iter().enumerate() {
+            csv.write_record([
+                record.run.to_string().as_str(),
+                &record.step.to_string(),
+                name(record.policy),
+                &(k + 1).to_string(),
+                name(call.from),
+                name(call.to),
+                &call.h.to_string(),
+                &number(&call.omega),
+                &number(&call.eta),
+                &number(&call.delta),
+                if call.stopped { "true" } else { "false" },
+            ])
+            .with_context(|| format!("writing {path}"))?;
+        }
+        Ok(())
+    }
+
+    /// Puts what is buffered on disk: at every episode's end, so a stopped run keeps it.
+    pub fn flush(&mut self) -> Result<()> {
+        self.csv
+            .flush()
+            .with_context(|| format!("writing {}", self.path))
+    }
+}
+
+/// The shortest text that reads back as `x`, with an exponent where that is shorter (a
+/// selection probability of 1.8e-184 would otherwise take 200 digits).
+fn number(x: &f64) -> String {
+    format!("{x:?}")
 }
 
 /// A source policy as `summary.json` lists it.
