@@ -113,11 +113,8 @@ pub fn run(
     }
     let chosen = ChosenCopies::new(config, output, &options.library);
     let mut sink = Sink::create(config, &output.dir, sources.as_deref(), &specs, chosen)?;
-    if options.trace && sources.is_some() {
-        sink.trace = Some(results::TraceWriter::create(
-            &output.dir.join("trace.csv"),
-            &sink.names,
-        )?);
+    if options.trace {
+        sink.trace_to(&output.dir.join("trace.csv"))?;
     }
     let started = Instant::now();
 
@@ -338,6 +335,14 @@ impl Sink {
         })
     }
 
+    /// Writes SAP-Net's trace events to `path` (nothing to write without SAP-Net runs).
+    fn trace_to(&mut self, path: &Path) -> Result<()> {
+        if self.activations.is_some() {
+            self.trace = Some(results::TraceWriter::create(path, &self.names)?);
+        }
+        Ok(())
+    }
+
     fn on_event(&mut self, event: Event) -> Result<()> {
         match event {
             Event::RunStarted { run, method, .. } => self.progress.run_started(&method, run),
@@ -418,8 +423,8 @@ impl Sink {
             let info = policy_info(config, &record, spec);
             policy_store::save(&output.dir.join("policies"), &name, &outcome.net, &info)
                 .with_context(|| format!("saving the trained {}", record.method))?;
-            // Only a finished transfer's choice, tested, is worth reusing.
-            // The results hold it already: a library that cannot take it costs a warning.
+            // Only a finished transfer's choice, tested, is worth reusing. The results hold
+            // it already, so a library that cannot take it costs a warning, not the run.
             if matches!(spec, RunSpec::Transfer(_)) && !record.stopped {
                 match self.chosen.add(&name, &outcome.net, &info) {
                     Ok(path) => library_copy = Some(path),
@@ -621,6 +626,7 @@ fn prepare_output(output: &OutputOptions) -> Result<()> {
     }
     for stale in [
         "activations.csv",
+        "trace.csv",
         "learning_curve.png",
         "learning_curve.svg",
         "tests.png",
