@@ -386,8 +386,12 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
         Mode::Paused => ("PAUSED", "space resume · n step · t teach · ? keys"),
         Mode::Teach => ("TEACH", "a · s · r · u · c · t back · ? keys"),
     };
-    let failed = dashboard.runs.iter().any(|r| r.failed.is_some());
-    let hints = if failed {
+    // A failed run is the one thing worth the whole line: training went no further.
+    let failure = dashboard
+        .runs
+        .iter()
+        .find_map(|r| Some((&r.method, r.failed.as_ref()?)));
+    let hints = if failure.is_some() {
         "q quit"
     } else if area.width < 100 {
         "? keys · q quit"
@@ -408,11 +412,6 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
         d => format!("{} ms/step", d.as_millis()),
     };
     let epsilon = run.map_or(0.0, |r| r.epsilon);
-    // A failed run is the one thing worth the whole line: training went no further.
-    let failure = dashboard
-        .runs
-        .iter()
-        .find_map(|r| Some((&r.method, r.failed.as_ref()?)));
     let figures = match failure {
         Some((method, error)) => Line::from(vec![
             Span::styled(" FAILED ", theme.stopped().add_modifier(Modifier::REVERSED)),
