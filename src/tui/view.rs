@@ -391,15 +391,18 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
         .runs
         .iter()
         .find_map(|r| Some((&r.method, r.failed.as_ref()?)));
+    let run = dashboard.main_run();
+    let finished = run.is_some_and(|r| r.ended.is_some());
     let hints = if failure.is_some() {
         "q quit"
     } else if area.width < 100 {
         "? keys · q quit"
+    } else if finished && dashboard.mode != Mode::Teach {
+        // Nothing left to pause or step; the graph can still be taught on.
+        "t teach · ? keys · q quit"
     } else {
         hints
     };
-    let run = dashboard.main_run();
-    let finished = run.is_some_and(|r| r.ended.is_some());
     let episode = run.map_or("-".to_string(), |r| {
         format!("{} ep {}/{}", r.method, r.episode, r.planned_episodes)
     });
