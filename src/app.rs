@@ -21,6 +21,14 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Env(args)) => run_env(&cli, args),
         Some(Command::Teach(args)) => run_teach(&cli, args),
         Some(Command::Sources(args)) => run_sources(&cli, args),
+        Some(Command::Plot(args)) => {
+            headless::replot(&args.dir)?;
+            eprintln!(
+                "plots in {}: learning_curve.png, learning_curve.svg, tests.png, activations.png",
+                args.dir.display()
+            );
+            Ok(())
+        }
         None => run_experiment(&cli),
     }
 }

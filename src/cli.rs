@@ -79,6 +79,16 @@ pub enum Command {
     /// Train the library of source policies the config describes (`sources`: N random
     /// architectures) and write it to <LIBRARY>/<task>/.
     Sources(SourcesArgs),
+    /// Draw a results directory's plots again from its files (summary.json, episodes.csv,
+    /// tests.csv, activations.csv): for a run stopped before its plots, or older plots.
+    Plot(PlotArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct PlotArgs {
+    /// The results directory (a headless run's --out).
+    #[arg(value_name = "DIR")]
+    pub dir: PathBuf,
 }
 
 #[derive(Debug, Args)]

@@ -136,14 +136,60 @@ fn a_missing_library_is_trained_then_every_result_is_written() {
         message.contains("added to the policy library as"),
         "{message}"
     );
-    for plot in [
+    let plots = [
         "learning_curve.png",
         "learning_curve.svg",
         "tests.png",
         "activations.png",
-    ] {
+    ];
+    for plot in plots {
         assert!(out.join(plot).metadata().unwrap().len() > 1000, "{plot}");
     }
+
+    // `sapnet plot` draws the same plots again from the files alone.
+    let again = tmp.path().join("again");
+    std::fs::create_dir(&again).unwrap();
+    for file in [
+        "summary.json",
+        "episodes.csv",
+        "tests.csv",
+        "activations.csv",
+    ] {
+        std::fs::copy(out.join(file), again.join(file)).unwrap();
+    }
+    let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .arg("plot")
+        .arg(&again)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    for plot in plots {
+        assert!(
+            std::fs::read(again.join(plot)).unwrap() == std::fs::read(out.join(plot)).unwrap(),
+            "{plot} differs when drawn again"
+        );
+    }
+}
+
+#[test]
+fn plotting_a_directory_without_results_names_the_missing_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .arg("plot")
+        .arg(tmp.path())
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(message.contains("summary.json"), "{message}");
+    assert!(
+        message.contains("is this a results directory?"),
+        "{message}"
+    );
+    assert!(
+        std::fs::read_dir(tmp.path()).unwrap().next().is_none(),
+        "nothing written"
+    );
 }
 
 #[test]

@@ -21,6 +21,7 @@
 
 mod plots;
 mod progress;
+mod replot;
 mod results;
 
 use std::collections::{BTreeMap, VecDeque};
@@ -43,6 +44,7 @@ use crate::trainer::{
 };
 
 pub(crate) use progress::Progress;
+pub use replot::replot;
 pub use results::{RunSummary, Summary};
 
 /// How often the scheduler drains the runs' events and checks for Ctrl-C.

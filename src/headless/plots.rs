@@ -131,6 +131,8 @@ fn learning_curve<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotD
             (FAMILY, 22),
         )
         .margin(12)
+        // Room for the last x label, which plotters centres on the axis's end.
+        .margin_right(30)
         .x_label_area_size(45)
         .y_label_area_size(60)
         .build_cartesian_2d(0f64..episodes as f64, low..high)?;
@@ -190,12 +192,17 @@ fn test_bars<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotData) 
             .flat_map(|(_, _, t)| t.iter().copied())
             .chain([0.0]),
     );
+    // Headroom for the legend above the bars, which grow up (or hang down) from 0: about a
+    // twentieth of the height per method, and some.
+    let high = high + (high - low) * (0.08 + 0.06 * tested.len() as f64);
     let mut chart = ChartBuilder::on(&root)
         .caption(
             format!("{}: greedy test episodes, mean of runs", data.task),
             (FAMILY, 22),
         )
         .margin(12)
+        // Room for the last x label, which plotters centres on the axis's end.
+        .margin_right(30)
         .x_label_area_size(45)
         .y_label_area_size(60)
         .build_cartesian_2d(0.5f64..tests as f64 + 0.5, low..high)?;
@@ -264,6 +271,8 @@ fn activation_lines<DB: DrawingBackend>(
             (FAMILY, 22),
         )
         .margin(12)
+        // Room for the last x label, which plotters centres on the axis's end.
+        .margin_right(30)
         .x_label_area_size(45)
         .y_label_area_size(70)
         .build_cartesian_2d(1f64..episodes as f64, 0f64..high)?;
