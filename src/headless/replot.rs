@@ -75,13 +75,13 @@ pub fn read(dir: &Path) -> Result<PlotData> {
             })
         })
         .collect();
-    let (policy_names, activations) = read_activations(&dir.join("activations.csv"))?;
+    let activations = read_activations(&dir.join("activations.csv"))?;
     Ok(PlotData {
         task: crate::env::make(&config.env).id().to_string(),
         window: config.protocol.moving_average,
         curves,
-        policy_names,
-        activations,
+        policy_names: activations.names,
+        activations: activations.runs,
     })
 }
 
@@ -107,11 +107,19 @@ fn rows<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {
         .collect()
 }
 
-/// The sources' names (`A_<name>` columns) and, per run, each episode's activations. No
-/// file (a config without SAP-Net) is no activations.
-fn read_activations(path: &Path) -> Result<(Vec<String>, Vec<Vec<Vec<f64>>>)> {
+/// What `activations.csv` holds for the plots.
+#[derive(Default)]
+struct Activations {
+    /// The sources' names (the `A_<name>` columns).
+    names: Vec<String>,
+    /// Per run, each episode's activations.
+    runs: Vec<Vec<Vec<f64>>>,
+}
+
+/// No file (a config without SAP-Net) is no activations.
+fn read_activations(path: &Path) -> Result<Activations> {
     if !path.exists() {
-        return Ok((Vec::new(), Vec::new()));
+        return Ok(Activations::default());
     }
     let mut reader =
         csv::Reader::from_path(path).with_context(|| format!("reading {}", path.display()))?;
@@ -148,8 +156,8 @@ fn read_activations(path: &Path) -> Result<(Vec<String>, Vec<Vec<Vec<f64>>>)> {
             .collect::<Result<Vec<f64>>>()?;
         runs.entry(run).or_default().push(values);
     }
-    Ok((
-        columns.into_iter().map(|(_, name)| name).collect(),
-        runs.into_values().collect(),
-    ))
+    Ok(Activations {
+        names: columns.into_iter().map(|(_, name)| name).collect(),
+        runs: runs.into_values().collect(),
+    })
 }
