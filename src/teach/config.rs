@@ -120,6 +120,7 @@ impl TeachConfig {
         let params = self.params();
         params.validate().map_err(|e| e.to_string())?;
         let graph = if self.descriptions.is_empty() {
+            self.no_category_fields()?;
             Graph::from_edges(n, self.edges.iter().copied()).map_err(in_field("edges"))?
         } else if !self.edges.is_empty() {
             return Err("give the graph by `edges` or by `descriptions`, not both".into());
@@ -139,6 +140,24 @@ impl TeachConfig {
             self.names.clone()
         };
         Ok(Lesson { names, net })
+    }
+
+    /// With the graph given by its `edges`, the fields that build M from categories would
+    /// be silently ignored: a file that sets them is refused instead.
+    fn no_category_fields(&self) -> Result<(), String> {
+        let defaults = Self::default();
+        let set = [
+            ("prototypes", self.prototypes != defaults.prototypes),
+            ("delta", self.delta != defaults.delta),
+            ("base_graph", self.base_graph != defaults.base_graph),
+        ];
+        match set.iter().find(|(_, differs)| *differs) {
+            Some((field, _)) => Err(format!(
+                "field `{field}` builds M from categories (eq. 3-5) and needs `descriptions`; \
+                 with `edges` the weights are given directly, so leave `{field}` out"
+            )),
+            None => Ok(()),
+        }
     }
 
     /// N, from whichever of `policies`, `names` and `descriptions` are given; they must agree.
@@ -211,6 +230,16 @@ mod tests {
         let e = lesson("(policies: 3,\n edgs: [])").unwrap_err();
         assert!(e.contains("line 2"), "{e}");
         assert!(e.contains("edgs"), "{e}");
+    }
+
+    #[test]
+    fn category_fields_beside_edges_are_refused_not_ignored() {
+        let err = lesson("(policies: 2, edges: [(0, 1, 0.4)], delta: -0.2)").unwrap_err();
+        assert!(err.contains("test.ron"), "{err}");
+        assert!(err.contains("field `delta`"), "{err}");
+        assert!(err.contains("needs `descriptions`"), "{err}");
+        // Their defaults are no setting: Fig. 2 itself leaves them out.
+        assert!(lesson("(policies: 2, edges: [(0, 1, 0.4)])").is_ok());
     }
 
     #[test]
