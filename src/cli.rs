@@ -6,9 +6,9 @@ use clap::{Args, Parser, Subcommand};
 
 /// SAP-Net: reuse a library of DQN policies by spreading activation over a policy graph.
 ///
-/// With no subcommand, runs the experiment of `--config` (default: the embedded
+/// With no subcommand, opens the live dashboard on `--config` (default: the embedded
 /// `assets/cartpole.ron`, the paper's CartPole-v1 experiment: SAP-Net and three DQN
-/// baselines).
+/// baselines); with `--headless`, runs that experiment's whole protocol and writes results.
 #[derive(Debug, Parser)]
 #[command(name = "sapnet", version, about, long_about = None)]
 pub struct Cli {
