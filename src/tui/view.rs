@@ -211,11 +211,12 @@ fn draw_policy_table(
         }
         cells.push(Cell::from(format_activation(a)));
         cells.push(Cell::from(probability_bar(probability, bar_width)));
-        cells.push(Cell::from(view.selections[i].to_string()));
+        cells.push(Cell::from(count(view.selections[i])));
         if full {
             cells.push(Cell::from(format!(
                 "{}/{}",
-                view.positive[i], view.negative[i]
+                count(view.positive[i]),
+                count(view.negative[i])
             )));
         }
         let row = Row::new(cells);
@@ -253,6 +254,17 @@ fn draw_policy_table(
         .header(Row::new(header).style(theme.title()))
         .block(block);
     frame.render_widget(table, area);
+}
+
+/// A count in at most five characters, so that a long run's tallies fit their column:
+/// 9999, then 10k … 9999k, then 10M ….
+fn count(n: u64) -> String {
+    match n {
+        0..10_000 => n.to_string(),
+        // Up to where rounding to thousands would make 10000k.
+        10_000..9_999_500 => format!("{}k", (n + 500) / 1000),
+        _ => format!("{}M", (n + 500_000) / 1_000_000),
+    }
 }
 
 fn format_activation(a: f64) -> String {
@@ -713,4 +725,21 @@ fn trace_row(k: usize, s: &TraceStep, names: &[String], theme: Theme) -> Row<'st
         Cell::from(delta),
     ])
     .style(Style::new())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::count;
+
+    #[test]
+    fn counts_fit_five_characters() {
+        assert_eq!(count(0), "0");
+        assert_eq!(count(9_999), "9999");
+        assert_eq!(count(10_000), "10k");
+        assert_eq!(count(143_250), "143k");
+        assert_eq!(count(37_813), "38k");
+        assert_eq!(count(9_999_499), "9999k");
+        assert_eq!(count(9_999_500), "10M");
+        assert_eq!(count(12_600_000), "13M");
+    }
 }
