@@ -247,6 +247,7 @@ fn main() {
     if let Some(pairs) = std::env::var("SAPNET_AB_PAIRS")
         .ok()
         .and_then(|n| n.parse::<usize>().ok())
+        .filter(|&n| n > 0)
     {
         one_thread();
         headless_against_dashboard(pairs);

@@ -62,16 +62,43 @@ fn dashboard_after_the_run_names_the_chosen_policy_and_its_tests() {
 }
 
 #[test]
-fn a_failed_run_takes_the_status_bar() {
+fn a_failed_sapnet_run_takes_the_status_bar() {
+    let mut d = dashboard();
+    d.on_event(sapnet::trainer::Event::RunFailed {
+        run: 0,
+        method: "sapnet".into(),
+        error: "policy sapnet (source-3) (run 0) diverged: the loss is NaN at step 5120".into(),
+    });
+    assert!(d.runs[0].failed.is_some());
+    let terminal = draw_dashboard(&d, (120, 40));
+    insta::assert_snapshot!("failed_status_120x40", status_line(&terminal));
+}
+
+#[test]
+fn a_failed_baseline_is_a_note_while_sapnet_goes_on() {
     let mut d = dashboard();
     d.on_event(sapnet::trainer::Event::RunFailed {
         run: 0,
         method: "dqn[100]".into(),
         error: "policy dqn[100] (run 0) diverged: the loss is NaN at step 5120".into(),
     });
-    assert!(d.runs[1].failed.is_some());
-    let terminal = draw_dashboard(&d, (120, 40));
-    insta::assert_snapshot!("failed_status_120x40", status_line(&terminal));
+    let terminal = draw_dashboard(&d, (80, 24));
+    insta::assert_snapshot!("failed_baseline_status_80x24", status_line(&terminal));
+}
+
+#[test]
+fn a_run_that_fails_before_it_starts_still_shows() {
+    // SAP-Net's networks would not build: no RunStarted ever came.
+    let mut d = Dashboard::new("CartPole-v1");
+    d.on_event(tui_script::baseline_start());
+    d.on_event(sapnet::trainer::Event::RunFailed {
+        run: 0,
+        method: "sapnet".into(),
+        error: "building SAP-Net over the source policies: no policies".into(),
+    });
+    assert_eq!(d.main_run().unwrap().method, "sapnet");
+    let line = status_line(&draw_dashboard(&d, (80, 24)));
+    assert!(line.contains("FAILED  sapnet: building SAP-Net"), "{line}");
 }
 
 /// The bottom row of the screen.

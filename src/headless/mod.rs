@@ -129,10 +129,12 @@ pub fn run(
     if let Err(err) = outcome {
         summary.error = Some(format!("{err:#}"));
     }
+    if let Err(err) = &trace_flushed {
+        summary.error.get_or_insert_with(|| format!("{err:#}"));
+    }
     summary.runs = std::mem::take(&mut sink.finished).into_values().collect();
     summary.wall_s = started.elapsed().as_secs_f64();
     results::write_summary(&output.dir.join("summary.json"), &summary)?;
-    trace_flushed?;
     if let Some(error) = &summary.error {
         bail!("{error}");
     }
@@ -285,19 +287,39 @@ impl ChosenCopies {
     /// Writes `net` under a name no policy in the directory has yet (`…-2`, `…-3` after
     /// the first), and returns the path of its metadata file.
     fn add(&self, file_name: &str, net: &QNet, info: &PolicyInfo) -> Result<PathBuf> {
+        std::fs::create_dir_all(&self.dir)
+            .with_context(|| format!("creating {}", self.dir.display()))?;
         let base = format!("{}-{file_name}", self.prefix);
-        let taken = |name: &str| {
-            let (weights, metadata) = policy_store::paths(&self.dir, name);
-            weights.exists() || metadata.exists()
-        };
-        let mut name = base.clone();
         let mut k = 1;
-        while taken(&name) {
+        let (name, metadata) = loop {
+            let name = match k {
+                1 => base.clone(),
+                k => format!("{base}-{k}"),
+            };
+            let (weights, metadata) = policy_store::paths(&self.dir, &name);
+            // The metadata file is claimed by creating it, so that another sapnet writing
+            // to the same library at the same time cannot take the same name; the store's
+            // save then renames the real metadata over this placeholder.
+            if !weights.exists() {
+                match std::fs::OpenOptions::new()
+                    .write(true)
+                    .create_new(true)
+                    .open(&metadata)
+                {
+                    Ok(_) => break (name, metadata),
+                    Err(err) if err.kind() == std::io::ErrorKind::AlreadyExists => {}
+                    Err(err) => {
+                        return Err(err).with_context(|| format!("creating {}", metadata.display()))
+                    }
+                }
+            }
             k += 1;
-            name = format!("{base}-{k}");
+        };
+        if let Err(err) = policy_store::save(&self.dir, &name, net, info) {
+            let _ = std::fs::remove_file(&metadata);
+            return Err(err.into());
         }
-        policy_store::save(&self.dir, &name, net, info)?;
-        Ok(policy_store::paths(&self.dir, &name).1)
+        Ok(metadata)
     }
 }
 
@@ -701,6 +723,44 @@ mod tests {
         assert_eq!(policy_file_name("dqn[100,100]", 0), "dqn-100-100-run0");
         assert_eq!(policy_file_name("dqn[16]", 3), "dqn-16-run3");
         assert_eq!(policy_file_name("sapnet", 1), "sapnet-run1");
+    }
+
+    #[test]
+    fn a_chosen_copy_skips_names_taken_or_being_written() {
+        use rand::SeedableRng;
+        let tmp = tempfile::tempdir().unwrap();
+        let output = OutputOptions {
+            dir: tmp.path().join(".hidden-out"),
+            force: false,
+        };
+        let copies = ChosenCopies::new(&Config::default(), &output, &tmp.path().join("lib"));
+        let net = QNet::new(
+            crate::dqn::Architecture::new(4, &[3], 2),
+            &mut rand::rngs::StdRng::seed_from_u64(0),
+        )
+        .unwrap();
+        let info = PolicyInfo {
+            source_task: Config::default().env,
+            training: TrainingBudget {
+                episodes: 1,
+                steps: 1,
+            },
+            seed: 0,
+            final_score: None,
+            reused: None,
+        };
+        // A leading dot would make a hidden name, which the store refuses.
+        let first = copies.add("sapnet-run0", &net, &info).unwrap();
+        assert!(first.ends_with("lib/cartpole/chosen/hidden-out-sapnet-run0.ron"));
+        // Another process has claimed "-2" but not written it yet.
+        std::fs::write(copies.dir.join("hidden-out-sapnet-run0-2.ron"), "").unwrap();
+        let third = copies.add("sapnet-run0", &net, &info).unwrap();
+        assert!(third.ends_with("hidden-out-sapnet-run0-3.ron"));
+        assert!(policy_store::load(&copies.dir, "hidden-out-sapnet-run0-3").is_ok());
+        assert_eq!(
+            std::fs::read(copies.dir.join("hidden-out-sapnet-run0-2.ron")).unwrap(),
+            b""
+        );
     }
 
     #[test]

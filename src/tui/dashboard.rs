@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
 use crate::sapnet::{PolicyDescription, Prototype, SapNet};
-use crate::trainer::{ActivationSnapshot, Command, Event, RunRecord};
+use crate::trainer::{ActivationSnapshot, Command, Event, RunRecord, SAPNET_LABEL};
 
 use super::teach::Teach;
 
@@ -179,6 +179,21 @@ pub struct RunView {
     pub failed: Option<String>,
 }
 
+impl RunView {
+    fn new(method: String, planned_episodes: u32) -> Self {
+        Self {
+            method,
+            planned_episodes,
+            episode: 0,
+            curve: Curve::default(),
+            epsilon: 0.0,
+            statistic_loss: Vec::new(),
+            ended: None,
+            failed: None,
+        }
+    }
+}
+
 /// Everything the dashboard draws.
 #[derive(Debug, Clone)]
 pub struct Dashboard {
@@ -232,16 +247,7 @@ impl Dashboard {
                 sapnet,
                 ..
             } => {
-                let run = RunView {
-                    method,
-                    planned_episodes,
-                    episode: 0,
-                    curve: Curve::default(),
-                    epsilon: 0.0,
-                    statistic_loss: Vec::new(),
-                    ended: None,
-                    failed: None,
-                };
+                let run = RunView::new(method, planned_episodes);
                 if let Some(start) = sapnet {
                     let n = start.net.len();
                     self.sapnet = Some(SapNetView {
@@ -299,8 +305,19 @@ impl Dashboard {
                 }
             }
             Event::RunFailed { method, error, .. } => {
-                if let Some(run) = self.runs.iter_mut().find(|r| r.method == method) {
-                    run.failed = Some(error);
+                match self.runs.iter_mut().find(|r| r.method == method) {
+                    Some(run) => run.failed = Some(error),
+                    // It failed before it started (its networks would not build): it still
+                    // gets its row, SAP-Net's first, so that the failure is seen.
+                    None => {
+                        let mut run = RunView::new(method, 0);
+                        run.failed = Some(error);
+                        if run.method == SAPNET_LABEL {
+                            self.runs.insert(0, run);
+                        } else {
+                            self.runs.push(run);
+                        }
+                    }
                 }
             }
         }

@@ -155,9 +155,15 @@ fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Th
 fn policies_title(dashboard: &Dashboard, width: u16) -> String {
     let ended = dashboard.main_run().and_then(|r| r.ended.as_ref());
     match ended.and_then(|record| Some((record, record.chosen.as_ref()?))) {
-        Some((record, chosen)) if record.test_returns.is_empty() => {
-            format!("policies · chosen {} (stopped, not tested)", chosen.name)
-        }
+        Some((record, chosen)) if record.test_returns.is_empty() => format!(
+            "policies · chosen {} ({})",
+            chosen.name,
+            if record.stopped {
+                "stopped, not tested"
+            } else {
+                "not tested"
+            }
+        ),
         Some((record, chosen)) => {
             let tests: Vec<String> = record
                 .test_returns
@@ -398,13 +404,18 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
         Mode::Paused => ("PAUSED", "space resume · n step · t teach · ? keys"),
         Mode::Teach => ("TEACH", "a · s · r · u · c · t back · ? keys"),
     };
-    // A failed run is the one thing worth the whole line: training went no further.
-    let failure = dashboard
-        .runs
-        .iter()
-        .find_map(|r| Some((&r.method, r.failed.as_ref()?)));
     let run = dashboard.main_run();
     let finished = run.is_some_and(|r| r.ended.is_some());
+    // The followed run failing is the one thing worth the whole line: its training went no
+    // further. A baseline's failure is a note after the figures; the rest goes on.
+    let failure = run.and_then(|r| Some((&r.method, r.failed.as_ref()?)));
+    let other_failures: Vec<&str> = dashboard
+        .runs
+        .iter()
+        .skip(1)
+        .filter(|r| r.failed.is_some())
+        .map(|r| r.method.as_str())
+        .collect();
     let hints = if failure.is_some() {
         "q quit"
     } else if area.width < 100 {
@@ -436,16 +447,22 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
                 format!(" {method}: {error}")
             }),
         ]),
-        None => Line::from(vec![
-            Span::styled(
+        None => {
+            let mut spans = vec![Span::styled(
                 format!(" {} ", if finished { "DONE" } else { mode }),
                 theme.title().add_modifier(Modifier::REVERSED),
-            ),
-            Span::raw(format!(
+            )];
+            // First, where a narrow terminal cannot cut it off; the error itself is
+            // printed when the dashboard closes.
+            for method in other_failures {
+                spans.push(Span::styled(format!(" {method} FAILED ·"), theme.stopped()));
+            }
+            spans.push(Span::raw(format!(
                 " {} · {episode} · step {} · {speed} · ε {epsilon:.2} · {throttle}",
                 dashboard.task, dashboard.step
-            )),
-        ]),
+            )));
+            Line::from(spans)
+        }
     };
     let [left, right] = Layout::horizontal([
         Constraint::Min(0),
