@@ -407,7 +407,7 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
     let run = dashboard.main_run();
     let finished = run.is_some_and(|r| r.ended.is_some());
     // The followed run failing is the one thing worth the whole line: its training went no
-    // further. A baseline's failure is a note after the figures; the rest goes on.
+    // further. A baseline's failure is a note beside the figures; the rest goes on.
     let failure = run.and_then(|r| Some((&r.method, r.failed.as_ref()?)));
     let other_failures: Vec<&str> = dashboard
         .runs
