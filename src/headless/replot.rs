@@ -38,33 +38,23 @@ pub fn replot(dir: &Path) -> Result<()> {
 /// The plots' data, from the files of a results directory.
 pub fn read(dir: &Path) -> Result<PlotData> {
     let config = read_config(&dir.join("summary.json"))?;
-    // (method, run) → values in order of episode or test.
-    let mut returns: BTreeMap<(String, u32), Vec<(u32, f64)>> = BTreeMap::new();
-    for row in rows::<EpisodeRow>(&dir.join("episodes.csv"))? {
-        returns
-            .entry((row.method, row.run))
-            .or_default()
-            .push((row.episode, row.reward));
-    }
-    let mut tests: BTreeMap<(String, u32), Vec<(u32, f64)>> = BTreeMap::new();
-    for row in rows::<TestRow>(&dir.join("tests.csv"))? {
-        tests
-            .entry((row.method, row.run))
-            .or_default()
-            .push((row.test, row.test_return));
-    }
-    let in_order = |mut values: Vec<(u32, f64)>| {
-        // Runs side by side interleave their rows; each run's are in order of writing.
-        values.sort_by_key(|&(k, _)| k);
-        values.into_iter().map(|(_, v)| v).collect::<Vec<f64>>()
-    };
+    let returns = by_run(
+        rows::<EpisodeRow>(&dir.join("episodes.csv"))?
+            .into_iter()
+            .map(|r| (r.method, r.run, r.episode, r.reward)),
+    );
+    let tests = by_run(
+        rows::<TestRow>(&dir.join("tests.csv"))?
+            .into_iter()
+            .map(|r| (r.method, r.run, r.test, r.test_return)),
+    );
     let curves = super::method_labels(&config)
         .into_iter()
         .filter_map(|label| {
-            let of = |map: &BTreeMap<(String, u32), Vec<(u32, f64)>>| -> Vec<Vec<f64>> {
+            let of = |map: &ByRun| -> Vec<Vec<f64>> {
                 map.iter()
                     .filter(|((method, _), _)| *method == label)
-                    .map(|(_, values)| in_order(values.clone()))
+                    .map(|(_, values)| values.clone())
                     .collect()
             };
             let (runs, tested) = (of(&returns), of(&tests));
@@ -83,6 +73,25 @@ pub fn read(dir: &Path) -> Result<PlotData> {
         policy_names: activations.names,
         activations: activations.runs,
     })
+}
+
+/// (method, run) → that run's values in order.
+type ByRun = BTreeMap<(String, u32), Vec<f64>>;
+
+/// Groups `(method, run, index, value)` rows by run, each run's values in order of their
+/// index (episode or test): runs side by side interleave their rows.
+fn by_run(rows: impl IntoIterator<Item = (String, u32, u32, f64)>) -> ByRun {
+    let mut keyed: BTreeMap<(String, u32), Vec<(u32, f64)>> = BTreeMap::new();
+    for (method, run, index, value) in rows {
+        keyed.entry((method, run)).or_default().push((index, value));
+    }
+    keyed
+        .into_iter()
+        .map(|(key, mut values)| {
+            values.sort_by_key(|&(index, _)| index);
+            (key, values.into_iter().map(|(_, v)| v).collect())
+        })
+        .collect()
 }
 
 fn read_config(path: &Path) -> Result<Config> {

@@ -54,14 +54,8 @@ struct TestRow<'a> {
 
 impl TestsWriter {
     pub fn create(path: &Path) -> Result<Self> {
-        let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
-        // The header is written by hand so that it is there even if no run gets to its tests.
-        let mut csv = csv::WriterBuilder::new()
-            .has_headers(false)
-            .from_writer(file);
-        csv.write_record(["run", "method", "test", "return", "policy"])
-            .and_then(|()| csv.flush().map_err(Into::into))
-            .with_context(|| format!("writing {}", path.display()))?;
+        // The header is written at once so that it is there even if no run gets to its tests.
+        let csv = with_header(path, &["run", "method", "test", "return", "policy"])?;
         Ok(Self {
             csv,
             path: path.display().to_string(),
@@ -100,15 +94,11 @@ pub struct ActivationsWriter {
 
 impl ActivationsWriter {
     pub fn create(path: &Path, names: &[String]) -> Result<Self> {
-        let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
-        let mut csv = csv::Writer::from_writer(file);
         let mut header = vec!["run".to_string(), "episode".to_string()];
         for prefix in ["A", "P", "selected"] {
             header.extend(names.iter().map(|n| format!("{prefix}_{n}")));
         }
-        csv.write_record(&header)
-            .and_then(|()| csv.flush().map_err(Into::into))
-            .with_context(|| format!("writing {}", path.display()))?;
+        let csv = with_header(path, &header)?;
         Ok(Self {
             csv,
             path: path.display().to_string(),
@@ -151,12 +141,13 @@ pub struct TraceWriter {
 
 impl TraceWriter {
     pub fn create(path: &Path, names: &[String]) -> Result<Self> {
-        let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
-        let mut csv = csv::Writer::from_writer(file);
-        csv.write_record([
-            "run", "step", "policy", "call", "from", "to", "h", "omega", "eta", "delta", "stopped",
-        ])
-        .with_context(|| format!("writing {}", path.display()))?;
+        let csv = with_header(
+            path,
+            &[
+                "run", "step", "policy", "call", "from", "to", "h", "omega", "eta", "delta",
+                "stopped",
+            ],
+        )?;
         Ok(Self {
             csv,
             path: path.display().to_string(),
@@ -193,6 +184,18 @@ impl TraceWriter {
             .flush()
             .with_context(|| format!("writing {}", self.path))
     }
+}
+
+/// A new CSV file at `path` with its header already on disk; rows are written by hand.
+fn with_header(path: &Path, header: &[impl AsRef<[u8]>]) -> Result<csv::Writer<File>> {
+    let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    let mut csv = csv::WriterBuilder::new()
+        .has_headers(false)
+        .from_writer(file);
+    csv.write_record(header)
+        .and_then(|()| csv.flush().map_err(Into::into))
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(csv)
 }
 
 /// The shortest text that reads back as `x`, with an exponent where that is shorter (a
