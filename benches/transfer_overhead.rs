@@ -19,9 +19,10 @@ use rand::SeedableRng;
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
 use sapnet::config::Config;
+use sapnet::config::Method;
 use sapnet::dqn::{Architecture, QNet};
 use sapnet::sapnet::PolicyDescription;
-use sapnet::trainer::{self, DqnRunSpec, Event, SourcePolicy, StreamOptions, TransferRunSpec};
+use sapnet::trainer::{self, Event, MethodId, RunSpec, SourcePolicy, StreamOptions};
 use sapnet::tui::dashboard::Dashboard;
 use sapnet::tui::theme::Theme;
 use sapnet::tui::view;
@@ -126,27 +127,27 @@ fn watched(
 }
 
 /// The DQN and the transfer run (with `stream`) over the same `steps` learning steps.
-fn specs(stream: StreamOptions, steps: u64) -> (DqnRunSpec, TransferRunSpec) {
+fn specs(stream: StreamOptions, steps: u64) -> (RunSpec, RunSpec) {
     let config = Config::default();
     let warm_up = 10 * config.dqn.replay_start_size as u64;
-    let dqn = DqnRunSpec {
-        run: 0,
-        method: "dqn[100]".into(),
-        env: config.env.clone(),
-        dqn: sapnet::config::DqnConfig {
+    let mut dqn = RunSpec::scratch(
+        0,
+        "dqn[100]",
+        config.env.clone(),
+        sapnet::config::DqnConfig {
             replay_start_size: config.dqn.replay_start_size * 10,
             ..config.dqn.clone()
         },
-        hidden: vec![100],
-        episodes: u32::MAX,
-        max_steps: Some(steps + warm_up),
-        test_episodes: 0,
-        seed: 1,
-        stream: StreamOptions::episodes(),
-    };
-    let transfer = TransferRunSpec {
+        vec![100],
+        u32::MAX,
+        0,
+        1,
+    );
+    dqn.max_steps = Some(steps + warm_up);
+    let transfer = RunSpec {
         run: 0,
-        method: "sapnet".into(),
+        method: MethodId::new(0, &Method::SapNet),
+        reuse: Method::SapNet,
         env: config.env.clone(),
         dqn: config.dqn.clone(),
         sapnet: config.sapnet.clone(),
@@ -197,9 +198,7 @@ fn overhead(c: &mut Criterion) {
         group.bench_function(name, |b| {
             b.iter_custom(|n| {
                 (0..n)
-                    .map(|_| {
-                        drained(|e, c| drop(trainer::train_transfer(&spec, e, c).expect("run")))
-                    })
+                    .map(|_| drained(|e, c| drop(trainer::train(&spec, e, c).expect("run"))))
                     .sum()
             })
         });
@@ -208,13 +207,13 @@ fn overhead(c: &mut Criterion) {
     group.bench_function("sapnet 10x[100] live, dashboard drawn at 30 fps", |b| {
         b.iter_custom(|n| {
             (0..n)
-                .map(|_| watched(|e, c| drop(trainer::train_transfer(&live, e, c).expect("run"))))
+                .map(|_| watched(|e, c| drop(trainer::train(&live, e, c).expect("run"))))
                 .sum()
         })
     });
     // One source, warming up as long as the others: SAP-Net's bookkeeping without the
     // cost of keeping ten networks warm in the caches.
-    let single = TransferRunSpec {
+    let single = RunSpec {
         dqn: sapnet::config::DqnConfig {
             replay_start_size: config.dqn.replay_start_size * 10,
             ..config.dqn.clone()
@@ -225,7 +224,7 @@ fn overhead(c: &mut Criterion) {
     group.bench_function("sapnet 1x[100] results only", |b| {
         b.iter_custom(|n| {
             (0..n)
-                .map(|_| drained(|e, c| drop(trainer::train_transfer(&single, e, c).expect("run"))))
+                .map(|_| drained(|e, c| drop(trainer::train(&single, e, c).expect("run"))))
                 .sum()
         })
     });
@@ -262,7 +261,7 @@ fn main() {
         let (dqn, transfer) = specs(stream, STEPS);
         drained(|e, c| match case.as_str() {
             "dqn" => drop(trainer::train(&dqn, e, c).expect("run")),
-            _ => drop(trainer::train_transfer(&transfer, e, c).expect("run")),
+            _ => drop(trainer::train(&transfer, e, c).expect("run")),
         });
         return;
     }
@@ -274,11 +273,10 @@ fn main() {
 fn headless_against_dashboard(pairs: usize) {
     let headless = specs(StreamOptions::episodes(), AB_STEPS).1;
     let live = specs(StreamOptions::live(), AB_STEPS).1;
-    let run_headless = || {
-        drained(|e, c| drop(trainer::train_transfer(&headless, e, c).expect("run"))).as_secs_f64()
-    };
+    let run_headless =
+        || drained(|e, c| drop(trainer::train(&headless, e, c).expect("run"))).as_secs_f64();
     let run_watched =
-        || watched(|e, c| drop(trainer::train_transfer(&live, e, c).expect("run"))).as_secs_f64();
+        || watched(|e, c| drop(trainer::train(&live, e, c).expect("run"))).as_secs_f64();
     // One of each first, unmeasured: caches, allocator and page tables warm.
     run_headless();
     run_watched();

@@ -3,18 +3,19 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{mpsc, Arc};
+use std::sync::mpsc;
 use std::time::{SystemTime, UNIX_EPOCH};
 
 use anyhow::{Context, Result};
 
 use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, TeachArgs};
-use crate::config::{Config, Method};
+use crate::config::{Config, MethodKind};
+use crate::experiment;
 use crate::headless::{self, OutputOptions, RunOptions};
 use crate::teach::config::TeachConfig;
-use crate::trainer::{RunSpec, StreamOptions, TransferRunSpec};
+use crate::trainer::StreamOptions;
 use crate::tui::{self, teach::Teach};
-use crate::{assets, env, random_episodes, sources, trainer};
+use crate::{assets, env, random_episodes, trainer};
 
 pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
@@ -111,12 +112,12 @@ fn run_experiment(cli: &Cli) -> Result<()> {
         library: cli.run.library.clone(),
         trace: cli.run.trace,
     };
-    let summary = headless::run(&config, &output, &options, on_interrupt()?)?;
+    let summary = headless::run(&config, &output, &options, &on_interrupt()?)?;
     let dir = output.dir.display();
     if summary.stopped() {
         eprintln!("stopped by the user: what was done so far is in {dir} (episodes.csv, tests.csv, summary.json, plots)");
     } else {
-        eprintln!("results in {dir}: episodes.csv, tests.csv, summary.json, policies/, learning_curve.png, tests.png");
+        eprintln!("results in {dir}: episodes.csv, tests.csv, activations.csv, comparison.csv, summary.json, policies/, learning_curve.png, learning_curve.svg, tests.png, activations.png, selections.png");
     }
     for run in &summary.runs {
         let tests: Vec<String> = run
@@ -137,38 +138,41 @@ fn run_experiment(cli: &Cli) -> Result<()> {
         );
         if let Some(chosen) = &run.record.chosen {
             eprintln!(
-                "  chosen policy {} {:?} (activation {:.2})",
-                chosen.name, chosen.hidden, chosen.activation
+                "  chosen policy {} {:?} ({} {:.2})",
+                chosen.name, chosen.hidden, chosen.score_name, chosen.score
             );
         }
         if let Some(copy) = &run.library_copy {
             eprintln!("  added to the policy library as {}", copy.display());
         }
     }
+    if !summary.comparison.is_empty() {
+        let mut out = std::io::stdout().lock();
+        write!(out, "{}", headless::comparison::table(&summary.comparison))
+            .and_then(|()| out.flush())
+            .context("writing to stdout")?;
+    }
     Ok(())
 }
 
-/// The dashboard follows the first run of SAP-Net, step by step, beside the first run of
-/// the first baseline, episode by episode; the library is loaded (or trained, with a
-/// progress bar) before the screen switches.
+/// The dashboard follows the first run of the first SAP-Net method, step by step, beside
+/// the first run of the first DQN baseline, episode by episode; the library is loaded (or
+/// trained, with a progress bar) before the screen switches.
 fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
-    let sources = if config.protocol.methods.contains(&Method::SapNet) {
-        let (sources, _) = sources::ensure_library(config, &cli.run.library, on_interrupt()?)?;
-        Some(Arc::new(sources))
-    } else {
-        None
-    };
-    let specs = headless::run_specs(config, sources.as_ref())?;
-    let transfer = specs.iter().find_map(|s| match s {
-        RunSpec::Transfer(t) if t.run == 0 => Some(RunSpec::Transfer(TransferRunSpec {
-            stream: StreamOptions::live(),
-            ..t.clone()
-        })),
-        _ => None,
-    });
-    let baseline = specs
+    let plan = experiment::plan(config, &cli.run.library, &on_interrupt()?)?;
+    let transfer = plan
+        .specs
         .iter()
-        .find(|s| matches!(s, RunSpec::Dqn(d) if d.run == 0))
+        .find(|s| s.run == 0 && s.method.kind == MethodKind::SapNet)
+        .map(|s| {
+            let mut spec = s.clone();
+            spec.stream = StreamOptions::live();
+            spec
+        });
+    let baseline = plan
+        .specs
+        .iter()
+        .find(|s| s.run == 0 && s.method.kind == MethodKind::Dqn)
         .cloned();
     let (events_tx, events) = mpsc::channel();
     let mut runs = Vec::new();
@@ -191,7 +195,7 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
 fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
     let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
     let dir =
-        crate::sources::train_library(&config, &cli.run.library, args.retrain, on_interrupt()?)?;
+        crate::sources::train_library(&config, &cli.run.library, args.retrain, &on_interrupt()?)?;
     eprintln!(
         "{} source policies in {}",
         config.sources.count,

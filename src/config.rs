@@ -11,6 +11,8 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::env::{CartPoleParams, EnvConfig};
+use crate::reuse::prql::PrqlKnobs;
+use crate::reuse::sapnet::SapNetKnobs;
 use crate::sapnet::SapNetParams;
 
 /// Everything one run needs.
@@ -149,14 +151,90 @@ impl Default for SourcesConfig {
     }
 }
 
-/// A learner an experiment compares.
+/// A learner an experiment compares (`protocol.methods`). Each reusing method's selector is
+/// a file of [`crate::reuse`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum Method {
-    /// Transfer learning with SAP-Net over the source library (Algorithm 3).
+    /// Transfer learning with SAP-Net over the source library (Algorithm 3), as the paper
+    /// specifies it.
     SapNet,
+    /// SAP-Net with knobs beyond the paper: a temperature schedule, another judgment,
+    /// activation decay (`SapNetWith(judgment: Episode)`; every knob left out is the paper's).
+    SapNetWith(SapNetKnobs),
+    /// A uniformly random source acts (and fine-tunes) at every step.
+    Random,
+    /// A uniformly random source acts (and fine-tunes) for a whole episode.
+    RandomPerEpisode,
+    /// UCB1 over the sources, one pull per episode, on the return scaled to [0, 1].
+    Ucb1,
+    /// PRQ-learning: a new learner, guided by sources through π-reuse
+    /// (`Prql()` for the paper's defaults).
+    Prql(PrqlKnobs),
+    /// Fine-tune the library's best source by its recorded score: the selection oracle.
+    BestSource,
     /// DQN from scratch with these hidden layers (the paper's baselines: `[100]`,
     /// `[100, 100]`, `[100, 100, 100]`).
     Dqn { hidden: Vec<usize> },
+}
+
+/// What kind of learner a method is, without its knobs: what front ends and results branch
+/// on, where they must.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub enum MethodKind {
+    SapNet,
+    Random,
+    RandomPerEpisode,
+    Ucb1,
+    Prql,
+    BestSource,
+    Dqn,
+}
+
+impl MethodKind {
+    /// Whether the method draws on the source library.
+    pub fn reuses(self) -> bool {
+        self != Self::Dqn
+    }
+}
+
+impl Method {
+    pub fn kind(&self) -> MethodKind {
+        match self {
+            Self::SapNet | Self::SapNetWith(_) => MethodKind::SapNet,
+            Self::Random => MethodKind::Random,
+            Self::RandomPerEpisode => MethodKind::RandomPerEpisode,
+            Self::Ucb1 => MethodKind::Ucb1,
+            Self::Prql(_) => MethodKind::Prql,
+            Self::BestSource => MethodKind::BestSource,
+            Self::Dqn { .. } => MethodKind::Dqn,
+        }
+    }
+
+    /// The method's name in results: `sapnet`, `ucb1`, `dqn[100,100]`…
+    pub fn label(&self) -> String {
+        match self {
+            Self::SapNet => "sapnet".into(),
+            Self::SapNetWith(knobs) => knobs.label(),
+            Self::Random => "random".into(),
+            Self::RandomPerEpisode => "random-episode".into(),
+            Self::Ucb1 => "ucb1".into(),
+            Self::Prql(knobs) => knobs.label(),
+            Self::BestSource => "best-source".into(),
+            Self::Dqn { hidden } => {
+                let layers: Vec<String> = hidden.iter().map(ToString::to_string).collect();
+                format!("dqn[{}]", layers.join(","))
+            }
+        }
+    }
+
+    /// The hidden layers of the method's own learner, if it has one.
+    pub fn learner_hidden(&self) -> Option<&[usize]> {
+        match self {
+            Self::Dqn { hidden } => Some(hidden),
+            Self::Prql(knobs) => Some(&knobs.hidden),
+            _ => None,
+        }
+    }
 }
 
 /// What an experiment runs and how often (paper III-B).
@@ -174,7 +252,20 @@ pub struct ProtocolConfig {
     pub test_episodes: u32,
     /// Window of the moving average of episode returns in plots (paper: 10).
     pub moving_average: usize,
+    /// Moving averages whose first episode `comparison.csv` reports per method; `None`:
+    /// the task's own (CartPole 195 and 475, MountainCar −150 and −110, Acrobot −150 and
+    /// −100).
+    pub thresholds: Option<Vec<f64>>,
     pub methods: Vec<Method>,
+}
+
+impl ProtocolConfig {
+    /// The thresholds of the comparison on `env`.
+    pub fn thresholds(&self, env: &EnvConfig) -> Vec<f64> {
+        self.thresholds
+            .clone()
+            .unwrap_or_else(|| env.return_thresholds().to_vec())
+    }
 }
 
 impl Default for ProtocolConfig {
@@ -185,6 +276,7 @@ impl Default for ProtocolConfig {
             runs: 5,
             test_episodes: 5,
             moving_average: 10,
+            thresholds: None,
             methods: vec![
                 Method::SapNet,
                 Method::Dqn { hidden: vec![100] },
@@ -346,14 +438,29 @@ impl Config {
             "[]",
         )?;
         for (i, method) in p.methods.iter().enumerate() {
-            if let Method::Dqn { hidden } = method {
-                check(
+            let field = format!("protocol.methods[{i}]");
+            match method {
+                Method::Dqn { hidden } => check(
                     !hidden.is_empty() && hidden.iter().all(|&u| u > 0),
-                    &format!("protocol.methods[{i}].hidden"),
+                    &format!("{field}.hidden"),
                     "a non-empty list of layer sizes > 0",
                     format!("{hidden:?}"),
-                )?;
+                )?,
+                Method::SapNetWith(knobs) => knobs.validate(&field)?,
+                Method::Prql(knobs) => knobs.validate(&field)?,
+                _ => {}
             }
+        }
+        let labels: Vec<String> = p.methods.iter().map(Method::label).collect();
+        if let Some((i, twice)) = labels
+            .iter()
+            .enumerate()
+            .find(|(i, l)| labels[..*i].contains(l))
+        {
+            return Err(format!(
+                "field `protocol.methods[{i}]`: lists {twice} a second time; each method runs \
+                 once per run (give a SapNetWith its own `label`)"
+            ));
         }
         Ok(())
     }
@@ -495,5 +602,69 @@ mod tests {
             EnvConfig::MountainCar(p) => assert_eq!(p.max_episode_steps, 300),
             other => panic!("wrong env {other:?}"),
         }
+    }
+
+    #[test]
+    fn a_method_listed_twice_is_refused_with_its_place() {
+        let err = Config::from_ron(
+            "(protocol: (methods: [Dqn(hidden: [8]), Ucb1, Dqn(hidden: [8])]))",
+            "test",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("field `protocol.methods[2]`: lists dqn[8] a second time"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn every_method_reads_from_ron_and_bad_knobs_are_located() {
+        let c = Config::from_ron(
+            "(protocol: (methods: [SapNet, SapNetWith(judgment: Episode, decay: 0.999), \
+             SapNetWith(judgment: KSteps(10), temperature: Some(Linear(from: 4.0, to: 0.5, \
+             steps: 1000))), Random, RandomPerEpisode, Ucb1, Prql(), BestSource, \
+             Dqn(hidden: [100])]))",
+            "test",
+        )
+        .unwrap();
+        let labels: Vec<String> = c.protocol.methods.iter().map(Method::label).collect();
+        assert_eq!(
+            labels,
+            [
+                "sapnet",
+                "sapnet-episode-decay0.999",
+                "sapnet-tau-lin4-0.5-k10",
+                "random",
+                "random-episode",
+                "ucb1",
+                "prql",
+                "best-source",
+                "dqn[100]"
+            ]
+        );
+        for (text, field) in [
+            ("SapNetWith(decay: 0.0)", "protocol.methods[0].decay"),
+            (
+                "SapNetWith(judgment: KSteps(0))",
+                "protocol.methods[0].judgment",
+            ),
+            (
+                "SapNetWith(temperature: Some(Exponential(from: 0.0, to: 1.0, steps: 5)))",
+                "protocol.methods[0].temperature.from",
+            ),
+            ("Prql(psi: 2.0)", "protocol.methods[0].psi"),
+            ("Prql(upsilon: 0.0)", "protocol.methods[0].upsilon"),
+        ] {
+            let err = Config::from_ron(&format!("(protocol: (methods: [{text}]))"), "x.ron")
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(&format!("field `{field}`")), "{text}: {err}");
+        }
+        // τ ≤ 0 for the paper's SAP-Net is refused in its own section.
+        let err = Config::from_ron("(sapnet: (temperature: 0.0))", "x.ron")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("temperature"), "{err}");
     }
 }

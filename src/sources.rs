@@ -11,13 +11,11 @@ use rand::{Rng, SeedableRng};
 
 use crate::config::Config;
 use crate::env::EnvConfig;
-use crate::headless::drive;
+use crate::experiment::{schedule, Observer};
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::sapnet::PolicyDescription;
 use crate::seeds;
-use crate::trainer::{
-    Command, DqnRunSpec, Event, RunOutcome, SourcePolicy, StreamOptions, TrainerError,
-};
+use crate::trainer::{Command, Event, RunOutcome, RunSpec, SourcePolicy, TrainerError};
 
 /// Stream key of the source library's seeds, apart from the experiments' `[method, run]`.
 const SOURCES_STREAM: u64 = u64::MAX;
@@ -61,24 +59,14 @@ pub fn plan(config: &Config) -> Vec<SourcePlan> {
 }
 
 /// Trains every planned source, then writes them all. Nothing is written if one fails or
-/// the user stops, and a library already on disk is replaced only when `retrain` is set.
+/// the user stops (a [`Command::Stop`] on `stop`), and a library already on disk is
+/// replaced only when `retrain` is set.
 pub fn train_library(
     config: &Config,
     library: &Path,
     retrain: bool,
-    commands: Receiver<Command>,
+    stop: &Receiver<Command>,
 ) -> Result<PathBuf> {
-    train_library_with(config, library, retrain, commands)?;
-    Ok(library_dir(library, config))
-}
-
-/// [`train_library`], giving the command channel back for what follows.
-fn train_library_with(
-    config: &Config,
-    library: &Path,
-    retrain: bool,
-    commands: Receiver<Command>,
-) -> Result<Receiver<Command>> {
     let dir = library_dir(library, config);
     let existing = policy_store::list(&dir)?;
     if !existing.is_empty() && !retrain {
@@ -93,34 +81,28 @@ fn train_library_with(
         u64::from(config.sources.training_episodes) * plans.len() as u64,
     );
     let source_dqn = config.sources.dqn.as_ref().unwrap_or(&config.dqn);
-    let mut commands = commands;
     let mut trained = Vec::with_capacity(plans.len());
     for (i, source) in plans.iter().enumerate() {
-        let spec = DqnRunSpec {
-            run: i as u32,
-            method: source.name.clone(),
-            env: source_task(config).clone(),
-            dqn: source_dqn.clone(),
-            hidden: source.hidden.clone(),
-            episodes: config.sources.training_episodes,
-            max_steps: None,
-            test_episodes: config.protocol.test_episodes,
-            seed: source.seed,
-            stream: StreamOptions::episodes(),
+        let spec = RunSpec::scratch(
+            i as u32,
+            &source.name,
+            source_task(config).clone(),
+            source_dqn.clone(),
+            source.hidden.clone(),
+            config.sources.training_episodes,
+            config.protocol.test_episodes,
+            source.seed,
+        );
+        let mut training = SourceTraining {
+            progress: &mut progress,
+            outcome: None,
         };
-        let (outcome, returned) = drive(&spec, commands, |event| {
-            match event {
-                Event::RunStarted { method, .. } => progress.run_started(&method, 0),
-                Event::EpisodeEnded(record) => progress.episode(&record),
-                _ => {}
-            }
-            Ok(())
-        })?;
-        commands = returned;
-        let outcome: RunOutcome = outcome.map_err(|err: TrainerError| {
-            anyhow::Error::new(err).context(format!("training {}", source.name))
-        })?;
-        if outcome.record.stopped {
+        let stopped = schedule(vec![spec], 1, stop, &mut training)
+            .with_context(|| format!("training {}", source.name))?;
+        let outcome = training
+            .outcome
+            .expect("a run that neither failed nor was stopped has an outcome");
+        if stopped || outcome.record.stopped {
             progress.finish(false);
             bail!(
                 "stopped by the user: nothing in {} was changed",
@@ -163,7 +145,33 @@ fn train_library_with(
             }
         }
     }
-    Ok(commands)
+    Ok(dir)
+}
+
+/// Progress of one source's training, and its outcome.
+struct SourceTraining<'a> {
+    progress: &'a mut crate::headless::Progress,
+    outcome: Option<RunOutcome>,
+}
+
+impl Observer for SourceTraining<'_> {
+    fn on_event(&mut self, event: Event) -> Result<()> {
+        match event {
+            Event::RunStarted { method, .. } => self.progress.run_started(method.label(), 0),
+            Event::EpisodeEnded(record) => self.progress.episode(&record),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn on_finished(&mut self, _order: usize, _spec: &RunSpec, outcome: RunOutcome) -> Result<()> {
+        self.outcome = Some(outcome);
+        Ok(())
+    }
+
+    fn on_failed(&mut self, _spec: &RunSpec, err: TrainerError) -> anyhow::Error {
+        anyhow::Error::new(err)
+    }
 }
 
 /// Reads the source library of `config` from `<library>/<source task>/` for reuse on the
@@ -210,12 +218,12 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
 }
 
 /// The library of `config`, trained first if `<library>/<task>/` holds none (with progress
-/// on stderr), then loaded.
+/// on stderr; `stop` ends it), then loaded.
 pub fn ensure_library(
     config: &Config,
     library: &Path,
-    commands: Receiver<Command>,
-) -> Result<(Vec<SourcePolicy>, Receiver<Command>)> {
+    stop: &Receiver<Command>,
+) -> Result<Vec<SourcePolicy>> {
     let dir = library_dir(library, config);
     if policy_store::list(&dir)?.is_empty() {
         eprintln!(
@@ -224,10 +232,9 @@ pub fn ensure_library(
             config.sources.count,
             config.sources.training_episodes
         );
-        let commands = train_library_with(config, library, false, commands)?;
-        return Ok((load_library(config, library)?, commands));
+        train_library(config, library, false, stop)?;
     }
-    Ok((load_library(config, library)?, commands))
+    load_library(config, library)
 }
 
 /// `source-10` → ("source-", 10): names with the same prefix sort by number.

@@ -5,7 +5,7 @@ use std::path::Path;
 use std::sync::mpsc;
 
 use sapnet::config::{Config, Method};
-use sapnet::trainer::{self, DqnRunSpec, Event, StreamOptions};
+use sapnet::trainer::{self, Event, RunSpec};
 
 #[test]
 fn a_100_unit_dqn_learns_cartpole() {
@@ -14,18 +14,16 @@ fn a_100_unit_dqn_learns_cartpole() {
     let Method::Dqn { hidden } = &config.protocol.methods[0] else {
         panic!("the learning config runs a DQN");
     };
-    let spec = DqnRunSpec {
-        run: 0,
-        method: trainer::dqn_label(hidden),
-        env: config.env.clone(),
-        dqn: config.dqn.clone(),
-        hidden: hidden.clone(),
-        episodes: config.protocol.episodes,
-        max_steps: None,
-        test_episodes: config.protocol.test_episodes,
-        seed: config.seed,
-        stream: StreamOptions::episodes(),
-    };
+    let spec = RunSpec::scratch(
+        0,
+        "dqn[100]",
+        config.env.clone(),
+        config.dqn.clone(),
+        hidden.clone(),
+        config.protocol.episodes,
+        config.protocol.test_episodes,
+        config.seed,
+    );
     let (events, received) = mpsc::channel();
     let (_commands, commands) = mpsc::channel();
     let outcome = trainer::train(&spec, &events, &commands).unwrap();

@@ -38,8 +38,13 @@ fn digest(path: &Path, key: &[&str], numbers: &dyn Fn(&str) -> bool) -> String {
         .map(|k| col(k).unwrap_or_else(|| panic!("{path:?} has no column {k}")))
         .collect();
     let number_cols: Vec<usize> = (0..header.len()).filter(|&i| numbers(&header[i])).collect();
+    // activations.csv lists every reusing method; the pinned numbers are SAP-Net's.
+    let method = col("method").filter(|_| !key.contains(&"method"));
     let mut lines = BTreeMap::new();
     for row in rows {
+        if method.is_some_and(|m| row[m] != "sapnet") {
+            continue;
+        }
         let k: Vec<String> = key_cols.iter().map(|&i| row[i].clone()).collect();
         let v: Vec<String> = number_cols.iter().map(|&i| row[i].clone()).collect();
         if v.iter().all(String::is_empty) {

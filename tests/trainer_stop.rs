@@ -6,21 +6,19 @@ use std::thread;
 
 use sapnet::config::DqnConfig;
 use sapnet::env::{CartPoleParams, EnvConfig};
-use sapnet::trainer::{self, Command, DqnRunSpec, Event, StreamOptions};
+use sapnet::trainer::{self, Command, Event, RunSpec};
 
-fn spec() -> DqnRunSpec {
-    DqnRunSpec {
-        run: 0,
-        method: trainer::dqn_label(&[8]),
-        env: EnvConfig::CartPole(CartPoleParams::default()),
-        dqn: DqnConfig::default(),
-        hidden: vec![8],
-        episodes: 1_000_000,
-        max_steps: None,
-        test_episodes: 5,
-        seed: 3,
-        stream: StreamOptions::episodes(),
-    }
+fn spec() -> RunSpec {
+    RunSpec::scratch(
+        0,
+        "dqn[8]",
+        EnvConfig::CartPole(CartPoleParams::default()),
+        DqnConfig::default(),
+        vec![8],
+        1_000_000,
+        5,
+        3,
+    )
 }
 
 #[test]

@@ -95,7 +95,9 @@ fn a_missing_library_is_trained_then_every_result_is_written() {
         .all(|l| l.ends_with(|c: char| c.is_ascii_digit()) && l.contains("source-")));
 
     let activations = std::fs::read_to_string(out.join("activations.csv")).unwrap();
-    assert!(activations.starts_with("run,episode,A_source-0,A_source-1,A_source-2,P_source-0"));
+    assert!(
+        activations.starts_with("run,method,episode,A_source-0,A_source-1,A_source-2,P_source-0")
+    );
     assert_eq!(activations.lines().count(), 1 + 2 * 12);
 
     let summary: serde_json::Value =
@@ -237,7 +239,8 @@ fn trace_csv_holds_every_spread_call_and_adds_up_to_the_activations() {
     assert_eq!(
         trace.headers().unwrap(),
         vec![
-            "run", "step", "policy", "call", "from", "to", "h", "omega", "eta", "delta", "stopped"
+            "run", "method", "step", "policy", "call", "from", "to", "h", "omega", "eta", "delta",
+            "stopped"
         ]
     );
     // Deposits per (run, policy), and activations per (run, policy): a call numbered 1 opens
@@ -248,8 +251,9 @@ fn trace_csv_holds_every_spread_call_and_adds_up_to_the_activations() {
         let row = row.unwrap();
         rows += 1;
         let num = |i: usize| row[i].parse::<f64>().unwrap();
-        let (h, omega, eta, delta) = (num(6), num(7), num(8), num(9));
-        let stopped = &row[10] == "true";
+        assert_eq!(&row[1], "sapnet");
+        let (h, omega, eta, delta) = (num(7), num(8), num(9), num(10));
+        let stopped = &row[11] == "true";
         // Eq. 10 with Table II's T_ω = 1: stopped exactly when Ω ≥ T_ω, else η/(h·Ω).
         assert_eq!(stopped, omega >= 1.0, "{row:?}");
         if stopped {
@@ -258,10 +262,10 @@ fn trace_csv_holds_every_spread_call_and_adds_up_to_the_activations() {
             assert!((delta - eta / (h * omega)).abs() < 1e-12, "{row:?}");
         }
         if h == 1.0 {
-            assert_eq!(row[4], row[2], "a first hop leaves the activated policy");
+            assert_eq!(row[5], row[3], "a first hop leaves the activated policy");
         }
         *deposits
-            .entry((row[0].to_string(), row[5].to_string()))
+            .entry((row[0].to_string(), row[6].to_string()))
             .or_default() += delta;
     }
     assert!(rows > 0, "the tiny run spreads at least once");

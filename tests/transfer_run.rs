@@ -6,12 +6,10 @@ use std::sync::Arc;
 
 use rand::rngs::StdRng;
 use rand::SeedableRng;
-use sapnet::config::Config;
+use sapnet::config::{Config, Method};
 use sapnet::dqn::{Architecture, QNet};
 use sapnet::sapnet::PolicyDescription;
-use sapnet::trainer::{
-    self, Command, Event, RunSpec, SourcePolicy, StreamOptions, TransferRunSpec,
-};
+use sapnet::trainer::{self, Command, Event, MethodId, RunSpec, SourcePolicy, StreamOptions};
 
 /// Four random CartPole policies: two with one hidden layer, two with two (two categories
 /// under the paper's prototype).
@@ -34,7 +32,7 @@ fn sources() -> Arc<Vec<SourcePolicy>> {
     Arc::new(sources)
 }
 
-fn spec(episodes: u32, stream: StreamOptions) -> TransferRunSpec {
+fn spec(episodes: u32, stream: StreamOptions) -> RunSpec {
     let config = Config::default();
     let mut dqn = config.dqn.clone();
     dqn.replay_start_size = 10;
@@ -42,9 +40,10 @@ fn spec(episodes: u32, stream: StreamOptions) -> TransferRunSpec {
     // E tracks the loss closely, so that T_a ≤ 0 happens within a few episodes (from E = 0
     // at the paper's 0.99 the first hundreds of updates only raise it).
     dqn.loss_decay = 0.5;
-    TransferRunSpec {
+    RunSpec {
         run: 0,
-        method: "sapnet".into(),
+        method: MethodId::new(0, &Method::SapNet),
+        reuse: Method::SapNet,
         env: config.env.clone(),
         dqn,
         sapnet: config.sapnet.clone(),
@@ -57,10 +56,10 @@ fn spec(episodes: u32, stream: StreamOptions) -> TransferRunSpec {
     }
 }
 
-fn collect(spec: &TransferRunSpec) -> (Vec<Event>, trainer::RunOutcome) {
+fn collect(spec: &RunSpec) -> (Vec<Event>, trainer::RunOutcome) {
     let (events, received) = mpsc::channel();
     let (_commands, commands_rx) = mpsc::channel();
-    let outcome = trainer::train_transfer(spec, &events, &commands_rx).unwrap();
+    let outcome = trainer::train(spec, &events, &commands_rx).unwrap();
     drop(events);
     (received.into_iter().collect(), outcome)
 }
@@ -98,21 +97,22 @@ fn the_warm_up_acts_in_turn_then_sap_net_selects_learns_and_activates() {
     // N × replay_start_size = 40 warm-up steps, 10 per policy in index order, no learning.
     for (t, step) in steps.iter().take(40).enumerate() {
         assert!(step.warm_up, "step {t}");
-        assert_eq!(step.policy, t / 10, "step {t}");
+        assert_eq!(step.policy, Some(t / 10), "step {t}");
         assert_eq!(step.loss, None);
     }
     assert!(steps.len() > 40, "20 CartPole episodes outlast the warm-up");
     for step in &steps[40..] {
         assert!(!step.warm_up);
-        // One update per step (update_interval 1), judged by its T_a.
+        // One update per step (update_interval 1), judged by its T_a (eq. 7).
         assert!(step.loss.is_some() && step.transition.is_some());
+        assert_eq!(step.judgment, Some(step.transition.unwrap() <= 0.0));
     }
     assert_eq!(steps.last().unwrap().step, outcome.record.steps);
 
     // Every positive transition was traced, and its first call starts at the policy.
     let positives = steps[40..]
         .iter()
-        .filter(|s| s.transition.unwrap() <= 0.0)
+        .filter(|s| s.judgment == Some(true))
         .count();
     let traces: Vec<_> = events
         .iter()
@@ -177,7 +177,8 @@ fn the_warm_up_acts_in_turn_then_sap_net_selects_learns_and_activates() {
         .iter()
         .copied()
         .fold(f64::MIN, f64::max);
-    assert_eq!(chosen.activation, highest);
+    assert_eq!(chosen.score, highest);
+    assert_eq!(chosen.score_name, "A");
     assert_eq!(
         final_snapshot.activations[chosen.index], highest,
         "{final_snapshot:?}"
@@ -214,8 +215,7 @@ fn the_same_seed_gives_the_same_run() {
 #[test]
 fn a_paused_run_takes_exactly_the_steps_it_is_given_then_stops() {
     let (events, received) = mpsc::channel();
-    let handle =
-        trainer::spawn(RunSpec::Transfer(spec(1000, StreamOptions::live())), events).unwrap();
+    let handle = trainer::spawn(spec(1000, StreamOptions::live()), events).unwrap();
     handle.commands.send(Command::Pause).unwrap();
     // Wait until the pause has taken hold: no new step arrives for a while.
     let mut seen = 0;

@@ -66,7 +66,7 @@ fn a_failed_sapnet_run_takes_the_status_bar() {
     let mut d = dashboard();
     d.on_event(sapnet::trainer::Event::RunFailed {
         run: 0,
-        method: "sapnet".into(),
+        method: tui_script::method("sapnet"),
         error: "policy sapnet (source-3) (run 0) diverged: the loss is NaN at step 5120".into(),
     });
     assert!(d.runs[0].failed.is_some());
@@ -79,7 +79,7 @@ fn a_failed_baseline_is_a_note_while_sapnet_goes_on() {
     let mut d = dashboard();
     d.on_event(sapnet::trainer::Event::RunFailed {
         run: 0,
-        method: "dqn[100]".into(),
+        method: tui_script::method("dqn[100]"),
         error: "policy dqn[100] (run 0) diverged: the loss is NaN at step 5120".into(),
     });
     let terminal = draw_dashboard(&d, (80, 24));
@@ -93,10 +93,10 @@ fn a_run_that_fails_before_it_starts_still_shows() {
     d.on_event(tui_script::baseline_start());
     d.on_event(sapnet::trainer::Event::RunFailed {
         run: 0,
-        method: "sapnet".into(),
+        method: tui_script::method("sapnet"),
         error: "building SAP-Net over the source policies: no policies".into(),
     });
-    assert_eq!(d.main_run().unwrap().method, "sapnet");
+    assert_eq!(d.main_run().unwrap().method.label(), "sapnet");
     let line = status_line(&draw_dashboard(&d, (80, 24)));
     assert!(line.contains("FAILED  sapnet: building SAP-Net"), "{line}");
 }

@@ -27,7 +27,7 @@ fn scripted(episodes: u32) -> Dashboard {
 #[test]
 fn events_fill_the_table_the_curves_and_the_status() {
     let d = scripted(30);
-    let methods: Vec<&str> = d.runs.iter().map(|r| r.method.as_str()).collect();
+    let methods: Vec<&str> = d.runs.iter().map(|r| r.method.label()).collect();
     assert_eq!(methods, ["sapnet", "dqn[100]"]);
     let view = d.sapnet.as_ref().unwrap();
     assert_eq!(view.acting, Some(6));

@@ -23,6 +23,26 @@ impl EnvConfig {
         }
     }
 
+    /// The lowest and highest return an episode can have: each step gives +1 (CartPole) or
+    /// −1 (MountainCar and Acrobot, until the goal), for at most the time limit.
+    pub fn return_range(&self) -> (f64, f64) {
+        let steps = f64::from(self.max_episode_steps());
+        match self {
+            EnvConfig::CartPole(_) => (0.0, steps),
+            EnvConfig::MountainCar(_) | EnvConfig::Acrobot(_) => (-steps, 0.0),
+        }
+    }
+
+    /// Moving averages of returns a comparison reports reaching: Gymnasium's "solved"
+    /// levels (CartPole-v1 475, v0 195; MountainCar −110; Acrobot −100) and an easier one.
+    pub fn return_thresholds(&self) -> [f64; 2] {
+        match self {
+            EnvConfig::CartPole(_) => [195.0, 475.0],
+            EnvConfig::MountainCar(_) => [-150.0, -110.0],
+            EnvConfig::Acrobot(_) => [-150.0, -100.0],
+        }
+    }
+
     pub fn max_episode_steps(&self) -> u32 {
         match self {
             EnvConfig::CartPole(p) => p.max_episode_steps,

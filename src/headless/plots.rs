@@ -1,5 +1,7 @@
-//! The paper's figures, drawn with plotters: learning curves (Fig. 5 and 7), greedy test
-//! returns (Fig. 6 and 8), and the activation of every source policy over the episodes.
+//! The paper's figures, drawn with plotters: learning curves (Fig. 5 and 7) with a band of
+//! ± one standard deviation over runs, greedy test returns (Fig. 6 and 8), the activation
+//! of every source policy over the episodes, and, per method that reuses the library, the
+//! share of the steps each source acted (`selections.png`).
 
 use std::path::Path;
 use std::sync::Once;
@@ -20,6 +22,8 @@ const SIZE: (u32, u32) = (1000, 600);
 #[derive(Debug, Clone)]
 pub struct Curve {
     pub label: String,
+    /// SAP-Net's curves get the paper's red.
+    pub sapnet: bool,
     /// Training returns of each run.
     pub returns: Vec<Vec<f64>>,
     /// Greedy test returns of each tested run.
@@ -34,8 +38,21 @@ pub struct PlotData {
     /// In the protocol's order; SAP-Net first if it ran.
     pub curves: Vec<Curve>,
     pub policy_names: Vec<String>,
-    /// SAP-Net: activations at the end of each episode (run → episode → policy).
+    /// SAP-Net (the first SAP-Net method listed): activations at the end of each episode
+    /// (run → episode → policy).
     pub activations: Vec<Vec<Vec<f64>>>,
+    /// Per method that reuses the library: the steps each source acted in each episode
+    /// (run → episode → policy).
+    pub acted: Vec<(String, Vec<Vec<Vec<u64>>>)>,
+}
+
+/// What a reusing run's selector did, episode by episode.
+#[derive(Debug, Clone, Default)]
+pub struct SelectionHistory {
+    /// Its scores at the end of each episode (SAP-Net: the activations).
+    pub scores: Vec<Vec<f64>>,
+    /// Steps each source acted in each episode.
+    pub acted: Vec<Vec<u64>>,
 }
 
 /// Writes `learning_curve.png`, `learning_curve.svg`, `tests.png` and, with SAP-Net
@@ -55,6 +72,15 @@ pub fn write_all(dir: &Path, data: &PlotData) -> Result<()> {
         let path = dir.join("activations.png");
         activation_lines(BitMapBackend::new(&path, SIZE).into_drawing_area(), data)
             .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    }
+    if !data.acted.is_empty() {
+        let path = dir.join("selections.png");
+        let height = 220 * data.acted.len() as u32 + 60;
+        selection_shares(
+            BitMapBackend::new(&path, (SIZE.0, height)).into_drawing_area(),
+            data,
+        )
+        .map_err(|e| anyhow!("{}: {e}", path.display()))?;
     }
     Ok(())
 }
@@ -80,7 +106,7 @@ fn method_colour(curves: &[Curve], i: usize) -> RGBColor {
         RGBColor(140, 86, 75),
         RGBColor(127, 127, 127),
     ];
-    let is_sapnet = |c: &Curve| c.label == crate::trainer::SAPNET_LABEL;
+    let is_sapnet = |c: &Curve| c.sapnet;
     if is_sapnet(&curves[i]) {
         RGBColor(214, 39, 40)
     } else {
@@ -97,6 +123,24 @@ pub fn mean_over_runs(series: &[Vec<f64>]) -> Vec<f64> {
         .map(|i| {
             let values: Vec<f64> = series.iter().filter_map(|s| s.get(i).copied()).collect();
             values.iter().sum::<f64>() / values.len() as f64
+        })
+        .collect()
+}
+
+/// Element-wise standard deviation over the runs that reach each index (0 where only one
+/// does).
+pub fn std_over_runs(series: &[Vec<f64>]) -> Vec<f64> {
+    let means = mean_over_runs(series);
+    means
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let values: Vec<f64> = series.iter().filter_map(|s| s.get(i).copied()).collect();
+            if values.len() < 2 {
+                return 0.0;
+            }
+            let ss: f64 = values.iter().map(|v| (v - m).powi(2)).sum();
+            (ss / (values.len() - 1) as f64).sqrt()
         })
         .collect()
 }
@@ -147,6 +191,21 @@ fn learning_curve<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotD
     for (i, curve, line) in &lines {
         let colour = method_colour(&data.curves, *i);
         let runs = curve.returns.len();
+        if runs > 1 {
+            let averaged: Vec<Vec<f64>> =
+                curve.returns.iter().map(|r| moving_average(r, w)).collect();
+            let spread = std_over_runs(&averaged);
+            let upper = line.iter().zip(&spread).enumerate();
+            let lower = line.iter().zip(&spread).enumerate().rev();
+            let band: Vec<(f64, f64)> = upper
+                .map(|(e, (m, s))| ((e + w) as f64, (m + s).min(high)))
+                .chain(lower.map(|(e, (m, s))| ((e + w) as f64, (m - s).max(low))))
+                .collect();
+            chart.draw_series(std::iter::once(Polygon::new(
+                band,
+                colour.mix(0.18).filled(),
+            )))?;
+        }
         chart
             .draw_series(LineSeries::new(
                 line.iter().enumerate().map(|(e, &v)| ((e + w) as f64, v)),
@@ -310,6 +369,92 @@ fn activation_lines<DB: DrawingBackend>(
     root.present()
 }
 
+/// For each reusing method, a panel of stacked shares: the fraction of each episode's
+/// acting steps taken by each source, mean over runs (episodes spent in the warm-up left
+/// out).
+fn selection_shares<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    data: &PlotData,
+) -> Drawn<DB> {
+    root.fill(&WHITE)?;
+    let root = root.titled(
+        &format!(
+            "{}: share of the acting steps taken by each source, mean of runs",
+            data.task
+        ),
+        (FAMILY, 20),
+    )?;
+    let panels = root.split_evenly((data.acted.len(), 1));
+    let policies = data.policy_names.len();
+    for (panel, (label, runs)) in panels.iter().zip(&data.acted) {
+        // run → episode → share per policy.
+        let shares: Vec<Vec<Vec<f64>>> = runs
+            .iter()
+            .map(|run| {
+                run.iter()
+                    .filter(|acted| acted.iter().sum::<u64>() > 0)
+                    .map(|acted| {
+                        let total = acted.iter().sum::<u64>() as f64;
+                        acted.iter().map(|&a| a as f64 / total).collect()
+                    })
+                    .collect()
+            })
+            .collect();
+        let per_policy: Vec<Vec<f64>> = (0..policies)
+            .map(|p| {
+                let series: Vec<Vec<f64>> = shares
+                    .iter()
+                    .map(|run| run.iter().map(|s| s[p]).collect())
+                    .collect();
+                mean_over_runs(&series)
+            })
+            .collect();
+        let episodes = per_policy.iter().map(Vec::len).max().unwrap_or(1).max(2);
+        let mut chart = ChartBuilder::on(panel)
+            .caption(label.as_str(), (FAMILY, 16))
+            .margin(8)
+            .margin_right(140)
+            .x_label_area_size(30)
+            .y_label_area_size(50)
+            .build_cartesian_2d(1f64..episodes as f64, 0f64..1f64)?;
+        chart
+            .configure_mesh()
+            .x_desc("episode after the warm-up")
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .y_label_formatter(&|y| format!("{y:.1}"))
+            .label_style((FAMILY, 12))
+            .draw()?;
+        // Stacked from the top: each area reaches the cumulative share up to its policy.
+        for p in (0..policies).rev() {
+            let colour = Palette99::pick(p).to_rgba();
+            let top: Vec<(f64, f64)> = (0..episodes)
+                .map(|e| {
+                    let stacked: f64 = per_policy[..=p]
+                        .iter()
+                        .map(|l| l.get(e).copied().unwrap_or(0.0))
+                        .sum();
+                    ((e + 1) as f64, stacked.min(1.0))
+                })
+                .collect();
+            chart
+                .draw_series(AreaSeries::new(top, 0.0, colour.filled()))?
+                .label(data.policy_names[p].clone())
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 5), (x + 12, y + 5)], colour.filled())
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .margin(4)
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK)
+            .label_font((FAMILY, 11))
+            .draw()?;
+    }
+    root.present()
+}
+
 /// A y range with a little room around the values (and some height when they are all
 /// equal or there are none).
 fn value_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -357,17 +502,23 @@ mod tests {
             curves: vec![
                 Curve {
                     label: "sapnet".into(),
+                    sapnet: true,
                     returns: vec![vec![10.0, 20.0, 30.0], vec![12.0, 18.0]],
                     tests: vec![vec![100.0, 90.0]],
                 },
                 Curve {
                     label: "dqn[100]".into(),
+                    sapnet: false,
                     returns: vec![vec![9.0, 11.0, 10.0]],
                     tests: vec![vec![9.0, 10.0]],
                 },
             ],
             policy_names: vec!["source-0".into(), "source-1".into()],
             activations: vec![vec![vec![0.0, 1.0], vec![1.5, 1.0]]],
+            acted: vec![(
+                "sapnet".into(),
+                vec![vec![vec![0, 0], vec![3, 1], vec![0, 4]]],
+            )],
         };
         write_all(dir.path(), &data).unwrap();
         for file in [
@@ -375,6 +526,7 @@ mod tests {
             "learning_curve.svg",
             "tests.png",
             "activations.png",
+            "selections.png",
         ] {
             let bytes = std::fs::read(dir.path().join(file)).unwrap();
             assert!(bytes.len() > 1000, "{file} is {} bytes", bytes.len());

@@ -9,8 +9,8 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 
-use super::plots::{self, Curve, PlotData};
-use crate::config::Config;
+use super::plots::{self, Curve, PlotData, SelectionHistory};
+use crate::config::{Config, MethodKind};
 
 #[derive(Deserialize)]
 struct EpisodeRow {
@@ -48,9 +48,11 @@ pub fn read(dir: &Path) -> Result<PlotData> {
             .into_iter()
             .map(|r| (r.method, r.run, r.test, r.test_return)),
     );
-    let curves = super::method_labels(&config)
-        .into_iter()
-        .filter_map(|label| {
+    let methods = crate::experiment::method_ids(&config);
+    let curves = methods
+        .iter()
+        .filter_map(|method| {
+            let label = method.label().to_string();
             let of = |map: &ByRun| -> Vec<Vec<f64>> {
                 map.iter()
                     .filter(|((method, _), _)| *method == label)
@@ -60,18 +62,49 @@ pub fn read(dir: &Path) -> Result<PlotData> {
             let (runs, tested) = (of(&returns), of(&tests));
             (!runs.is_empty()).then_some(Curve {
                 label,
+                sapnet: method.kind == MethodKind::SapNet,
                 returns: runs,
                 tests: tested,
             })
         })
         .collect();
-    let activations = read_activations(&dir.join("activations.csv"))?;
+    let read = read_activations(&dir.join("activations.csv"))?;
+    let of_method = |label: &str| -> Vec<&SelectionHistory> {
+        read.runs
+            .iter()
+            .filter(|((m, _), _)| m == label)
+            .map(|(_, history)| history)
+            .collect()
+    };
+    let activations = methods
+        .iter()
+        .find(|m| m.kind == MethodKind::SapNet)
+        .map(|m| {
+            of_method(m.label())
+                .into_iter()
+                .map(|h| h.scores.clone())
+                .collect()
+        })
+        .unwrap_or_default();
+    let acted = methods
+        .iter()
+        .filter(|m| m.kind.reuses())
+        .map(|m| {
+            let runs: Vec<Vec<Vec<u64>>> = of_method(m.label())
+                .into_iter()
+                .map(|h| h.acted.clone())
+                .collect();
+            (m.label().to_string(), runs)
+        })
+        .filter(|(_, runs)| !runs.is_empty())
+        .collect();
     Ok(PlotData {
         task: crate::env::make(&config.env).id().to_string(),
         window: config.protocol.moving_average,
         curves,
-        policy_names: activations.names,
-        activations: activations.runs,
+        policy_names: read.names,
+        activations,
+        acted,
     })
 }
 
@@ -121,11 +154,12 @@ fn rows<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {
 struct Activations {
     /// The sources' names (the `A_<name>` columns).
     names: Vec<String>,
-    /// Per run, each episode's activations.
-    runs: Vec<Vec<Vec<f64>>>,
+    /// Per (method, run), each episode's scores and steps acted.
+    runs: BTreeMap<(String, u32), SelectionHistory>,
 }
 
-/// No file (a config without SAP-Net) is no activations.
+/// No file (a config without a reusing method) is no activations. A file without the
+/// `method` column (before the comparison of methods) is SAP-Net's.
 fn read_activations(path: &Path) -> Result<Activations> {
     if !path.exists() {
         return Ok(Activations::default());
@@ -136,19 +170,24 @@ fn read_activations(path: &Path) -> Result<Activations> {
         .headers()
         .with_context(|| format!("reading {}", path.display()))?
         .clone();
-    let columns: Vec<(usize, String)> = headers
-        .iter()
-        .enumerate()
-        .filter_map(|(i, h)| Some((i, h.strip_prefix("A_")?.to_string())))
-        .collect();
-    if headers.get(0) != Some("run") || columns.is_empty() {
+    let prefixed = |prefix: &str| -> Vec<(usize, String)> {
+        headers
+            .iter()
+            .enumerate()
+            .filter_map(|(i, h)| Some((i, h.strip_prefix(prefix)?.to_string())))
+            .collect()
+    };
+    let (scores, acted) = (prefixed("A_"), prefixed("selected_"));
+    let method_column = headers.iter().position(|h| h == "method");
+    if headers.get(0) != Some("run") || scores.is_empty() || acted.len() != scores.len() {
         bail!(
-            "{}: expected the columns run, episode, A_<policy>…, found {:?}",
+            "{}: expected the columns run, method, episode, A_<policy>…, P_<policy>…, \
+             selected_<policy>…, found {:?}",
             path.display(),
             headers.iter().collect::<Vec<_>>()
         );
     }
-    let mut runs: BTreeMap<u32, Vec<Vec<f64>>> = BTreeMap::new();
+    let mut runs: BTreeMap<(String, u32), SelectionHistory> = BTreeMap::new();
     for (i, record) in reader.records().enumerate() {
         let at = || format!("{}: row {}", path.display(), i + 2);
         let record = record.with_context(at)?;
@@ -159,14 +198,24 @@ fn read_activations(path: &Path) -> Result<Activations> {
             })
         };
         let run = number(0)? as u32;
-        let values = columns
+        let method = method_column
+            .and_then(|c| record.get(c))
+            .unwrap_or("sapnet")
+            .to_string();
+        let values = scores
             .iter()
             .map(|&(c, _)| number(c))
             .collect::<Result<Vec<f64>>>()?;
-        runs.entry(run).or_default().push(values);
+        let steps = acted
+            .iter()
+            .map(|&(c, _)| number(c).map(|v| v as u64))
+            .collect::<Result<Vec<u64>>>()?;
+        let entry = runs.entry((method, run)).or_default();
+        entry.scores.push(values);
+        entry.acted.push(steps);
     }
     Ok(Activations {
-        names: columns.into_iter().map(|(_, name)| name).collect(),
-        runs: runs.into_values().collect(),
+        names: scores.into_iter().map(|(_, name)| name).collect(),
+        runs,
     })
 }

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 
 use crate::config::Config;
-use crate::trainer::{EpisodeRecord, RunRecord, TraceRecord};
+use crate::trainer::{EpisodeRecord, MethodId, RunRecord, TraceRecord};
 
 /// `episodes.csv`, one row per episode, flushed row by row so that an interrupted run
 /// keeps every finished episode.
@@ -67,7 +67,7 @@ impl TestsWriter {
         for (i, &test_return) in record.test_returns.iter().enumerate() {
             let row = TestRow {
                 run: record.run,
-                method: &record.method,
+                method: record.method.label(),
                 test: i + 1,
                 test_return,
                 policy,
@@ -82,9 +82,11 @@ impl TestsWriter {
     }
 }
 
-/// `activations.csv`: SAP-Net's state at the end of every episode of every transfer run:
-/// `run, episode, A_<name>…, P_<name>…, selected_<name>…` (steps each policy acted in that
-/// episode).
+/// `activations.csv`: the selector's state at the end of every episode of every run that
+/// reuses the library: `run, method, episode, A_<name>…, P_<name>…, selected_<name>…`.
+/// `A` is SAP-Net's activation (another selector's own score: UCB's mean, PRQ-learning's
+/// W…), `P` the probability of picking the source next, `selected` the steps it acted in
+/// that episode.
 pub struct ActivationsWriter {
     csv: csv::Writer<File>,
     path: String,
@@ -94,7 +96,11 @@ pub struct ActivationsWriter {
 
 impl ActivationsWriter {
     pub fn create(path: &Path, names: &[String]) -> Result<Self> {
-        let mut header = vec!["run".to_string(), "episode".to_string()];
+        let mut header = vec![
+            "run".to_string(),
+            "method".to_string(),
+            "episode".to_string(),
+        ];
         for prefix in ["A", "P", "selected"] {
             header.extend(names.iter().map(|n| format!("{prefix}_{n}")));
         }
@@ -110,6 +116,7 @@ impl ActivationsWriter {
     pub fn write(
         &mut self,
         run: u32,
+        method: &MethodId,
         episode: u32,
         activations: &[f64],
         probabilities: &[f64],
@@ -118,6 +125,7 @@ impl ActivationsWriter {
         debug_assert_eq!(activations.len(), self.policies);
         self.row.clear();
         self.row.push(run.to_string());
+        self.row.push(method.label().to_string());
         self.row.push(episode.to_string());
         self.row.extend(activations.iter().map(number));
         self.row.extend(probabilities.iter().map(number));
@@ -130,7 +138,7 @@ impl ActivationsWriter {
 }
 
 /// `trace.csv` (`--trace`): every `spread` call of every positive activation of SAP-Net's
-/// runs, as teach mode shows them: `run, step, policy, call, from, to, h, omega, eta, delta,
+/// runs, as teach mode shows them: `run, method, step, policy, call, from, to, h, omega, eta, delta,
 /// stopped` (`policy` the activated one, `call` numbering the calls of one activation from
 /// 1, `delta` = η/(h·Ω) or 0 when `Ω ≥ T_ω` stopped the call).
 pub struct TraceWriter {
@@ -144,8 +152,8 @@ impl TraceWriter {
         let csv = with_header(
             path,
             &[
-                "run", "step", "policy", "call", "from", "to", "h", "omega", "eta", "delta",
-                "stopped",
+                "run", "method", "step", "policy", "call", "from", "to", "h", "omega", "eta",
+                "delta", "stopped",
             ],
         )?;
         Ok(Self {
@@ -162,6 +170,7 @@ impl TraceWriter {
         for (k, call) in record.calls.iter().enumerate() {
             csv.write_record([
                 record.run.to_string().as_str(),
+                record.method.label(),
                 &record.step.to_string(),
                 name(record.policy),
                 &(k + 1).to_string(),
@@ -217,9 +226,11 @@ pub struct LibraryEntry {
 pub struct Summary {
     pub crate_version: &'static str,
     pub config: Config,
-    /// The source library SAP-Net reused (absent without a SAP-Net method).
+    /// The source library the reusing methods drew on (absent without one).
     pub library: Option<Vec<LibraryEntry>>,
     pub runs: Vec<RunSummary>,
+    /// The methods side by side (`comparison.csv`).
+    pub comparison: Vec<super::comparison::MethodComparison>,
     pub wall_s: f64,
     /// Why the experiment ended early, if it failed (the runs above finished before).
     pub error: Option<String>,
@@ -238,7 +249,8 @@ pub struct RunSummary {
     pub best_moving_average: Option<f64>,
     /// First episode (1-based) whose moving average reached the best value.
     pub best_moving_average_episode: Option<u32>,
-    /// SAP-Net: where the chosen policy was added to the policy library (its metadata file).
+    /// Where the chosen source, fine-tuned, was added to the policy library (its metadata
+    /// file).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub library_copy: Option<std::path::PathBuf>,
 }
@@ -250,6 +262,7 @@ impl Summary {
             config: config.clone(),
             library: None,
             runs: Vec::new(),
+            comparison: Vec::new(),
             wall_s: 0.0,
             error: None,
         }
@@ -334,12 +347,14 @@ mod tests {
     fn the_best_window_is_dated_by_its_last_episode() {
         let record = RunRecord {
             run: 0,
-            method: "dqn[4]".into(),
+            method: MethodId::new(0, &crate::config::Method::Dqn { hidden: vec![4] }),
             seed: 0,
             episodes: 5,
             steps: 0,
             updates: 0,
             chosen: None,
+            source_steps: Vec::new(),
+            lock_in_step: None,
             test_returns: vec![10.0, 20.0],
             stopped: false,
             wall_s: 0.0,

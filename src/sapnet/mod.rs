@@ -212,6 +212,37 @@ impl SapNet {
             .update(&self.activations, self.params.temperature);
     }
 
+    /// The largest probability of eq. 6: how close selection is to an argmax.
+    pub fn top_probability(&self) -> f64 {
+        self.selection.top()
+    }
+
+    /// Sets τ of eq. 6, for a temperature that follows a schedule (beyond the paper, which
+    /// keeps τ = 1).
+    ///
+    /// # Errors
+    /// If `temperature` is not a finite number > 0.
+    pub fn set_temperature(&mut self, temperature: f64) -> Result<(), SapNetError> {
+        if !(temperature > 0.0 && temperature.is_finite()) {
+            return Err(SapNetError::BadParameter {
+                name: "temperature".into(),
+                value: temperature,
+                expected: "a finite number > 0",
+            });
+        }
+        self.params.temperature = temperature;
+        self.selection.update(&self.activations, temperature);
+        Ok(())
+    }
+
+    /// `A ← λ·A` for every policy: activation decay, the spreading-activation literature's
+    /// usual answer to activations that only grow (beyond the paper, whose λ is 1).
+    pub fn decay(&mut self, lambda: f64) {
+        self.activations.iter_mut().for_each(|a| *a *= lambda);
+        self.selection
+            .update(&self.activations, self.params.temperature);
+    }
+
     /// Replaces the activations, e.g. with a state a front end stepped back to.
     pub fn set_activations(&mut self, activations: Vec<f64>) -> Result<(), SapNetError> {
         check_activations(self.len(), &activations)?;

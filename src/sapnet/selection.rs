@@ -79,6 +79,12 @@ impl SelectionTerms {
         draw(self.terms.iter().copied(), self.total, rng)
     }
 
+    /// The largest probability: the largest term over the sum.
+    pub fn top(&self) -> f64 {
+        let largest = self.terms.iter().copied().fold(0.0, f64::max);
+        largest / self.total
+    }
+
     /// As [`probabilities`] on the activations of the last update.
     pub fn probabilities(&self) -> Vec<f64> {
         self.terms.iter().map(|t| t / self.total).collect()

@@ -8,21 +8,58 @@
 //! just before each `EpisodeEnded` of a SAP-Net run), then `EpisodeEnded` per episode and
 //! `RunEnded` last.
 
+use std::fmt;
+use std::sync::Arc;
 use std::time::Duration;
 
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 
+use crate::config::{Method, MethodKind};
 use crate::sapnet::{PolicyDescription, SapNet, TraceStep};
 
-/// Which learner a run trains, as it appears in results (`dqn[100,100]`, `sapnet`).
-pub type MethodLabel = String;
+/// Which learner a run trains: its place in `protocol.methods`, its kind and its label in
+/// results (`sapnet`, `ucb1`, `dqn[100,100]`). Written as its label; ordered as the
+/// protocol lists the methods.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct MethodId {
+    pub index: usize,
+    pub kind: MethodKind,
+    pub label: Arc<str>,
+}
+
+impl MethodId {
+    /// The id of `method`, listed at `index` in the protocol.
+    pub fn new(index: usize, method: &Method) -> Self {
+        Self {
+            index,
+            kind: method.kind(),
+            label: method.label().into(),
+        }
+    }
+
+    pub fn label(&self) -> &str {
+        &self.label
+    }
+}
+
+impl fmt::Display for MethodId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.label)
+    }
+}
+
+impl Serialize for MethodId {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(&self.label)
+    }
+}
 
 /// One finished training episode: a row of `episodes.csv`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EpisodeRecord {
     /// Index of the independent run (0-based).
     pub run: u32,
-    pub method: MethodLabel,
+    pub method: MethodId,
     /// 1-based, as the paper counts.
     pub episode: u32,
     pub reward: f64,
@@ -42,21 +79,25 @@ pub struct EpisodeRecord {
     pub wall_s: f64,
 }
 
-/// The policy a SAP-Net run ends with: the highest activation (Algorithm 3).
+/// The source a reusing run ends with: for SAP-Net the highest activation (Algorithm 3),
+/// for the other selectors what [`crate::reuse::Selector::chosen`] says.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ChosenPolicy {
     pub index: usize,
     /// Its name in the source library, e.g. `source-3`.
     pub name: String,
     pub hidden: Vec<usize>,
-    pub activation: f64,
+    /// Its score under the selector when the run ended (SAP-Net: its activation A).
+    pub score: f64,
+    /// What the score is (`A`, `mean`, `score`…).
+    pub score_name: &'static str,
 }
 
 /// How a run ended.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RunRecord {
     pub run: u32,
-    pub method: MethodLabel,
+    pub method: MethodId,
     /// The seed of this run's random streams, derived from the config's run seed, the
     /// method's index and the run's index (`seeds::derive(seed, &[method, run])`).
     pub seed: u64,
@@ -65,8 +106,14 @@ pub struct RunRecord {
     pub episodes: u32,
     pub steps: u64,
     pub updates: u64,
-    /// SAP-Net: the chosen policy, whose greedy returns `test_returns` are.
+    /// The chosen source, whose greedy returns `test_returns` are (`None` when the run's
+    /// result is a learner of its own: DQN, PRQ-learning).
     pub chosen: Option<ChosenPolicy>,
+    /// Steps each source acted after the warm-up (empty without a library).
+    pub source_steps: Vec<u64>,
+    /// The first step at which one source's probability of being picked exceeded 0.99
+    /// (lock-in), for selectors with probabilities.
+    pub lock_in_step: Option<u64>,
     /// Returns of the greedy test episodes after training (empty if stopped before).
     pub test_returns: Vec<f64>,
     /// Stopped by the user before the planned episodes were done.
@@ -100,27 +147,33 @@ pub struct StepRecord {
     pub step: u64,
     /// The episode this step belongs to (1-based).
     pub episode: u32,
-    /// The policy that acted (always 0 for DQN).
-    pub policy: usize,
+    /// The source that acted (`None`: the method's own learner).
+    pub policy: Option<usize>,
     pub action: usize,
     pub reward: f64,
     /// The loss of the update this step made, if it made one.
     pub loss: Option<f64>,
-    /// SAP-Net: `T_a = E_{t+1} − E_t` of that update (eq. 7); `≤ 0` activated the policy.
+    /// SAP-Net: `T_a = E_{t+1} − E_t` of that update (eq. 7).
     pub transition: Option<f64>,
+    /// The selector's judgment of the step, if it judged one (SAP-Net: positive activated
+    /// the policy and spread).
+    pub judgment: Option<bool>,
     /// One of the first `N × replay_start_size` steps, acted in turn without learning.
     pub warm_up: bool,
 }
 
-/// The state of SAP-Net at a step.
+/// The state of a run's selector at a step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ActivationSnapshot {
     pub run: u32,
+    pub method: MethodId,
     pub step: u64,
     pub episode: u32,
-    /// 𝔸.
+    /// What the scores are: `A` for SAP-Net's activations 𝔸, or the selector's own.
+    pub score_name: &'static str,
+    /// The selector's score of each source (SAP-Net: 𝔸).
     pub activations: Vec<f64>,
-    /// P(π_i), eq. 6.
+    /// The probability of picking each source next (SAP-Net: P(π_i), eq. 6).
     pub probabilities: Vec<f64>,
     /// Steps each policy acted after the warm-up, since the run started.
     pub selections: Vec<u64>,
@@ -133,6 +186,7 @@ pub struct ActivationSnapshot {
 #[derive(Debug, Clone, PartialEq)]
 pub struct TraceRecord {
     pub run: u32,
+    pub method: MethodId,
     pub step: u64,
     /// The activated policy.
     pub policy: usize,
@@ -144,7 +198,7 @@ pub struct TraceRecord {
 pub enum Event {
     RunStarted {
         run: u32,
-        method: MethodLabel,
+        method: MethodId,
         planned_episodes: u32,
         /// Present for SAP-Net runs.
         sapnet: Option<Box<SapNetStart>>,
@@ -159,7 +213,7 @@ pub enum Event {
     /// front end can say so at once; the thread's result carries the error itself.
     RunFailed {
         run: u32,
-        method: MethodLabel,
+        method: MethodId,
         error: String,
     },
 }

@@ -1,35 +1,33 @@
 //! The trainer: owns all training state on its own thread and reports through [`Event`]s.
 //! Front ends (headless, the TUI) consume the same stream and know nothing of each other.
 //!
-//! - [`train`]: DQN from scratch (the paper's baselines, and the source policies);
-//! - [`train_transfer`]: transfer with SAP-Net (Algorithm 3);
-//! - [`spawn`]: either one on a thread of its own, with its command channel.
+//! - [`train`]: one run of any method (SAP-Net's Algorithm 3, the comparators, DQN from
+//!   scratch; the source policies are trained as DQN from scratch);
+//! - [`spawn`]: a run on a thread of its own, with its command channel.
 
 mod control;
-mod dqn_run;
 mod events;
-mod transfer_run;
+mod run;
 
-use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::mpsc::{self, Sender};
 use std::thread::{self, JoinHandle};
 
-pub use dqn_run::{test_greedy, train, DqnRunSpec};
 pub use events::{
-    ActivationSnapshot, ChosenPolicy, Command, EpisodeRecord, Event, MethodLabel, RunRecord,
+    ActivationSnapshot, ChosenPolicy, Command, EpisodeRecord, Event, MethodId, RunRecord,
     SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
 };
-pub use transfer_run::{train_transfer, SourcePolicy, TransferRunSpec};
+pub use run::{test_greedy, train, RunSpec, SourcePolicy, LOCK_IN};
 
 use crate::dqn::{DqnError, QNet};
-use crate::sapnet::SapNetError;
+use crate::reuse::ReuseError;
 
 /// Why a run could not go on.
 #[derive(Debug, thiserror::Error)]
 pub enum TrainerError {
     #[error(transparent)]
     Dqn(#[from] DqnError),
-    #[error("building SAP-Net over the source policies: {0}")]
-    SapNet(#[from] SapNetError),
+    #[error("building the selector over the source policies: {0}")]
+    Reuse(#[from] ReuseError),
     /// The loss or a gradient became NaN or infinite.
     #[error("policy {} (run {}) diverged: {}", .0.method, .0.run, .0.source)]
     Diverged(Box<Divergence>),
@@ -55,55 +53,6 @@ pub struct RunOutcome {
     pub net: QNet,
 }
 
-/// Any run the protocol lists.
-#[derive(Debug, Clone)]
-pub enum RunSpec {
-    Dqn(DqnRunSpec),
-    Transfer(TransferRunSpec),
-}
-
-impl RunSpec {
-    pub fn run(&self) -> u32 {
-        match self {
-            Self::Dqn(s) => s.run,
-            Self::Transfer(s) => s.run,
-        }
-    }
-
-    pub fn method(&self) -> &str {
-        match self {
-            Self::Dqn(s) => &s.method,
-            Self::Transfer(s) => &s.method,
-        }
-    }
-
-    pub fn episodes(&self) -> u32 {
-        match self {
-            Self::Dqn(s) => s.episodes,
-            Self::Transfer(s) => s.episodes,
-        }
-    }
-
-    pub fn seed(&self) -> u64 {
-        match self {
-            Self::Dqn(s) => s.seed,
-            Self::Transfer(s) => s.seed,
-        }
-    }
-
-    /// Trains on this thread.
-    pub fn train(
-        &self,
-        events: &Sender<Event>,
-        commands: &Receiver<Command>,
-    ) -> Result<RunOutcome, TrainerError> {
-        match self {
-            Self::Dqn(spec) => train(spec, events, commands),
-            Self::Transfer(spec) => train_transfer(spec, events, commands),
-        }
-    }
-}
-
 /// A run on its own thread: send it commands, join it for the outcome.
 #[derive(Debug)]
 pub struct RunHandle {
@@ -115,13 +64,13 @@ pub struct RunHandle {
 pub fn spawn(spec: RunSpec, events: Sender<Event>) -> std::io::Result<RunHandle> {
     let (commands, receiver) = mpsc::channel();
     let thread = thread::Builder::new()
-        .name(format!("trainer {} run {}", spec.method(), spec.run()))
+        .name(format!("trainer {} run {}", spec.method, spec.run))
         .spawn(move || {
-            let outcome = spec.train(&events, &receiver);
+            let outcome = train(&spec, &events, &receiver);
             if let Err(err) = &outcome {
                 let _ = events.send(Event::RunFailed {
-                    run: spec.run(),
-                    method: spec.method().to_string(),
+                    run: spec.run,
+                    method: spec.method.clone(),
                     error: err.to_string(),
                 });
             }
@@ -129,12 +78,3 @@ pub fn spawn(spec: RunSpec, events: Sender<Event>) -> std::io::Result<RunHandle>
         })?;
     Ok(RunHandle { commands, thread })
 }
-
-/// The label of a from-scratch DQN in results: `dqn[100,100]`.
-pub fn dqn_label(hidden: &[usize]) -> String {
-    let layers: Vec<String> = hidden.iter().map(ToString::to_string).collect();
-    format!("dqn[{}]", layers.join(","))
-}
-
-/// The label of SAP-Net transfer runs in results.
-pub const SAPNET_LABEL: &str = "sapnet";

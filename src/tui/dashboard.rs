@@ -11,8 +11,9 @@ use std::time::{Duration, Instant};
 
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
+use crate::config::MethodKind;
 use crate::sapnet::{PolicyDescription, Prototype, SapNet};
-use crate::trainer::{ActivationSnapshot, Command, Event, RunRecord, SAPNET_LABEL};
+use crate::trainer::{ActivationSnapshot, Command, Event, MethodId, RunRecord};
 
 use super::teach::Teach;
 
@@ -168,7 +169,7 @@ impl SapNetView {
 /// One training run as the dashboard follows it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunView {
-    pub method: String,
+    pub method: MethodId,
     pub planned_episodes: u32,
     pub episode: u32,
     pub curve: Curve,
@@ -180,7 +181,7 @@ pub struct RunView {
 }
 
 impl RunView {
-    fn new(method: String, planned_episodes: u32) -> Self {
+    fn new(method: MethodId, planned_episodes: u32) -> Self {
         Self {
             method,
             planned_episodes,
@@ -275,9 +276,9 @@ impl Dashboard {
             }
             Event::Step(step) => {
                 if let Some(view) = &mut self.sapnet {
-                    view.acting = Some(step.policy);
-                    if step.transition.is_some_and(|t| t <= 0.0) {
-                        view.spread = Some((step.policy, step.step));
+                    view.acting = step.policy;
+                    if let (Some(policy), Some(true)) = (step.policy, step.judgment) {
+                        view.spread = Some((policy, step.step));
                     }
                 }
                 self.step = step.step;
@@ -312,7 +313,7 @@ impl Dashboard {
                     None => {
                         let mut run = RunView::new(method, 0);
                         run.failed = Some(error);
-                        if run.method == SAPNET_LABEL {
+                        if run.method.kind == MethodKind::SapNet {
                             self.runs.insert(0, run);
                         } else {
                             self.runs.push(run);

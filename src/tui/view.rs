@@ -414,7 +414,7 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
         .iter()
         .skip(1)
         .filter(|r| r.failed.is_some())
-        .map(|r| r.method.as_str())
+        .map(|r| r.method.label())
         .collect();
     let hints = if failure.is_some() {
         "q quit"
@@ -441,7 +441,7 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
     let figures = match failure {
         Some((method, error)) => Line::from(vec![
             Span::styled(" FAILED ", theme.stopped().add_modifier(Modifier::REVERSED)),
-            Span::raw(if error.contains(method.as_str()) {
+            Span::raw(if error.contains(method.label()) {
                 format!(" {error}")
             } else {
                 format!(" {method}: {error}")

@@ -2,12 +2,22 @@
 //! library's ten architectures, with made-up but plausible numbers, so that what is drawn
 //! does not depend on timing.
 
-use sapnet::config::Config;
+use sapnet::config::{Config, Method};
 use sapnet::sapnet::{PolicyDescription, SapNet};
 use sapnet::trainer::{
-    ActivationSnapshot, ChosenPolicy, EpisodeRecord, Event, RunRecord, SapNetStart, SourceSummary,
-    StepRecord,
+    ActivationSnapshot, ChosenPolicy, EpisodeRecord, Event, MethodId, RunRecord, SapNetStart,
+    SourceSummary, StepRecord,
 };
+
+/// The id of the scripted methods: `sapnet` first, then `dqn[100]`, as the embedded
+/// config lists them.
+pub fn method(label: &str) -> MethodId {
+    match label {
+        "sapnet" => MethodId::new(0, &Method::SapNet),
+        "dqn[100]" => MethodId::new(1, &Method::Dqn { hidden: vec![100] }),
+        other => panic!("the script has no method {other}"),
+    }
+}
 
 /// The shipped CartPole library's hidden layers.
 pub const HIDDEN: [&[usize]; 10] = [
@@ -31,7 +41,7 @@ pub fn sapnet_start() -> Event {
     let net = SapNet::from_policies(&descriptions, Config::default().sapnet).expect("Table II net");
     Event::RunStarted {
         run: 0,
-        method: "sapnet".into(),
+        method: method("sapnet"),
         planned_episodes: 5000,
         sapnet: Some(Box::new(SapNetStart {
             policies: descriptions
@@ -51,7 +61,7 @@ pub fn sapnet_start() -> Event {
 pub fn baseline_start() -> Event {
     Event::RunStarted {
         run: 0,
-        method: "dqn[100]".into(),
+        method: method("dqn[100]"),
         planned_episodes: 5000,
         sapnet: None,
     }
@@ -90,16 +100,19 @@ pub fn episodes(episodes: u32) -> Vec<Event> {
             run: 0,
             step,
             episode,
-            policy,
+            policy: Some(policy),
             action: 1,
             reward: 1.0,
             loss: Some(0.05),
             transition: Some(-0.001),
+            judgment: Some(true),
             warm_up: false,
         }));
         events.push(Event::Activations(ActivationSnapshot {
             run: 0,
+            method: method("sapnet"),
             step,
+            score_name: "A",
             episode,
             activations: activations.clone(),
             probabilities: terms.iter().map(|t| t / total).collect(),
@@ -116,10 +129,10 @@ pub fn episodes(episodes: u32) -> Vec<Event> {
     events
 }
 
-fn episode_end(method: &str, episode: u32, reward: f64) -> Event {
+fn episode_end(label: &str, episode: u32, reward: f64) -> Event {
     Event::EpisodeEnded(EpisodeRecord {
         run: 0,
-        method: method.into(),
+        method: self::method(label),
         episode,
         reward,
         steps: reward as u32,
@@ -135,7 +148,7 @@ fn episode_end(method: &str, episode: u32, reward: f64) -> Event {
 pub fn sapnet_end(episodes: u32) -> Event {
     Event::RunEnded(RunRecord {
         run: 0,
-        method: "sapnet".into(),
+        method: method("sapnet"),
         seed: 1,
         episodes,
         steps: 6450,
@@ -144,8 +157,11 @@ pub fn sapnet_end(episodes: u32) -> Event {
             index: 6,
             name: "source-6".into(),
             hidden: HIDDEN[6].to_vec(),
-            activation: 3117.0,
+            score: 3117.0,
+            score_name: "A",
         }),
+        source_steps: Vec::new(),
+        lock_in_step: None,
         test_returns: vec![500.0, 500.0, 487.0, 500.0, 500.0],
         stopped: false,
         wall_s: 12.5,

@@ -1,0 +1,204 @@
+//! Policy reuse: which source policy acts now, and what it learns from. The seam between
+//! the run loop ([`crate::trainer`]) and the ways of reusing a library.
+//!
+//! A [`Selector`] answers three questions, and knows nothing of candle or the environment:
+//! - *who acts* at this step ([`Selector::act`]): a source ε-greedily, a source greedily
+//!   (π-reuse), or a learner that is not a source;
+//! - *what feedback* it takes: each update's report from the source that acted
+//!   ([`Selector::on_update`]), each step's end, each episode's end and return;
+//! - *what to show*: a score per source and the probability of picking it
+//!   ([`Selector::view`]).
+//!
+//! *Who learns* is fixed per method ([`Learning`]): either the source that acted learns from
+//! its step (SAP-Net, the paper), or a learner of its own learns from every step while the
+//! sources only guide (π-reuse in PRQ-learning; DQN from scratch is a learner that always
+//! acts).
+//!
+//! One file per method: [`sapnet`], [`random`], [`ucb1`], [`prql`], [`best_source`],
+//! [`scratch`]. Adding one is a new file here, a variant of [`crate::config::Method`] and
+//! an arm in [`build`].
+
+pub mod best_source;
+pub mod prql;
+pub mod random;
+pub mod sapnet;
+pub mod schedule;
+pub mod scratch;
+pub mod ucb1;
+
+use std::fmt;
+
+use rand::rngs::StdRng;
+
+use crate::config::Method;
+use crate::dqn::UpdateReport;
+use crate::sapnet::{PolicyDescription, SapNetError, SapNetParams, TraceStep};
+
+/// Who chooses this step's action.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Actor {
+    /// Source `i`, ε-greedily (it then learns from the step, if the method lets sources learn).
+    Source(usize),
+    /// Source `i`'s greedy action: π-reuse's "follow the past policy".
+    SourceGreedy(usize),
+    /// The method's own learner, ε-greedily.
+    Learner,
+}
+
+impl Actor {
+    /// The source this actor is, if it is one.
+    pub fn source(self) -> Option<usize> {
+        match self {
+            Self::Source(i) | Self::SourceGreedy(i) => Some(i),
+            Self::Learner => None,
+        }
+    }
+}
+
+/// Who learns from the steps of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Learning {
+    /// The source that acted does one round of updates on its step (Algorithm 3). The run
+    /// begins with the warm-up: `N × replay_start_size` steps acted by the sources in turn.
+    ActingSource,
+    /// A learner of the method's own, a fresh DQN, learns from every step; sources never
+    /// learn.
+    Learner,
+}
+
+/// How an episode ended, for selectors that judge per episode.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EpisodeEnd {
+    /// The undiscounted return.
+    pub episode_return: f64,
+    /// Σ_t γ^t r_t, with the DQN's γ.
+    pub discounted_return: f64,
+}
+
+/// One activation of a policy, with every `spread` call it made (eq. 8–11).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Activation {
+    pub policy: usize,
+    pub calls: Vec<TraceStep>,
+}
+
+/// What a selector shows of itself: one score and one probability per source.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelectorView {
+    /// What the scores are, as a column header: `A` (SAP-Net's activation), `UCB`, `W`.
+    pub score_name: &'static str,
+    pub scores: Vec<f64>,
+    /// The probability that each source is picked at the next choice.
+    pub probabilities: Vec<f64>,
+    /// Judgments per source (eq. 7 for SAP-Net), for methods that judge.
+    pub positive: Vec<u64>,
+    pub negative: Vec<u64>,
+}
+
+/// Which source acts and what it hears back. See the [module](self) documentation.
+pub trait Selector: Send + fmt::Debug {
+    /// Who learns from the run's steps.
+    fn learning(&self) -> Learning;
+
+    /// Who chooses the action of the next step (after the warm-up).
+    fn act(&mut self, rng: &mut StdRng) -> Actor;
+
+    /// The report of the update `source` just made on its step
+    /// ([`Learning::ActingSource`] only); returns the judgment it made of it, if it judged.
+    fn on_update(&mut self, _source: usize, _report: &UpdateReport) -> Option<bool> {
+        None
+    }
+
+    /// A step (after the warm-up) is over: time-driven changes go here.
+    fn on_step(&mut self) {}
+
+    /// The episode in progress ended (episodes cut by a step budget never end).
+    fn on_episode_end(&mut self, _end: &EpisodeEnd) {}
+
+    /// Scores and probabilities for display.
+    fn view(&self) -> SelectorView;
+
+    /// The largest probability of picking one source, where the method has probabilities:
+    /// what lock-in (one source above 0.99) is measured on.
+    fn top_probability(&self) -> Option<f64> {
+        None
+    }
+
+    /// The source the run ends with (tested and written to the library), or `None` when
+    /// the run's result is its learner.
+    fn chosen(&self) -> Option<usize>;
+
+    /// The SAP-Net behind the selector, if it is one: its graph, for drawing and teaching.
+    fn sapnet(&self) -> Option<&crate::sapnet::SapNet> {
+        None
+    }
+
+    /// Record the activations of the next feedback for a trace.
+    fn set_tracing(&mut self, _on: bool) {}
+
+    /// Activations recorded since the last call (with tracing on).
+    fn take_activations(&mut self) -> Vec<Activation> {
+        Vec::new()
+    }
+}
+
+/// What a selector needs to know of the library.
+#[derive(Debug, Clone, Copy)]
+pub struct Library<'a> {
+    pub descriptions: &'a [PolicyDescription],
+    /// Mean greedy return each source scored when it was trained, if tested.
+    pub scores: &'a [Option<f64>],
+    /// The target task's possible returns per episode, (lowest, highest).
+    pub return_range: (f64, f64),
+}
+
+/// Why a selector could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum ReuseError {
+    #[error(transparent)]
+    SapNet(#[from] SapNetError),
+    #[error("{0}")]
+    Library(String),
+}
+
+/// The selector of `method` over `library`; `sapnet` is the config's SAP-Net section.
+pub fn build(
+    method: &Method,
+    library: Library<'_>,
+    sapnet: &SapNetParams,
+) -> Result<Box<dyn Selector>, ReuseError> {
+    Ok(match method {
+        Method::SapNet => Box::new(sapnet::SapNetSelector::new(
+            library.descriptions,
+            sapnet.clone(),
+            &sapnet::SapNetKnobs::default(),
+        )?),
+        Method::SapNetWith(knobs) => Box::new(sapnet::SapNetSelector::new(
+            library.descriptions,
+            sapnet.clone(),
+            knobs,
+        )?),
+        Method::Random => Box::new(random::Random::per_step(library.descriptions.len())),
+        Method::RandomPerEpisode => {
+            Box::new(random::Random::per_episode(library.descriptions.len()))
+        }
+        Method::Ucb1 => Box::new(ucb1::Ucb1::new(
+            library.descriptions.len(),
+            library.return_range,
+        )),
+        Method::Prql(knobs) => Box::new(prql::Prql::new(library.descriptions.len(), knobs)),
+        Method::BestSource => Box::new(best_source::BestSource::new(library.scores)?),
+        Method::Dqn { .. } => Box::new(scratch::Scratch),
+    })
+}
+
+/// Index of the largest value, the lowest on a tie.
+pub(crate) fn argmax(values: &[f64]) -> usize {
+    let mut best = 0;
+    for (i, &v) in values.iter().enumerate() {
+        if v > values[best] {
+            best = i;
+        }
+    }
+    best
+}

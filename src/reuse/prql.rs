@@ -1,0 +1,303 @@
+//! PRQ-learning (Fernández & Veloso, "Probabilistic policy reuse in a reinforcement
+//! learning agent", AAMAS 2006), on DQN.
+//!
+//! A new learner Π_Ω (a DQN of its own) learns from every step. Each episode one policy of
+//! {Π_Ω, Π_1 … Π_n} is picked with `P(Π_j) = exp(τ·W_j) / Σ_p exp(τ·W_p)`:
+//! - Π_Ω: the learner acts ε-greedily for the whole episode;
+//! - a source Π_k: π-reuse, at every step its greedy action with probability ψ_h, else the
+//!   learner's ε-greedy action, with `ψ_{h+1} = ψ_h·υ` (ψ_0 = ψ each episode).
+//!
+//! After the episode, `W_k ← (W_k·U_k + R)/(U_k + 1)`, `U_k ← U_k + 1`, where R is the
+//! episode's discounted return, and `τ ← τ + Δτ`. The result of a run is the learner.
+
+use rand::rngs::StdRng;
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+use super::{Actor, EpisodeEnd, Learning, Selector, SelectorView};
+
+/// PRQ-learning's parameters (`Prql(...)` in `protocol.methods`). Defaults: the paper's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PrqlKnobs {
+    /// The learner's hidden layers.
+    pub hidden: Vec<usize>,
+    /// ψ: the probability of following the reused source at an episode's first step.
+    pub psi: f64,
+    /// υ in (0, 1]: ψ's decay per step.
+    pub upsilon: f64,
+    /// τ₀ ≥ 0: the initial inverse temperature of the choice among policies.
+    pub tau0: f64,
+    /// Δτ ≥ 0: τ's growth per episode.
+    pub delta_tau: f64,
+}
+
+impl Default for PrqlKnobs {
+    fn default() -> Self {
+        Self {
+            hidden: vec![100],
+            psi: 1.0,
+            upsilon: 0.95,
+            tau0: 0.0,
+            delta_tau: 0.05,
+        }
+    }
+}
+
+impl PrqlKnobs {
+    /// `prql`, or `prql[64,64]` for another learner.
+    pub fn label(&self) -> String {
+        if self.hidden == Self::default().hidden {
+            "prql".into()
+        } else {
+            let layers: Vec<String> = self.hidden.iter().map(ToString::to_string).collect();
+            format!("prql[{}]", layers.join(","))
+        }
+    }
+
+    /// The ranges serde cannot check; `field` is where the knobs sit in the config.
+    pub fn validate(&self, field: &str) -> Result<(), String> {
+        let fail = |name: &str, expected: &str, got: &dyn std::fmt::Display| {
+            Err(format!(
+                "field `{field}.{name}`: expected {expected}, got {got}"
+            ))
+        };
+        if self.hidden.is_empty() || self.hidden.contains(&0) {
+            return fail(
+                "hidden",
+                "a non-empty list of layer sizes > 0",
+                &format!("{:?}", self.hidden),
+            );
+        }
+        if !(0.0..=1.0).contains(&self.psi) {
+            return fail("psi", "ψ in [0, 1]", &self.psi);
+        }
+        if !(self.upsilon > 0.0 && self.upsilon <= 1.0) {
+            return fail("upsilon", "υ in (0, 1]", &self.upsilon);
+        }
+        if !(self.tau0 >= 0.0 && self.tau0.is_finite()) {
+            return fail("tau0", "a finite τ₀ ≥ 0", &self.tau0);
+        }
+        if !(self.delta_tau >= 0.0 && self.delta_tau.is_finite()) {
+            return fail("delta_tau", "a finite Δτ ≥ 0", &self.delta_tau);
+        }
+        Ok(())
+    }
+}
+
+/// Which policy an episode follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Pick {
+    Learner,
+    Source(usize),
+}
+
+#[derive(Debug)]
+pub struct Prql {
+    knobs: PrqlKnobs,
+    /// W and U: index 0 the learner, k + 1 source k.
+    w: Vec<f64>,
+    u: Vec<u64>,
+    tau: f64,
+    /// The episode in progress: its policy and ψ_h.
+    current: Option<Pick>,
+    psi: f64,
+}
+
+impl Prql {
+    pub fn new(n: usize, knobs: &PrqlKnobs) -> Self {
+        Self {
+            knobs: knobs.clone(),
+            w: vec![0.0; n + 1],
+            u: vec![0; n + 1],
+            tau: knobs.tau0,
+            current: None,
+            psi: knobs.psi,
+        }
+    }
+
+    /// `P(Π_j)` over the learner (index 0) and the sources.
+    fn probabilities(&self) -> Vec<f64> {
+        let max = self.w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let terms: Vec<f64> = self
+            .w
+            .iter()
+            .map(|&w| (self.tau * (w - max)).exp())
+            .collect();
+        let total: f64 = terms.iter().sum();
+        terms.iter().map(|t| t / total).collect()
+    }
+
+    fn pick(&self, rng: &mut StdRng) -> Pick {
+        let probabilities = self.probabilities();
+        let target = rng.random::<f64>();
+        let mut running = 0.0;
+        for (j, p) in probabilities.iter().enumerate() {
+            running += p;
+            if target < running {
+                return if j == 0 {
+                    Pick::Learner
+                } else {
+                    Pick::Source(j - 1)
+                };
+            }
+        }
+        Pick::Source(probabilities.len() - 2)
+    }
+}
+
+impl Selector for Prql {
+    fn learning(&self) -> Learning {
+        Learning::Learner
+    }
+
+    fn act(&mut self, rng: &mut StdRng) -> Actor {
+        let pick = match self.current {
+            Some(pick) => pick,
+            None => {
+                let pick = self.pick(rng);
+                self.current = Some(pick);
+                self.psi = self.knobs.psi;
+                pick
+            }
+        };
+        match pick {
+            Pick::Learner => Actor::Learner,
+            Pick::Source(k) => {
+                let follow = rng.random::<f64>() < self.psi;
+                self.psi *= self.knobs.upsilon;
+                if follow {
+                    Actor::SourceGreedy(k)
+                } else {
+                    Actor::Learner
+                }
+            }
+        }
+    }
+
+    fn on_episode_end(&mut self, end: &EpisodeEnd) {
+        let Some(pick) = self.current.take() else {
+            return;
+        };
+        let j = match pick {
+            Pick::Learner => 0,
+            Pick::Source(k) => k + 1,
+        };
+        self.w[j] = (self.w[j] * self.u[j] as f64 + end.discounted_return) / (self.u[j] + 1) as f64;
+        self.u[j] += 1;
+        self.tau += self.knobs.delta_tau;
+    }
+
+    /// Scores: W of each source (the learner's is not a source's).
+    fn view(&self) -> SelectorView {
+        let n = self.w.len() - 1;
+        SelectorView {
+            score_name: "W",
+            scores: self.w[1..].to_vec(),
+            probabilities: self.probabilities()[1..].to_vec(),
+            positive: vec![0; n],
+            negative: vec![0; n],
+        }
+    }
+
+    fn top_probability(&self) -> Option<f64> {
+        self.probabilities()[1..].iter().copied().reduce(f64::max)
+    }
+
+    /// The learner is the result.
+    fn chosen(&self) -> Option<usize> {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+
+    use super::*;
+
+    fn end(discounted_return: f64) -> EpisodeEnd {
+        EpisodeEnd {
+            episode_return: 0.0,
+            discounted_return,
+        }
+    }
+
+    #[test]
+    fn psi_decays_by_upsilon_each_step_and_restarts_each_episode() {
+        let knobs = PrqlKnobs {
+            psi: 0.8,
+            upsilon: 0.5,
+            ..PrqlKnobs::default()
+        };
+        let mut prql = Prql::new(2, &knobs);
+        let mut rng = StdRng::seed_from_u64(1);
+        prql.current = Some(Pick::Source(1));
+        prql.psi = 0.8;
+        for expected in [0.4, 0.2, 0.1] {
+            prql.act(&mut rng);
+            assert_eq!(prql.psi, expected);
+        }
+        prql.on_episode_end(&end(1.0));
+        // The next episode starts again from ψ.
+        prql.act(&mut rng);
+        assert!(prql.psi == 0.8 || prql.psi == 0.4, "{}", prql.psi);
+    }
+
+    #[test]
+    fn w_is_the_running_mean_of_discounted_returns_and_tau_grows() {
+        let mut prql = Prql::new(2, &PrqlKnobs::default());
+        for r in [3.0, 6.0] {
+            prql.current = Some(Pick::Source(0));
+            prql.on_episode_end(&end(r));
+        }
+        prql.current = Some(Pick::Learner);
+        prql.on_episode_end(&end(-1.0));
+        assert_eq!(prql.w, [-1.0, 4.5, 0.0]);
+        assert_eq!(prql.u, [1, 2, 0]);
+        assert!((prql.tau - 0.15).abs() < 1e-15);
+        // τ₀ = 0: the first choice is uniform over the learner and the sources.
+        assert_eq!(
+            Prql::new(3, &PrqlKnobs::default()).probabilities(),
+            [0.25; 4]
+        );
+    }
+
+    #[test]
+    fn follows_the_source_with_probability_psi() {
+        let knobs = PrqlKnobs {
+            psi: 1.0,
+            upsilon: 1.0,
+            ..PrqlKnobs::default()
+        };
+        let mut prql = Prql::new(1, &knobs);
+        let mut rng = StdRng::seed_from_u64(3);
+        prql.current = Some(Pick::Source(0));
+        assert!((0..100).all(|_| prql.act(&mut rng) == Actor::SourceGreedy(0)));
+        prql.psi = 0.0;
+        prql.knobs.psi = 0.0;
+        assert!((0..100).all(|_| prql.act(&mut rng) == Actor::Learner));
+    }
+
+    #[test]
+    fn bad_knobs_are_located() {
+        let bad = |knobs: PrqlKnobs| knobs.validate("protocol.methods[4]").unwrap_err();
+        assert_eq!(
+            bad(PrqlKnobs {
+                psi: 1.5,
+                ..PrqlKnobs::default()
+            }),
+            "field `protocol.methods[4].psi`: expected ψ in [0, 1], got 1.5"
+        );
+        assert!(bad(PrqlKnobs {
+            upsilon: 0.0,
+            ..PrqlKnobs::default()
+        })
+        .contains("upsilon"));
+        assert!(bad(PrqlKnobs {
+            hidden: vec![],
+            ..PrqlKnobs::default()
+        })
+        .contains("hidden"));
+    }
+}

@@ -1,0 +1,114 @@
+//! The chance baselines: a uniformly random source, drawn every step or once per episode.
+//! The acting source fine-tunes as in SAP-Net; only the choice differs.
+
+use rand::rngs::StdRng;
+use rand::Rng;
+
+use super::{Actor, EpisodeEnd, Learning, Selector, SelectorView};
+
+/// A uniform draw over the sources.
+#[derive(Debug)]
+pub struct Random {
+    n: usize,
+    per_episode: bool,
+    /// The source of the episode in progress (per episode only).
+    current: Option<usize>,
+    acted: Vec<u64>,
+}
+
+impl Random {
+    /// A new source every step.
+    pub fn per_step(n: usize) -> Self {
+        Self::new(n, false)
+    }
+
+    /// A new source at the first step of every episode.
+    pub fn per_episode(n: usize) -> Self {
+        Self::new(n, true)
+    }
+
+    fn new(n: usize, per_episode: bool) -> Self {
+        Self {
+            n,
+            per_episode,
+            current: None,
+            acted: vec![0; n],
+        }
+    }
+}
+
+impl Selector for Random {
+    fn learning(&self) -> Learning {
+        Learning::ActingSource
+    }
+
+    fn act(&mut self, rng: &mut StdRng) -> Actor {
+        let i = match self.current {
+            Some(i) if self.per_episode => i,
+            _ => rng.random_range(0..self.n),
+        };
+        self.current = Some(i);
+        self.acted[i] += 1;
+        Actor::Source(i)
+    }
+
+    fn on_episode_end(&mut self, _end: &EpisodeEnd) {
+        self.current = None;
+    }
+
+    /// Scores: the steps each source acted.
+    fn view(&self) -> SelectorView {
+        let mut probabilities = vec![1.0 / self.n as f64; self.n];
+        if let (true, Some(i)) = (self.per_episode, self.current) {
+            probabilities.iter_mut().for_each(|p| *p = 0.0);
+            probabilities[i] = 1.0;
+        }
+        SelectorView {
+            score_name: "acted",
+            scores: self.acted.iter().map(|&n| n as f64).collect(),
+            probabilities,
+            positive: vec![0; self.n],
+            negative: vec![0; self.n],
+        }
+    }
+
+    /// The source that acted most.
+    fn chosen(&self) -> Option<usize> {
+        let acted: Vec<f64> = self.acted.iter().map(|&n| n as f64).collect();
+        Some(super::argmax(&acted))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+
+    use super::*;
+
+    #[test]
+    fn per_step_draws_every_source_and_per_episode_keeps_one() {
+        let mut rng = StdRng::seed_from_u64(5);
+        let mut every_step = Random::per_step(4);
+        let drawn: Vec<usize> = (0..400)
+            .map(|_| every_step.act(&mut rng).source().unwrap())
+            .collect();
+        for i in 0..4 {
+            let share = drawn.iter().filter(|&&d| d == i).count();
+            // Binomial(400, 1/4): mean 100, sd 8.7.
+            assert!((60..140).contains(&share), "{i}: {share}");
+        }
+        let mut per_episode = Random::per_episode(4);
+        let end = EpisodeEnd {
+            episode_return: 0.0,
+            discounted_return: 0.0,
+        };
+        let mut picks = Vec::new();
+        for _ in 0..20 {
+            let first = per_episode.act(&mut rng);
+            assert!((0..50).all(|_| per_episode.act(&mut rng) == first));
+            picks.push(first);
+            per_episode.on_episode_end(&end);
+        }
+        assert!(picks.iter().any(|&p| p != picks[0]), "{picks:?}");
+    }
+}

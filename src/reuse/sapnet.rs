@@ -1,0 +1,402 @@
+//! SAP-Net as a selector: eq. 6 picks the source that acts, eq. 7 judges its update,
+//! eq. 8–11 activate and spread (Algorithm 3). With [`SapNetKnobs::default`] this is the
+//! paper; the knobs are variants beyond it: a temperature schedule, a judgment over
+//! episodes or over k updates, and activation decay.
+
+use rand::rngs::StdRng;
+use serde::{Deserialize, Serialize};
+
+use super::schedule::Schedule;
+use super::{Activation, Actor, EpisodeEnd, Learning, Selector, SelectorView};
+use crate::dqn::UpdateReport;
+use crate::sapnet::{self, PolicyDescription, SapNet, SapNetError, SapNetParams, TraceStep};
+
+/// When a source's learning is judged positive or negative.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Judgment {
+    /// After every update: `T_a = E_{t+1} − E_t ≤ 0` (eq. 7, the paper).
+    Step,
+    /// Once per episode, for each source that acted in it: positive when the episode's
+    /// return is at least the mean return of the earlier episodes that source acted in (the
+    /// first such episode is positive). The paper's own proposal for MountainCar.
+    Episode,
+    /// After every k updates of a source: eq. 7 over the k updates, `E_{t+k} − E_t ≤ 0`.
+    KSteps(u32),
+}
+
+/// SAP-Net's variants beyond the paper (`SapNetWith(...)` in `protocol.methods`); the
+/// graph and the spreading come from the config's `sapnet` section.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SapNetKnobs {
+    /// The name in results; `None`: `sapnet` followed by the knobs that differ from the
+    /// paper, e.g. `sapnet-episode-decay0.999`.
+    pub label: Option<String>,
+    /// τ of eq. 6 over the learning steps (those after the warm-up); `None`: the constant
+    /// `sapnet.temperature`.
+    pub temperature: Option<Schedule>,
+    pub judgment: Judgment,
+    /// λ in (0, 1]: every activation is multiplied by λ after every learning step
+    /// (1: the paper).
+    pub decay: f64,
+}
+
+impl Default for SapNetKnobs {
+    fn default() -> Self {
+        Self {
+            label: None,
+            temperature: None,
+            judgment: Judgment::Step,
+            decay: 1.0,
+        }
+    }
+}
+
+impl SapNetKnobs {
+    /// The label of results: the given one, or one built from the knobs.
+    pub fn label(&self) -> String {
+        if let Some(label) = &self.label {
+            return label.clone();
+        }
+        let mut label = String::from("sapnet");
+        if let Some(schedule) = &self.temperature {
+            let (kind, from, to) = match *schedule {
+                Schedule::Linear { from, to, .. } => ("lin", from, to),
+                Schedule::Exponential { from, to, .. } => ("exp", from, to),
+            };
+            label.push_str(&format!("-tau-{kind}{from}-{to}"));
+        }
+        match self.judgment {
+            Judgment::Step => {}
+            Judgment::Episode => label.push_str("-episode"),
+            Judgment::KSteps(k) => label.push_str(&format!("-k{k}")),
+        }
+        if self.decay != 1.0 {
+            label.push_str(&format!("-decay{}", self.decay));
+        }
+        label
+    }
+
+    /// The ranges serde cannot check; `field` is where the knobs sit in the config.
+    pub fn validate(&self, field: &str) -> Result<(), String> {
+        if let Some(schedule) = &self.temperature {
+            schedule.validate_positive(&format!("{field}.temperature"))?;
+        }
+        if !(self.decay > 0.0 && self.decay <= 1.0) {
+            return Err(format!(
+                "field `{field}.decay`: expected λ in (0, 1], got {}",
+                self.decay
+            ));
+        }
+        if self.judgment == Judgment::KSteps(0) {
+            return Err(format!(
+                "field `{field}.judgment`: expected KSteps(k) with k ≥ 1, got KSteps(0)"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// SAP-Net over the library, with its judgment's bookkeeping.
+#[derive(Debug)]
+pub struct SapNetSelector {
+    net: SapNet,
+    knobs: SapNetKnobs,
+    positive: Vec<u64>,
+    negative: Vec<u64>,
+    /// Learning steps so far, the clock of the temperature schedule.
+    steps: u64,
+    /// `Episode`: which sources acted in the episode in progress, and per source the mean
+    /// return of the earlier episodes it acted in, with their count.
+    acted: Vec<bool>,
+    mean_return: Vec<(f64, u64)>,
+    /// `KSteps`: per source, E before the window of updates in progress and its length.
+    window: Vec<(f64, u32)>,
+    tracing: bool,
+    traced: Vec<Activation>,
+}
+
+impl SapNetSelector {
+    pub fn new(
+        policies: &[PolicyDescription],
+        mut params: SapNetParams,
+        knobs: &SapNetKnobs,
+    ) -> Result<Self, SapNetError> {
+        if let Some(schedule) = &knobs.temperature {
+            params.temperature = schedule.at(0);
+        }
+        let n = policies.len();
+        Ok(Self {
+            net: SapNet::from_policies(policies, params)?,
+            knobs: knobs.clone(),
+            positive: vec![0; n],
+            negative: vec![0; n],
+            steps: 0,
+            acted: vec![false; n],
+            mean_return: vec![(0.0, 0); n],
+            window: vec![(0.0, 0); n],
+            tracing: false,
+            traced: Vec::new(),
+        })
+    }
+
+    /// The SAP-Net, with its graph and activations.
+    pub fn net(&self) -> &SapNet {
+        &self.net
+    }
+
+    /// Counts the judgment, then activates `i` (eq. 8–11) if it was positive.
+    fn judged(&mut self, i: usize, positive: bool) {
+        if !positive {
+            self.negative[i] += 1;
+            return;
+        }
+        self.positive[i] += 1;
+        if self.tracing {
+            let mut calls: Vec<TraceStep> = Vec::new();
+            self.net.activate_traced(i, true, &mut calls);
+            self.traced.push(Activation { policy: i, calls });
+        } else {
+            self.net.activate(i, true);
+        }
+    }
+}
+
+impl Selector for SapNetSelector {
+    fn learning(&self) -> Learning {
+        Learning::ActingSource
+    }
+
+    /// Eq. 6.
+    fn act(&mut self, rng: &mut StdRng) -> Actor {
+        let i = self.net.select(rng);
+        self.acted[i] = true;
+        Actor::Source(i)
+    }
+
+    fn on_update(&mut self, source: usize, report: &UpdateReport) -> Option<bool> {
+        let positive = match self.knobs.judgment {
+            Judgment::Step => sapnet::judge(report.previous_statistic_loss, report.statistic_loss),
+            Judgment::Episode => return None,
+            Judgment::KSteps(k) => {
+                let (start, count) = &mut self.window[source];
+                if *count == 0 {
+                    *start = report.previous_statistic_loss;
+                }
+                *count += 1;
+                if *count < k {
+                    return None;
+                }
+                *count = 0;
+                sapnet::judge(*start, report.statistic_loss)
+            }
+        };
+        self.judged(source, positive);
+        Some(positive)
+    }
+
+    fn on_step(&mut self) {
+        self.steps += 1;
+        if self.knobs.decay != 1.0 {
+            self.net.decay(self.knobs.decay);
+        }
+        if let Some(schedule) = &self.knobs.temperature {
+            self.net
+                .set_temperature(schedule.at(self.steps))
+                .expect("a validated schedule stays > 0");
+        }
+    }
+
+    fn on_episode_end(&mut self, end: &EpisodeEnd) {
+        if self.knobs.judgment != Judgment::Episode {
+            return;
+        }
+        for i in 0..self.acted.len() {
+            if !std::mem::take(&mut self.acted[i]) {
+                continue;
+            }
+            let (mean, count) = self.mean_return[i];
+            let positive = count == 0 || end.episode_return >= mean;
+            let count = count + 1;
+            self.mean_return[i] = (mean + (end.episode_return - mean) / count as f64, count);
+            self.judged(i, positive);
+        }
+    }
+
+    fn view(&self) -> SelectorView {
+        SelectorView {
+            score_name: "A",
+            scores: self.net.activations().to_vec(),
+            probabilities: self.net.probabilities(),
+            positive: self.positive.clone(),
+            negative: self.negative.clone(),
+        }
+    }
+
+    fn top_probability(&self) -> Option<f64> {
+        Some(self.net.top_probability())
+    }
+
+    /// The highest activation (Algorithm 3).
+    fn chosen(&self) -> Option<usize> {
+        Some(self.net.chosen())
+    }
+
+    fn sapnet(&self) -> Option<&SapNet> {
+        Some(&self.net)
+    }
+
+    fn set_tracing(&mut self, on: bool) {
+        self.tracing = on;
+    }
+
+    fn take_activations(&mut self) -> Vec<Activation> {
+        std::mem::take(&mut self.traced)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn report(before: f64, after: f64) -> UpdateReport {
+        UpdateReport {
+            loss: 0.0,
+            previous_statistic_loss: before,
+            statistic_loss: after,
+        }
+    }
+
+    /// Two unrelated policies (one and two hidden layers): no edge, no spreading.
+    fn selector(knobs: SapNetKnobs) -> SapNetSelector {
+        let policies = [
+            PolicyDescription::new(vec![8], "t"),
+            PolicyDescription::new(vec![8, 8], "t"),
+        ];
+        SapNetSelector::new(&policies, SapNetParams::default(), &knobs).unwrap()
+    }
+
+    #[test]
+    fn the_paper_judges_every_update_by_eq_7() {
+        let mut s = selector(SapNetKnobs::default());
+        s.on_update(0, &report(0.5, 0.4));
+        s.on_update(0, &report(0.4, 0.6));
+        s.on_update(1, &report(0.4, 0.4));
+        let view = s.view();
+        assert_eq!(view.scores, vec![1.0, 1.0]);
+        assert_eq!((view.positive, view.negative), (vec![1, 1], vec![1, 0]));
+    }
+
+    #[test]
+    fn k_steps_judges_the_change_of_e_over_k_updates() {
+        let mut s = selector(SapNetKnobs {
+            judgment: Judgment::KSteps(3),
+            ..SapNetKnobs::default()
+        });
+        // E: 1.0 → 1.2 → 1.1 → 0.9: up twice, but lower after three updates.
+        for (before, after) in [(1.0, 1.2), (1.2, 1.1), (1.1, 0.9)] {
+            s.on_update(0, &report(before, after));
+        }
+        // E: 0.9 → 0.8 → 0.7 → 1.0: higher after three.
+        for (before, after) in [(0.9, 0.8), (0.8, 0.7), (0.7, 1.0)] {
+            s.on_update(0, &report(before, after));
+        }
+        let view = s.view();
+        assert_eq!((view.positive[0], view.negative[0]), (1, 1));
+        assert_eq!(view.scores[0], 1.0);
+    }
+
+    #[test]
+    fn an_episode_judgment_compares_with_the_sources_running_mean() {
+        let mut s = selector(SapNetKnobs {
+            judgment: Judgment::Episode,
+            ..SapNetKnobs::default()
+        });
+        let episode = |s: &mut SapNetSelector, ret: f64| {
+            s.acted = vec![true, false];
+            s.on_episode_end(&EpisodeEnd {
+                episode_return: ret,
+                discounted_return: 0.0,
+            });
+        };
+        // First episode: positive. Mean 10 → 12 ≥ 10 positive → mean 11 → 10.5 < 11 negative.
+        for ret in [10.0, 12.0, 10.5] {
+            episode(&mut s, ret);
+        }
+        // Source 1 never acted: it was never judged.
+        let view = s.view();
+        assert_eq!((view.positive, view.negative), (vec![2, 0], vec![1, 0]));
+        assert_eq!(view.scores, vec![2.0, 0.0]);
+        assert!((s.mean_return[0].0 - 32.5 / 3.0).abs() < 1e-12);
+        assert_eq!(s.mean_return[0].1, 3);
+    }
+
+    #[test]
+    fn decay_and_the_schedule_act_after_every_step() {
+        let mut s = selector(SapNetKnobs {
+            temperature: Some(Schedule::Linear {
+                from: 2.0,
+                to: 0.5,
+                steps: 2,
+            }),
+            decay: 0.5,
+            ..SapNetKnobs::default()
+        });
+        assert_eq!(s.net.params().temperature, 2.0);
+        s.on_update(0, &report(1.0, 0.5));
+        s.on_step();
+        assert_eq!(s.net.activations(), &[0.5, 0.0]);
+        assert_eq!(s.net.params().temperature, 1.25);
+        s.on_step();
+        assert_eq!(s.net.activations(), &[0.25, 0.0]);
+        assert_eq!(s.net.params().temperature, 0.5);
+    }
+
+    #[test]
+    fn labels_name_what_differs_from_the_paper() {
+        assert_eq!(SapNetKnobs::default().label(), "sapnet");
+        let knobs = SapNetKnobs {
+            temperature: Some(Schedule::Exponential {
+                from: 4.0,
+                to: 0.5,
+                steps: 100,
+            }),
+            judgment: Judgment::Episode,
+            decay: 0.999,
+            label: None,
+        };
+        assert_eq!(knobs.label(), "sapnet-tau-exp4-0.5-episode-decay0.999");
+    }
+
+    #[test]
+    fn bad_knobs_are_located() {
+        let bad = |knobs: SapNetKnobs| knobs.validate("protocol.methods[1]").unwrap_err();
+        let decay = bad(SapNetKnobs {
+            decay: 0.0,
+            ..SapNetKnobs::default()
+        });
+        assert_eq!(
+            decay,
+            "field `protocol.methods[1].decay`: expected λ in (0, 1], got 0"
+        );
+        assert!(bad(SapNetKnobs {
+            decay: 1.5,
+            ..SapNetKnobs::default()
+        })
+        .contains("decay"));
+        assert!(bad(SapNetKnobs {
+            judgment: Judgment::KSteps(0),
+            ..SapNetKnobs::default()
+        })
+        .contains("`protocol.methods[1].judgment`"));
+        assert!(bad(SapNetKnobs {
+            temperature: Some(Schedule::Linear {
+                from: -1.0,
+                to: 1.0,
+                steps: 5
+            }),
+            ..SapNetKnobs::default()
+        })
+        .contains("`protocol.methods[1].temperature.from`"));
+    }
+}
