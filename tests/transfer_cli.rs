@@ -421,3 +421,81 @@ fn a_library_of_another_source_task_is_refused() {
     assert!(message.contains("source-0.ron was trained on"), "{message}");
     assert!(message.contains("--retrain"), "{message}");
 }
+
+#[test]
+fn every_method_runs_and_the_comparison_has_a_row_for_each() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    train_library(&library);
+    let out = tmp.path().join("out");
+    let output = sapnet(
+        &[
+            "--headless",
+            "--config",
+            &config("tiny_reuse.ron"),
+            "--jobs",
+            "2",
+        ],
+        &library,
+        &out,
+    );
+    assert!(output.status.success(), "{}", stderr(&output));
+    let methods = [
+        "sapnet",
+        "sapnet-episode-decay0.99",
+        "sapnet-tau-lin5-1-k5",
+        "random",
+        "random-episode",
+        "ucb1",
+        "prql[8]",
+        "best-source",
+        "dqn[8]",
+    ];
+    let comparison = std::fs::read_to_string(out.join("comparison.csv")).unwrap();
+    let rows: Vec<&str> = comparison.lines().skip(1).collect();
+    assert_eq!(rows.len(), methods.len(), "{comparison}");
+    for (row, method) in rows.iter().zip(methods) {
+        assert!(row.starts_with(&format!("{method},2,")), "{row}");
+    }
+    assert!(comparison.starts_with(
+        "method,runs,episodes_to_15,reached_15,episodes_to_500,reached_500,mean_return,"
+    ));
+    // The table on stdout names every method.
+    let table = String::from_utf8_lossy(&output.stdout);
+    assert!(methods.iter().all(|m| table.contains(m)), "{table}");
+
+    // Every reusing method writes its selector's state per episode; DQN does not.
+    let activations = std::fs::read_to_string(out.join("activations.csv")).unwrap();
+    for method in &methods[..8] {
+        let episodes = activations
+            .lines()
+            .filter(|l| l.split(',').nth(1) == Some(method))
+            .count();
+        assert_eq!(episodes, 2 * 12, "{method}");
+    }
+    assert!(!activations.contains(",dqn[8],"));
+    assert!(out.join("selections.png").exists());
+
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let runs = summary["runs"].as_array().unwrap();
+    let run_of = |method: &str| runs.iter().find(|r| r["method"] == method).unwrap();
+    // PRQ-learning's result is its own learner; the selectors' results are sources.
+    assert!(run_of("prql[8]")["chosen"].is_null());
+    assert_eq!(run_of("best-source")["chosen"]["score_name"], "score");
+    assert_eq!(run_of("sapnet")["chosen"]["score_name"], "A");
+    // BestSource always acts with the best-scored source, so it locks in at once.
+    let best = run_of("best-source");
+    let steps: Vec<u64> = best["source_steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_u64().unwrap())
+        .collect();
+    assert_eq!(steps.iter().filter(|&&s| s > 0).count(), 1, "{steps:?}");
+    assert_eq!(best["lock_in_step"], 3 * 20 + 1);
+    // Learning steps all acted by sources, after the 3 × 20 warm-up.
+    let total: u64 = steps.iter().sum();
+    assert_eq!(total, best["steps"].as_u64().unwrap() - 60);
+    assert_eq!(summary["comparison"].as_array().unwrap().len(), methods.len());
+}
