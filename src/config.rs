@@ -195,6 +195,15 @@ impl MethodKind {
     pub fn reuses(self) -> bool {
         self != Self::Dqn
     }
+
+    /// Whether the method picks sources with probabilities, so that lock-in (one source
+    /// above 0.99) is measured; UCB1 and a random source per episode pick by rule.
+    pub fn picks_by_probability(self) -> bool {
+        matches!(
+            self,
+            Self::SapNet | Self::Random | Self::Prql | Self::BestSource
+        )
+    }
 }
 
 impl Method {

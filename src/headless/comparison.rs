@@ -40,6 +40,8 @@ pub struct MethodComparison {
     /// and how many did.
     pub lock_in_median: Option<f64>,
     pub locked_runs: usize,
+    /// Whether the method picks by probabilities, so that lock-in is measured at all.
+    pub lock_in_measured: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -132,6 +134,7 @@ pub fn compare(
             ranks,
             lock_in_median: median(&locks),
             locked_runs: locks.len(),
+            lock_in_measured: method.kind.picks_by_probability(),
         });
     }
     out
@@ -268,7 +271,7 @@ pub fn table(rows: &[MethodComparison]) -> String {
         });
         line.push(match row.lock_in_median {
             Some(s) => format!("{s:.0} ({}/{})", row.locked_runs, row.runs),
-            None if row.source_shares.is_empty() => "-".into(),
+            None if !row.lock_in_measured => "-".into(),
             None => format!("never (0/{})", row.runs),
         });
         lines.push(line);
