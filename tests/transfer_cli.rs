@@ -497,5 +497,8 @@ fn every_method_runs_and_the_comparison_has_a_row_for_each() {
     // Learning steps all acted by sources, after the 3 × 20 warm-up.
     let total: u64 = steps.iter().sum();
     assert_eq!(total, best["steps"].as_u64().unwrap() - 60);
-    assert_eq!(summary["comparison"].as_array().unwrap().len(), methods.len());
+    assert_eq!(
+        summary["comparison"].as_array().unwrap().len(),
+        methods.len()
+    );
 }
