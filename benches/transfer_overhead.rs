@@ -50,7 +50,8 @@ fn sources(n: u64) -> Arc<Vec<SourcePolicy>> {
                 )
                 .expect("network"),
                 description: PolicyDescription::new(vec![100], "cartpole"),
-                final_score: None,
+                // Scores for the selectors that read them (BestSource picks source-3).
+                final_score: Some(if i == 3 { 500.0 } else { 10.0 + i as f64 }),
             })
             .collect(),
     )
@@ -236,7 +237,9 @@ criterion_group!(benches, overhead);
 /// `SAPNET_RUN_ONCE=dqn|sapnet|live cargo bench --bench transfer_overhead` runs that case
 /// once, on this thread, without criterion: for counting its instructions under
 /// `valgrind --tool=callgrind --separate-threads=yes`, which is repeatable where the
-/// machine's timings are not.
+/// machine's timings are not. Any other value is read as a method of `protocol.methods`
+/// (`Ucb1`, `Random`, `SapNetWith(judgment: Episode)`…) and run as the transfer case is,
+/// over the same ten sources.
 ///
 /// `SAPNET_AB_PAIRS=N cargo bench --bench transfer_overhead` times N pairs, in turn, of the
 /// headless run (results-only events, drained every 10 ms) and the TUI's (every step
@@ -258,7 +261,13 @@ fn main() {
             "live" => StreamOptions::live(),
             _ => StreamOptions::episodes(),
         };
-        let (dqn, transfer) = specs(stream, STEPS);
+        let (dqn, mut transfer) = specs(stream, STEPS);
+        if !matches!(case.as_str(), "dqn" | "sapnet" | "live") {
+            let method: Method = sapnet::config::parse_ron(&case, "SAPNET_RUN_ONCE")
+                .unwrap_or_else(|e| panic!("{e}"));
+            transfer.method = MethodId::new(0, &method);
+            transfer.reuse = method;
+        }
         drained(|e, c| match case.as_str() {
             "dqn" => drop(trainer::train(&dqn, e, c).expect("run")),
             _ => drop(trainer::train(&transfer, e, c).expect("run")),

@@ -44,6 +44,9 @@ fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
     if let Some(seed) = cli.run.seed {
         config.seed = seed;
     }
+    if let Some(episodes) = cli.run.episodes {
+        config.protocol.episodes = episodes;
+    }
     Ok(config)
 }
 
@@ -95,6 +98,9 @@ fn run_experiment(cli: &Cli) -> Result<()> {
             );
         }
         return run_dashboard(cli, &config);
+    }
+    if cli.run.follow.is_some() {
+        anyhow::bail!("--follow is for the dashboard: --headless runs every method");
     }
     let dir = match &cli.run.out {
         Some(dir) => dir.clone(),
@@ -155,15 +161,39 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     Ok(())
 }
 
-/// The dashboard follows the first run of the first SAP-Net method, step by step, beside
-/// the first run of the first DQN baseline, episode by episode; the library is loaded (or
-/// trained, with a progress bar) before the screen switches.
+/// The dashboard follows the first run of one reusing method (`--follow`, else the first
+/// SAP-Net method, else the first that reuses), step by step, beside the first run of the
+/// first DQN baseline, episode by episode; the library is loaded (or trained, with a
+/// progress bar) before the screen switches.
 fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
+    let ids = experiment::method_ids(config);
+    let followed = match &cli.run.follow {
+        Some(label) => {
+            let Some(id) = ids.iter().find(|m| m.label() == label.as_str()) else {
+                let labels: Vec<&str> = ids.iter().map(|m| m.label()).collect();
+                anyhow::bail!(
+                    "--follow {label}: the config has no such method; its methods are {}",
+                    labels.join(", ")
+                );
+            };
+            anyhow::ensure!(
+                id.kind.reuses(),
+                "--follow {label}: the dashboard follows a method that reuses the library; \
+                 the DQN baseline runs beside it anyway"
+            );
+            Some(id.clone())
+        }
+        None => ids
+            .iter()
+            .find(|m| m.kind == MethodKind::SapNet)
+            .or_else(|| ids.iter().find(|m| m.kind.reuses()))
+            .cloned(),
+    };
     let plan = experiment::plan(config, &cli.run.library, &on_interrupt()?)?;
     let transfer = plan
         .specs
         .iter()
-        .find(|s| s.run == 0 && s.method.kind == MethodKind::SapNet)
+        .find(|s| s.run == 0 && Some(&s.method) == followed.as_ref())
         .map(|s| {
             let mut spec = s.clone();
             spec.stream = StreamOptions::live();

@@ -49,6 +49,17 @@ pub struct RunArgs {
     #[arg(long)]
     pub quick: bool,
 
+    /// The dashboard trains and shows run 1 of this method (its label in results, e.g.
+    /// `ucb1`, `sapnet-episode`), beside the first DQN baseline. Default: the first
+    /// SAP-Net method, else the first that reuses the library.
+    #[arg(long, value_name = "METHOD")]
+    pub follow: Option<String>,
+
+    /// Training episodes per run, overriding the config's `protocol.episodes`: the first N
+    /// episodes of every run are exactly those of the full protocol (the same seeds).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub episodes: Option<u32>,
+
     /// With --headless: also write trace.csv, every spread call (eq. 9-11) of every
     /// positive activation of SAP-Net's runs, as teach mode shows them. One row per call:
     /// millions over a full protocol, so best with --quick or a small config.

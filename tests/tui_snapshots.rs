@@ -163,3 +163,40 @@ fn a_small_terminal_is_told_the_size_needed() {
     assert!(text.contains("80×24"), "{text}");
     insta::assert_snapshot!("too_small_60x20", terminal.backend());
 }
+
+#[test]
+fn another_selector_is_drawn_under_its_own_scores() {
+    // UCB1 followed instead of SAP-Net: the graph and table name its scores.
+    let mut start = tui_script::sapnet_start();
+    if let sapnet::trainer::Event::RunStarted { method, sapnet, .. } = &mut start {
+        *method = sapnet::trainer::MethodId::new(7, &sapnet::config::Method::Ucb1);
+        sapnet.as_mut().unwrap().score_name = "mean";
+    }
+    let mut d = Dashboard::new("CartPole-v1");
+    d.on_event(start);
+    d.on_event(tui_script::baseline_start());
+    let terminal = draw_dashboard(&d, (120, 40));
+    let buffer = terminal.backend().buffer();
+    let lines: Vec<String> = (0..buffer.area.height)
+        .map(|y| {
+            (0..buffer.area.width)
+                .map(|x| buffer[(x, y)].symbol())
+                .collect()
+        })
+        .collect();
+    let text = lines.join("\n");
+    assert!(text.contains("library graph · ucb1 (mean)"), "{text}");
+    assert!(!text.contains("SAP-Net graph"), "{text}");
+    let header = lines
+        .iter()
+        .find(|l| l.contains("P(π)"))
+        .expect("the table's header");
+    let columns: Vec<&str> = header
+        .split(|c| c == ' ' || c == '│')
+        .filter(|w| !w.is_empty())
+        .collect();
+    assert!(
+        columns.windows(2).any(|w| w == ["mean", "P(π)"]),
+        "{header}"
+    );
+}

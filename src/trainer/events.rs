@@ -131,12 +131,16 @@ pub struct SourceSummary {
     pub final_score: Option<f64>,
 }
 
-/// What a SAP-Net run starts from: its policies and the SAP-Net (graph, weights M,
-/// parameters and the initial activations), enough to draw the graph or teach on it.
+/// What a reusing run starts from: its policies and the SAP-Net over them (graph, weights
+/// M, parameters and the initial activations), enough to draw the graph or teach on it.
+/// For a selector that is not SAP-Net the graph is the library's under the config's
+/// `sapnet` section, drawn with the selector's own scores.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SapNetStart {
     pub policies: Vec<SourceSummary>,
     pub net: SapNet,
+    /// What the selector's scores are: `A` for SAP-Net's activations, else its own.
+    pub score_name: &'static str,
 }
 
 /// One environment step.
@@ -200,7 +204,7 @@ pub enum Event {
         run: u32,
         method: MethodId,
         planned_episodes: u32,
-        /// Present for SAP-Net runs.
+        /// Present for runs that reuse the library.
         sapnet: Option<Box<SapNetStart>>,
     },
     Step(StepRecord),

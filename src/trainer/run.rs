@@ -191,6 +191,36 @@ impl Learners<'_> {
     }
 }
 
+/// The library as front ends draw it: SAP-Net's own net, or for another selector the
+/// library's graph under the config's SAP-Net section (none without a library, or if that
+/// graph cannot be built).
+fn library_start(
+    spec: &RunSpec,
+    selector: &dyn Selector,
+    descriptions: &[PolicyDescription],
+) -> Option<Box<SapNetStart>> {
+    if spec.sources.is_empty() {
+        return None;
+    }
+    let net = match selector.sapnet() {
+        Some(net) => net.clone(),
+        None => crate::sapnet::SapNet::from_policies(descriptions, spec.sapnet.clone()).ok()?,
+    };
+    Some(Box::new(SapNetStart {
+        policies: spec
+            .sources
+            .iter()
+            .map(|s| SourceSummary {
+                name: s.name.clone(),
+                description: s.description.clone(),
+                final_score: s.final_score,
+            })
+            .collect(),
+        net,
+        score_name: selector.view().score_name,
+    }))
+}
+
 /// Trains `spec` for its episodes (or `spec.max_steps` steps, whichever comes first), then
 /// tests the result greedily: the chosen source, or the method's own learner. Sends the
 /// events of `spec.stream` and obeys `commands` (see [`Command`]); a [`Command::Stop`] (or
@@ -249,20 +279,7 @@ pub fn train(
         run: spec.run,
         method: spec.method.clone(),
         planned_episodes: spec.episodes,
-        sapnet: selector.sapnet().map(|net| {
-            Box::new(SapNetStart {
-                policies: spec
-                    .sources
-                    .iter()
-                    .map(|s| SourceSummary {
-                        name: s.name.clone(),
-                        description: s.description.clone(),
-                        final_score: s.final_score,
-                    })
-                    .collect(),
-                net: net.clone(),
-            })
-        }),
+        sapnet: library_start(spec, selector.as_ref(), &descriptions),
     });
     let mut record = RunRecord {
         run: spec.run,

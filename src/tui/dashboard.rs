@@ -124,6 +124,10 @@ pub struct PolicyRow {
 /// The SAP-Net run's live state.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SapNetView {
+    /// The method whose selector this is (`sapnet`, `ucb1`…).
+    pub method: String,
+    /// What the scores are: `A` for SAP-Net's activations, else the selector's own.
+    pub score_name: &'static str,
     pub policies: Vec<PolicyRow>,
     /// The graph and parameters, with the activations of the latest snapshot.
     pub net: SapNet,
@@ -252,6 +256,8 @@ impl Dashboard {
                 if let Some(start) = sapnet {
                     let n = start.net.len();
                     self.sapnet = Some(SapNetView {
+                        method: run.method.label().to_string(),
+                        score_name: start.score_name,
                         policies: start
                             .policies
                             .into_iter()

@@ -119,10 +119,15 @@ fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Th
                 lit: &lit,
                 walking: None,
             };
+            let graph_title = if view.score_name == "A" {
+                "SAP-Net graph".to_string()
+            } else {
+                format!("library graph · {} ({})", view.method, view.score_name)
+            };
             graph_view::draw(
                 frame,
                 graph,
-                focus_block("SAP-Net graph", dashboard.focus == Focus::Graph),
+                focus_block(&graph_title, dashboard.focus == Focus::Graph),
                 scene,
                 theme,
             );
@@ -234,7 +239,15 @@ fn draw_policy_table(
     });
     let (header, widths) = if full {
         (
-            vec!["policy", "hidden", "cat", "A", "P(π)", "acted", "+/−"],
+            vec![
+                "policy",
+                "hidden",
+                "cat",
+                view.score_name,
+                "P(π)",
+                "acted",
+                "+/−",
+            ],
             vec![
                 Constraint::Length(9),
                 Constraint::Length(14),
@@ -247,7 +260,7 @@ fn draw_policy_table(
         )
     } else {
         (
-            vec!["policy", "A", "P(π)", "acted"],
+            vec!["policy", view.score_name, "P(π)", "acted"],
             vec![
                 Constraint::Length(9),
                 Constraint::Length(9),

@@ -54,6 +54,7 @@ pub fn sapnet_start() -> Event {
                 })
                 .collect(),
             net,
+            score_name: "A",
         })),
     }
 }
