@@ -192,7 +192,7 @@ fn another_selector_is_drawn_under_its_own_scores() {
         .find(|l| l.contains("P(π)"))
         .expect("the table's header");
     let columns: Vec<&str> = header
-        .split(|c| c == ' ' || c == '│')
+        .split([' ', '│'])
         .filter(|w| !w.is_empty())
         .collect();
     assert!(
