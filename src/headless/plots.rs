@@ -229,7 +229,7 @@ fn learning_curve<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotD
 }
 
 /// Fig. 6/8: the return of each greedy test episode, averaged over runs, as bars grouped
-/// by test and coloured by method.
+/// by test and coloured by method, with ± one standard deviation over runs.
 fn test_bars<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotData) -> Drawn<DB> {
     root.fill(&WHITE)?;
     let tested: Vec<(usize, &Curve, Vec<f64>)> = data
@@ -289,6 +289,14 @@ fn test_bars<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotData) 
             }))?
             .label(curve.label.clone())
             .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 14, y + 6)], colour.filled()));
+        // ± one standard deviation over runs, where there are runs to differ.
+        if curve.tests.len() > 1 {
+            let spread = std_over_runs(&curve.tests);
+            chart.draw_series(means.iter().zip(&spread).enumerate().map(|(t, (&m, &sd))| {
+                let x = left(t) + width * 0.45;
+                ErrorBar::new_vertical(x, (m - sd).max(low), m, (m + sd).min(high), BLACK, 6)
+            }))?;
+        }
     }
     chart
         .configure_series_labels()
@@ -486,6 +494,14 @@ mod tests {
     }
 
     #[test]
+    fn spreads_are_sample_deviations_over_the_runs_that_reach_each_index() {
+        // Index 0: 1 and 3 → mean 2, (1 + 1)/1 → 1.4142; index 1: one run → 0.
+        let spread = std_over_runs(&[vec![1.0, 5.0], vec![3.0]]);
+        assert!((spread[0] - 2f64.sqrt()).abs() < 1e-12);
+        assert_eq!(spread[1], 0.0);
+    }
+
+    #[test]
     fn ranges_have_room() {
         assert_eq!(value_range([].into_iter()), (0.0, 1.0));
         assert_eq!(value_range([5.0].into_iter()), (4.0, 6.0));
@@ -504,7 +520,7 @@ mod tests {
                     label: "sapnet".into(),
                     sapnet: true,
                     returns: vec![vec![10.0, 20.0, 30.0], vec![12.0, 18.0]],
-                    tests: vec![vec![100.0, 90.0]],
+                    tests: vec![vec![100.0, 90.0], vec![80.0, 95.0]],
                 },
                 Curve {
                     label: "dqn[100]".into(),

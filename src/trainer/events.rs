@@ -5,7 +5,7 @@
 //! [`StreamOptions::steps`] is on) and for every positive activation a `Trace` (only while
 //! tracing is on), an `Activations` snapshot at most every
 //! [`StreamOptions::snapshot_interval`] (every step while paused or throttled, and always
-//! just before each `EpisodeEnded` of a SAP-Net run), then `EpisodeEnded` per episode and
+//! just before each `EpisodeEnded` of a run that reuses the library), then `EpisodeEnded` per episode and
 //! `RunEnded` last.
 
 use std::fmt;

@@ -56,7 +56,7 @@ pub enum Focus {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Action {
     None,
-    /// Send this to the SAP-Net run (or the only run).
+    /// Send this to the followed run (or the only run).
     Send(Command),
     /// Pause or resume every run.
     SendAll(Command),
@@ -121,7 +121,8 @@ pub struct PolicyRow {
     pub final_score: Option<f64>,
 }
 
-/// The SAP-Net run's live state.
+/// The followed reusing run's live state: SAP-Net's, or another selector's drawn on the
+/// library's graph.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SapNetView {
     /// The method whose selector this is (`sapnet`, `ucb1`…).
@@ -209,7 +210,7 @@ pub struct Dashboard {
     /// The policy the arrows point at.
     pub cursor: usize,
     pub speed: usize,
-    /// The SAP-Net run (first) and the baselines, in the order they started.
+    /// The followed reusing run (first) and the baselines, in the order they started.
     pub runs: Vec<RunView>,
     pub sapnet: Option<SapNetView>,
     /// Steps of the followed run (SAP-Net if any).

@@ -56,7 +56,8 @@ fn open_terminal() -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
 /// A run the dashboard drives: its commands, and the thread to join at the end.
 pub struct Driven {
     pub handle: RunHandle,
-    /// Whether pause, step and speed go to this run (the SAP-Net run, or the only one).
+    /// Whether pause, step and speed go to this run (the followed reusing run, or the only
+    /// one).
     pub leads: bool,
 }
 

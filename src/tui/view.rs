@@ -154,7 +154,7 @@ fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Th
     draw_loss(frame, loss, dashboard.main_run(), theme);
 }
 
-/// "policies", and once SAP-Net's run has ended, the policy it chose (Algorithm 3: the
+/// "policies", and once the followed run has ended, the source it chose (SAP-Net: the
 /// highest activation) and that policy's greedy test returns (their mean, if the list does
 /// not fit in `width`).
 fn policies_title(dashboard: &Dashboard, width: u16) -> String {
