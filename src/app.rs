@@ -25,7 +25,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Plot(args)) => {
             headless::replot(&args.dir)?;
             eprintln!(
-                "plots in {}: learning_curve.png, learning_curve.svg, tests.png, activations.png",
+                "plots in {}: learning_curve.png, learning_curve.svg, tests.png, activations.png, selections.png",
                 args.dir.display()
             );
             Ok(())

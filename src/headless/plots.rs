@@ -95,23 +95,34 @@ fn register_font() -> Result<()> {
     result
 }
 
-/// SAP-Net red, then the paper's blue, orange and green for the baselines in the order
-/// they are listed.
+/// SAP-Net in the paper's red (its variants in other reds and pinks), then the paper's blue,
+/// orange and green for the other methods in the order they are listed.
 fn method_colour(curves: &[Curve], i: usize) -> RGBColor {
-    const BASELINES: [RGBColor; 6] = [
+    const SAPNETS: [RGBColor; 5] = [
+        RGBColor(214, 39, 40),
+        RGBColor(255, 152, 150),
+        RGBColor(140, 20, 25),
+        RGBColor(227, 119, 194),
+        RGBColor(247, 182, 210),
+    ];
+    const OTHERS: [RGBColor; 8] = [
         RGBColor(31, 119, 180),
         RGBColor(255, 127, 14),
         RGBColor(44, 160, 44),
         RGBColor(148, 103, 189),
         RGBColor(140, 86, 75),
         RGBColor(127, 127, 127),
+        RGBColor(23, 190, 207),
+        RGBColor(188, 189, 34),
     ];
-    let is_sapnet = |c: &Curve| c.sapnet;
-    if is_sapnet(&curves[i]) {
-        RGBColor(214, 39, 40)
+    let same_kind = curves[..i]
+        .iter()
+        .filter(|c| c.sapnet == curves[i].sapnet)
+        .count();
+    if curves[i].sapnet {
+        SAPNETS[same_kind % SAPNETS.len()]
     } else {
-        let baseline = curves[..i].iter().filter(|c| !is_sapnet(c)).count();
-        BASELINES[baseline % BASELINES.len()]
+        OTHERS[same_kind % OTHERS.len()]
     }
 }
 
@@ -203,7 +214,7 @@ fn learning_curve<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, data: &PlotD
                 .collect();
             chart.draw_series(std::iter::once(Polygon::new(
                 band,
-                colour.mix(0.18).filled(),
+                colour.mix(0.12).filled(),
             )))?;
         }
         chart
