@@ -162,9 +162,9 @@ fn run_experiment(cli: &Cli) -> Result<()> {
 }
 
 /// The dashboard follows the first run of one reusing method (`--follow`, else the first
-/// SAP-Net method, else the first that reuses), step by step, beside the first run of the
-/// first DQN baseline, episode by episode; the library is loaded (or trained, with a
-/// progress bar) before the screen switches.
+/// SAP-Net method, else the first that reuses; `m` moves to the next), step by step,
+/// beside the first run of the first DQN baseline, episode by episode; the library is
+/// loaded (or trained, with a progress bar) before the screen switches.
 fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
     let ids = experiment::method_ids(config);
     let followed = match &cli.run.follow {
@@ -190,31 +190,34 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
             .cloned(),
     };
     let plan = experiment::plan(config, &cli.run.library, &on_interrupt()?)?;
-    let transfer = plan
+    let followable: Vec<_> = plan
         .specs
         .iter()
-        .find(|s| s.run == 0 && Some(&s.method) == followed.as_ref())
+        .filter(|s| s.run == 0 && s.method.kind.reuses())
         .map(|s| {
             let mut spec = s.clone();
             spec.stream = StreamOptions::live();
             spec
-        });
+        })
+        .collect();
+    let first = followable
+        .iter()
+        .position(|s| Some(&s.method) == followed.as_ref())
+        .unwrap_or(0);
     let baseline = plan
         .specs
         .iter()
         .find(|s| s.run == 0 && s.method.kind == MethodKind::Dqn)
         .cloned();
-    let (events_tx, events) = mpsc::channel();
-    let mut runs = Vec::new();
-    for spec in transfer.into_iter().chain(baseline) {
-        let leads = runs.is_empty();
-        let handle =
-            trainer::spawn(spec, events_tx.clone()).context("starting a trainer thread")?;
-        runs.push(tui::Driven { handle, leads });
-    }
-    drop(events_tx);
     let task = env::make(&config.env).id().to_string();
-    tui::run_dashboard(&task, runs, events)?;
+    tui::run_dashboard(
+        &task,
+        tui::DashboardRuns {
+            followable,
+            followed: first,
+            baseline,
+        },
+    )?;
     eprintln!(
         "the dashboard keeps no files: `sapnet --headless --out DIR` writes the whole \
          protocol's results"

@@ -191,10 +191,7 @@ fn another_selector_is_drawn_under_its_own_scores() {
         .iter()
         .find(|l| l.contains("P(π)"))
         .expect("the table's header");
-    let columns: Vec<&str> = header
-        .split([' ', '│'])
-        .filter(|w| !w.is_empty())
-        .collect();
+    let columns: Vec<&str> = header.split([' ', '│']).filter(|w| !w.is_empty()).collect();
     assert!(
         columns.windows(2).any(|w| w == ["mean", "P(π)"]),
         "{header}"

@@ -154,3 +154,49 @@ fn help_opens_on_question_mark_and_any_key_closes_it_but_q_quits_always() {
         Action::Quit
     );
 }
+
+#[test]
+fn m_follows_the_next_method_and_late_events_of_the_old_one_are_left_out() {
+    let mut d = scripted(10);
+    d.follow("sapnet");
+    assert_eq!(d.on_key(key('m')), Action::FollowNext);
+    // The UI stops SAP-Net's run and starts UCB1's: the old run leaves the screen.
+    d.follow("ucb1");
+    assert!(d.sapnet.is_none());
+    let methods: Vec<&str> = d.runs.iter().map(|r| r.method.label()).collect();
+    assert_eq!(methods, ["dqn[100]"]);
+    // SAP-Net's late events change nothing.
+    for event in tui_script::episodes(3) {
+        d.on_event(event);
+    }
+    d.on_event(tui_script::sapnet_start());
+    assert!(d.sapnet.is_none());
+    assert_eq!(d.runs.len(), 1);
+    // UCB1's start takes the followed place, under its own scores.
+    let mut start = tui_script::sapnet_start();
+    if let sapnet::trainer::Event::RunStarted { method, sapnet, .. } = &mut start {
+        *method = sapnet::trainer::MethodId::new(7, &sapnet::config::Method::Ucb1);
+        sapnet.as_mut().unwrap().score_name = "mean";
+    }
+    d.on_event(start);
+    let view = d.sapnet.as_ref().unwrap();
+    assert_eq!((view.method.as_str(), view.score_name), ("ucb1", "mean"));
+    assert_eq!(d.runs[0].method.label(), "ucb1");
+    // A paused dashboard starts the new run paused, at its speed.
+    d.on_key(key(' '));
+    d.on_key(key('-'));
+    assert_eq!(d.settings(), [Command::Throttle(SPEEDS[1]), Command::Pause]);
+}
+
+#[test]
+fn a_step_count_that_goes_back_restarts_the_speedometer() {
+    let mut d = scripted(10);
+    let t0 = std::time::Instant::now();
+    d.tick(t0);
+    d.tick(t0 + Duration::from_secs(1));
+    assert!(d.steps_per_second.is_some());
+    // The next method's run starts at step 1, while late steps of the old one came last.
+    d.step = 3;
+    d.tick(t0 + Duration::from_millis(1500));
+    assert_eq!(d.steps_per_second, None);
+}

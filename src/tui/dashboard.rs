@@ -60,6 +60,8 @@ pub enum Action {
     Send(Command),
     /// Pause or resume every run.
     SendAll(Command),
+    /// Stop following this method's run and follow the next method's run 1 instead.
+    FollowNext,
     Quit,
 }
 
@@ -219,6 +221,9 @@ pub struct Dashboard {
     pub steps_per_second: Option<f64>,
     speedometer: VecDeque<(Instant, u64)>,
     pub teach: Option<Teach>,
+    /// The method whose run the dashboard follows, once the UI has said which: events of
+    /// a run it stopped following are then left out.
+    pub followed: Option<String>,
 }
 
 impl Dashboard {
@@ -236,7 +241,36 @@ impl Dashboard {
             steps_per_second: None,
             speedometer: VecDeque::new(),
             teach: None,
+            followed: None,
         }
+    }
+
+    /// Follows the run of `method` from now on: the run followed so far leaves the screen
+    /// (its late events are left out), the new one takes its place when it starts.
+    pub fn follow(&mut self, method: &str) {
+        if self.sapnet.take().is_some() && !self.runs.is_empty() {
+            self.runs.remove(0);
+        }
+        self.followed = Some(method.to_string());
+        self.step = 0;
+        self.steps_per_second = None;
+        self.speedometer.clear();
+        self.cursor = 0;
+    }
+
+    /// What the followed run must be told so that it runs as the screen says: paused, and at
+    /// the chosen speed.
+    pub fn settings(&self) -> Vec<Command> {
+        let mut commands = vec![Command::Throttle(SPEEDS[self.speed])];
+        if self.mode == Mode::Paused {
+            commands.push(Command::Pause);
+        }
+        commands
+    }
+
+    /// A run of a method the dashboard no longer follows.
+    fn is_stale(&self, method: &MethodId, reuses: bool) -> bool {
+        reuses && self.followed.as_ref().is_some_and(|f| f != method.label())
     }
 
     /// The run the status bar follows: SAP-Net's if there is one, else the first.
@@ -253,6 +287,9 @@ impl Dashboard {
                 sapnet,
                 ..
             } => {
+                if self.is_stale(&method, sapnet.is_some()) {
+                    return;
+                }
                 let run = RunView::new(method, planned_episodes);
                 if let Some(start) = sapnet {
                     let n = start.net.len();
@@ -335,6 +372,10 @@ impl Dashboard {
         let Some(view) = &mut self.sapnet else {
             return;
         };
+        // A late snapshot of a run no longer followed.
+        if snapshot.method.label() != view.method {
+            return;
+        }
         // A snapshot always comes from the net announced at the start, so the counts agree.
         if view.net.set_activations(snapshot.activations).is_ok() {
             view.probabilities = snapshot.probabilities;
@@ -347,6 +388,15 @@ impl Dashboard {
 
     /// Records the step count at `now` for the steps/s figure (over the last 2 s).
     pub fn tick(&mut self, now: Instant) {
+        // A count that went back belongs to a new run (`m`): measure it afresh.
+        if self
+            .speedometer
+            .back()
+            .is_some_and(|&(_, step)| step > self.step)
+        {
+            self.speedometer.clear();
+            self.steps_per_second = None;
+        }
         self.speedometer.push_back((now, self.step));
         while self
             .speedometer
@@ -402,6 +452,7 @@ impl Dashboard {
                 }
             },
             KeyCode::Char('n') if self.mode == Mode::Paused => Action::Send(Command::Step),
+            KeyCode::Char('m') => Action::FollowNext,
             KeyCode::Char('+') | KeyCode::Char('=') => self.set_speed(self.speed.saturating_sub(1)),
             KeyCode::Char('-') => self.set_speed((self.speed + 1).min(SPEEDS.len() - 1)),
             KeyCode::Tab => {

@@ -15,13 +15,13 @@ pub mod teach;
 pub mod theme;
 pub mod view;
 
-use std::sync::mpsc::Receiver;
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use crossterm::event::{self as term, KeyEventKind};
 
-use crate::trainer::{Command, Event, RunHandle};
+use crate::trainer::{self, Command, RunHandle, RunSpec};
 use dashboard::{apply_teach_key, Action, Dashboard};
 use teach::Teach;
 use theme::Theme;
@@ -54,17 +54,46 @@ fn open_terminal() -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
 }
 
 /// A run the dashboard drives: its commands, and the thread to join at the end.
-pub struct Driven {
-    pub handle: RunHandle,
+struct Driven {
+    handle: RunHandle,
     /// Whether pause, step and speed go to this run (the followed reusing run, or the only
     /// one).
-    pub leads: bool,
+    leads: bool,
+}
+
+/// What the dashboard trains: the run it follows step by step, chosen among one run per
+/// reusing method (`m` moves to the next), and a baseline beside it.
+pub struct DashboardRuns {
+    /// Run 1 of each method the dashboard can follow, streaming every step.
+    pub followable: Vec<RunSpec>,
+    /// The one followed first.
+    pub followed: usize,
+    /// Trained beside it, episode by episode (the first DQN baseline).
+    pub baseline: Option<RunSpec>,
 }
 
 /// Runs the dashboard until the user quits, then stops and joins the runs.
-pub fn run_dashboard(task: &str, runs: Vec<Driven>, events: Receiver<Event>) -> Result<()> {
+pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
     let theme = Theme::from_env();
     let mut dashboard = Dashboard::new(task);
+    let (events_tx, events) = mpsc::channel();
+    let mut runs: Vec<Driven> = Vec::new();
+    let mut followed = plan.followed;
+    if let Some(spec) = plan.followable.get(followed) {
+        dashboard.follow(spec.method.label());
+        let handle =
+            trainer::spawn(spec.clone(), events_tx.clone()).context("starting a trainer thread")?;
+        runs.push(Driven {
+            handle,
+            leads: true,
+        });
+    }
+    if let Some(spec) = plan.baseline {
+        let handle =
+            trainer::spawn(spec, events_tx.clone()).context("starting a trainer thread")?;
+        let leads = runs.is_empty();
+        runs.push(Driven { handle, leads });
+    }
     let (mut terminal, guard) = open_terminal()?;
     let result = (|| -> Result<()> {
         loop {
@@ -97,6 +126,26 @@ pub fn run_dashboard(task: &str, runs: Vec<Driven>, events: Receiver<Event>) -> 
                         let _ = run.handle.commands.send(command);
                     }
                 }
+                Action::FollowNext if plan.followable.len() > 1 => {
+                    // The run followed so far stops; it is joined with the others at the end.
+                    for run in runs.iter_mut().filter(|r| r.leads) {
+                        let _ = run.handle.commands.send(Command::Stop);
+                        run.leads = false;
+                    }
+                    followed = (followed + 1) % plan.followable.len();
+                    let spec = plan.followable[followed].clone();
+                    dashboard.follow(spec.method.label());
+                    let handle = trainer::spawn(spec, events_tx.clone())
+                        .context("starting a trainer thread")?;
+                    for command in dashboard.settings() {
+                        let _ = handle.commands.send(command);
+                    }
+                    runs.push(Driven {
+                        handle,
+                        leads: true,
+                    });
+                }
+                Action::FollowNext => {}
             }
         }
     })();

@@ -498,6 +498,7 @@ const HELP: &[(&str, &str)] = &[
     ),
     ("tab", "move focus between the graph and the table"),
     ("↑↓←→ hjkl", "pick a policy"),
+    ("m", "follow the next reusing method's run"),
     ("t", "teach mode on the live graph (pauses training)"),
     ("t / Esc", "teach: back to the paused dashboard"),
     ("a", "teach: activate the picked policy (A += 𝒜, eq. 8)"),
