@@ -418,8 +418,22 @@ impl Config {
         self.sapnet
             .validate()
             .map_err(|e| format!("section `sapnet`: {e}"))?;
+        // A negative transition activates with 0 (Algorithm 3): 𝒜 ≤ 0 would never credit a
+        // good step, and no selection could follow learning.
+        check(
+            self.sapnet.coefficient > 0.0,
+            "sapnet.coefficient",
+            "a finite number > 0 (𝒜 activates a policy after a positive transition)",
+            self.sapnet.coefficient,
+        )?;
         let src = &self.sources;
         check(src.count > 0, "sources.count", "at least 1", src.count)?;
+        check(
+            src.training_episodes > 0,
+            "sources.training_episodes",
+            "at least 1 (0 would write an untrained library)",
+            src.training_episodes,
+        )?;
         check(
             src.hidden_layers.0 >= 1 && src.hidden_layers.0 <= src.hidden_layers.1,
             "sources.hidden_layers",
@@ -434,6 +448,20 @@ impl Config {
         )?;
         let p = &self.protocol;
         check(p.runs > 0, "protocol.runs", "at least 1", p.runs)?;
+        check(
+            p.episodes > 0,
+            "protocol.episodes",
+            "at least 1",
+            p.episodes,
+        )?;
+        if let Some(steps) = p.max_steps {
+            check(
+                steps > 0,
+                "protocol.max_steps",
+                "None or Some(n) with n ≥ 1",
+                "Some(0)",
+            )?;
+        }
         check(
             p.moving_average > 0,
             "protocol.moving_average",
@@ -528,6 +556,22 @@ fn check_dqn(d: &DqnConfig, prefix: &str) -> Result<(), String> {
         &format!("{prefix}.update_interval"),
         "at least 1",
         d.update_interval,
+    )?;
+    check(
+        d.gradient_steps > 0,
+        &format!("{prefix}.gradient_steps"),
+        "at least 1 (0 never learns)",
+        d.gradient_steps,
+    )?;
+    check(
+        d.replay_start_size <= d.replay_capacity,
+        &format!("{prefix}.replay_start_size"),
+        &format!(
+            "at most {prefix}.replay_capacity ({}): a buffer that never holds that many \
+             never starts learning",
+            d.replay_capacity
+        ),
+        d.replay_start_size,
     )?;
     check(
         d.target_update_interval > 0,

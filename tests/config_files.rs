@@ -125,3 +125,32 @@ fn prototype_weights_that_would_make_a_distance_nonpositive_are_refused() {
     let err = Config::from_ron(text, "bad.ron").unwrap_err();
     assert!(err.to_string().contains("delta"), "{err}");
 }
+
+#[test]
+fn configs_that_cannot_work_are_refused_with_the_field() {
+    for (text, field) in [
+        ("(protocol: (episodes: 0))", "protocol.episodes"),
+        ("(protocol: (max_steps: Some(0)))", "protocol.max_steps"),
+        ("(dqn: (gradient_steps: 0))", "dqn.gradient_steps"),
+        (
+            "(dqn: (replay_capacity: 100, replay_start_size: 101))",
+            "dqn.replay_start_size",
+        ),
+        (
+            "(sources: (dqn: Some(gradient_steps: 0)))",
+            "sources.dqn.gradient_steps",
+        ),
+        (
+            "(sources: (training_episodes: 0))",
+            "sources.training_episodes",
+        ),
+        ("(sapnet: (coefficient: 0.0))", "sapnet.coefficient"),
+        ("(sapnet: (coefficient: -1.0))", "sapnet.coefficient"),
+    ] {
+        let err = Config::from_ron(text, "bad.ron").unwrap_err().to_string();
+        assert!(
+            err.starts_with("config bad.ron: field `") && err.contains(&format!("`{field}`")),
+            "{text}: {err}"
+        );
+    }
+}
