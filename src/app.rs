@@ -2,7 +2,6 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::time::{SystemTime, UNIX_EPOCH};
 
@@ -70,6 +69,8 @@ fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
                 n.saturating_sub(1)
             );
         }
+        // SIGTERM or SIGHUP end teach mode as `q` does, the terminal restored.
+        let _stop = crate::signals::stop_on_signals()?;
         let mut teach = Teach::new(lesson.names, lesson.net);
         for &i in &args.activate {
             teach.move_cursor(i as isize - teach.cursor() as isize);
@@ -237,19 +238,10 @@ fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
     Ok(())
 }
 
-/// The trainer's command channel, on which Ctrl-C asks it to stop. The handler keeps the
-/// sender for the life of the process.
+/// The trainer's command channel, on which SIGINT (Ctrl-C), SIGTERM and SIGHUP ask it to
+/// stop.
 fn on_interrupt() -> Result<mpsc::Receiver<trainer::Command>> {
-    let (sender, commands) = mpsc::channel();
-    let interrupted = AtomicBool::new(false);
-    ctrlc::set_handler(move || {
-        if !interrupted.swap(true, Ordering::Relaxed) {
-            eprintln!("\ninterrupted: finishing the current step");
-        }
-        let _ = sender.send(trainer::Command::Stop);
-    })
-    .context("installing the Ctrl-C handler")?;
-    Ok(commands)
+    crate::signals::stop_on_signals()
 }
 
 /// `out/<config stem>-<unix seconds>`: a new directory per run, so the default never

@@ -26,6 +26,7 @@ pub mod random_episodes;
 pub mod reuse;
 pub mod sapnet;
 pub mod seeds;
+pub mod signals;
 pub mod sources;
 pub mod teach;
 pub mod trainer;

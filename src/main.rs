@@ -16,14 +16,21 @@ fn main() -> ExitCode {
         std::env::set_var("RAYON_NUM_THREADS", "1");
     }
     let cli = Cli::parse();
-    match sapnet::app::run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
+    let result = sapnet::app::run(cli);
+    if let Err(err) = &result {
         // `sapnet teach --headless --json | head`: the reader left, nothing to report.
-        Err(err) if is_broken_pipe(&err) => ExitCode::SUCCESS,
-        Err(err) => {
-            eprintln!("error: {err:#}");
-            ExitCode::from(2)
+        if is_broken_pipe(err) {
+            return ExitCode::SUCCESS;
         }
+        eprintln!("error: {err:#}");
+    }
+    // A run stopped by a signal wrote what it had; the exit code says which signal.
+    if let Some(signal) = sapnet::signals::received() {
+        return ExitCode::from(sapnet::signals::exit_code(signal));
+    }
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(_) => ExitCode::from(2),
     }
 }
 

@@ -11,7 +11,10 @@ struct Session(String);
 
 impl Session {
     fn start(width: u16, height: u16, command: &str) -> Self {
-        let name = format!("sapnet-e2e-{}", std::process::id());
+        // One session per test, tests of this file running side by side.
+        static SESSIONS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let k = SESSIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let name = format!("sapnet-e2e-{}-{k}", std::process::id());
         let status = Command::new("tmux")
             .args(["new-session", "-d", "-s", &name])
             .args(["-x", &width.to_string(), "-y", &height.to_string()])
@@ -101,5 +104,43 @@ fn a_user_pauses_steps_teaches_and_quits() {
     assert!(
         !screen.contains("SAP-Net graph"),
         "the alternate screen was left:\n{screen}"
+    );
+}
+
+#[test]
+fn sigterm_leaves_the_dashboard_with_the_terminal_restored() {
+    if Command::new("tmux").arg("-V").output().is_err() {
+        eprintln!("tmux is not installed: the SIGTERM test is skipped (.ci/run installs it)");
+        return;
+    }
+    let library = Path::new(env!("CARGO_MANIFEST_DIR")).join("saved_policies");
+    // The seed marks this process apart from the other test's.
+    let command = format!(
+        "{} --library {} --seed 4242; echo SAPNET-EXITED $?; stty -a | grep -o -- '-*icanon'; sleep 60",
+        env!("CARGO_BIN_EXE_sapnet"),
+        library.display()
+    );
+    let session = Session::start(120, 40, &command);
+    session.wait_for(&["SAP-Net graph", "RUNNING"]);
+    // Anchored, so that the pane's shell, whose command line holds the same words, lives.
+    let pattern = format!(
+        "^{} --library {} --seed 4242$",
+        env!("CARGO_BIN_EXE_sapnet"),
+        library.display()
+    );
+    let killed = Command::new("pkill")
+        .args(["-TERM", "-f", &pattern])
+        .status()
+        .expect("running pkill");
+    assert!(killed.success(), "no dashboard process found");
+    let screen = session.wait_for(&["SAPNET-EXITED 143"]);
+    assert!(
+        !screen.contains("SAP-Net graph"),
+        "the alternate screen was left:\n{screen}"
+    );
+    // Raw mode is off again: the terminal reads lines (`icanon`, not `-icanon`).
+    assert!(
+        screen.lines().any(|l| l.trim() == "icanon"),
+        "raw mode was left on:\n{screen}"
     );
 }

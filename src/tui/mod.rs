@@ -100,6 +100,10 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
             for event in events.try_iter() {
                 dashboard.on_event(event);
             }
+            // SIGTERM or SIGHUP: leave as `q` does, the terminal restored.
+            if crate::signals::received().is_some() {
+                return Ok(());
+            }
             dashboard.tick(Instant::now());
             terminal
                 .draw(|frame| view::draw_dashboard(frame, &dashboard, theme))
@@ -169,9 +173,15 @@ pub fn run_teach(mut teach: Teach) -> Result<()> {
     let (mut terminal, _guard) = open_terminal()?;
     let mut help = false;
     loop {
+        if crate::signals::received().is_some() {
+            return Ok(());
+        }
         terminal
             .draw(|frame| view::draw_teach(frame, &teach, help, theme))
             .context("drawing teach mode")?;
+        if !term::poll(FRAME).context("reading the keyboard")? {
+            continue;
+        }
         let term::Event::Key(key) = term::read().context("reading the keyboard")? else {
             continue;
         };

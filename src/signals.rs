@@ -1,0 +1,70 @@
+//! SIGINT, SIGTERM and SIGHUP: each asks the runs to stop after their current step, so
+//! that what they did is written; the process then exits with 128 + the signal's number
+//! (130, 143, 129), as shells expect of an interrupted command.
+
+use std::sync::atomic::{AtomicI32, Ordering};
+use std::sync::mpsc::{self, Receiver};
+use std::thread;
+
+use anyhow::{Context, Result};
+use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+use signal_hook::iterator::Signals;
+
+use crate::trainer::Command;
+
+/// The first signal received, 0 before any.
+static RECEIVED: AtomicI32 = AtomicI32::new(0);
+
+/// Starts listening: every signal sends [`Command::Stop`] on the returned channel. The
+/// listening thread keeps the sender for the life of the process.
+pub fn stop_on_signals() -> Result<Receiver<Command>> {
+    let (sender, commands) = mpsc::channel();
+    let mut signals =
+        Signals::new([SIGINT, SIGTERM, SIGHUP]).context("installing the signal handlers")?;
+    thread::Builder::new()
+        .name("signals".into())
+        .spawn(move || {
+            for signal in signals.forever() {
+                if RECEIVED.swap(signal, Ordering::SeqCst) == 0 {
+                    eprintln!("\n{}: finishing the current step", name(signal));
+                }
+                let _ = sender.send(Command::Stop);
+            }
+        })
+        .context("starting the signal thread")?;
+    Ok(commands)
+}
+
+/// The first signal received, if any.
+pub fn received() -> Option<i32> {
+    match RECEIVED.load(Ordering::SeqCst) {
+        0 => None,
+        signal => Some(signal),
+    }
+}
+
+/// The exit code of a process that `signal` stopped: 128 + its number.
+pub fn exit_code(signal: i32) -> u8 {
+    u8::try_from(128 + signal).unwrap_or(u8::MAX)
+}
+
+fn name(signal: i32) -> &'static str {
+    match signal {
+        SIGINT => "interrupted",
+        SIGTERM => "terminated (SIGTERM)",
+        SIGHUP => "hung up (SIGHUP)",
+        _ => "signalled",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exit_codes_follow_the_shells_convention() {
+        assert_eq!(exit_code(SIGINT), 130);
+        assert_eq!(exit_code(SIGTERM), 143);
+        assert_eq!(exit_code(SIGHUP), 129);
+    }
+}

@@ -1,0 +1,95 @@
+//! SIGINT, SIGTERM and SIGHUP stop a headless run after its current step: everything it did
+//! is written, and the exit code is 128 + the signal (130, 143, 129), in headless runs and
+//! library training alike.
+
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A DQN that would train for hours: only a signal ends it.
+const ENDLESS: &str = "(protocol: (episodes: 1000000, runs: 1, methods: [Dqn(hidden: [8])]))";
+
+fn start(args: &[&str], dir: &Path) -> Child {
+    let config = dir.join("endless.ron");
+    std::fs::write(&config, ENDLESS).unwrap();
+    Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args(args)
+        .arg("--config")
+        .arg(&config)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Waits until `ready` holds (at most 60 s), then sends `signal` with kill(1).
+fn signal_when(child: &Child, signal: &str, ready: impl Fn() -> bool) {
+    let started = Instant::now();
+    while !ready() {
+        assert!(started.elapsed() < Duration::from_secs(60), "never ready");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let status = Command::new("kill")
+        .arg(format!("-{signal}"))
+        .arg(child.id().to_string())
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
+fn episodes_written(out: &Path) -> usize {
+    std::fs::read_to_string(out.join("episodes.csv")).map_or(0, |t| t.lines().count())
+}
+
+#[test]
+fn a_signalled_headless_run_writes_what_it_did_and_exits_128_plus_the_signal() {
+    for (signal, code, said) in [
+        ("TERM", 143, "terminated (SIGTERM)"),
+        ("INT", 130, "interrupted"),
+        ("HUP", 129, "hung up (SIGHUP)"),
+    ] {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("out");
+        let child = start(&["--headless", "--out", out.to_str().unwrap()], tmp.path());
+        signal_when(&child, signal, || episodes_written(&out) > 3);
+        let output = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(code), "{signal}: {stderr}");
+        assert!(stderr.contains(said), "{stderr}");
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["runs"][0]["stopped"], true, "{signal}");
+        assert!(out.join("learning_curve.png").exists());
+    }
+}
+
+#[test]
+fn a_signalled_library_training_changes_nothing_and_exits_143() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    let config = tmp.path().join("sources.ron");
+    std::fs::write(
+        &config,
+        "(sources: (count: 2, hidden_layers: (1, 1), units: (4, 4), training_episodes: 1000000))",
+    )
+    .unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args(["sources", "--config"])
+        .arg(&config)
+        .arg("--library")
+        .arg(&library)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    signal_when(&child, "TERM", || {
+        started.elapsed() > Duration::from_millis(800)
+    });
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(143), "{stderr}");
+    assert!(stderr.contains("nothing in"), "{stderr}");
+    assert!(!library.join("cartpole/source-0.ron").exists());
+}
