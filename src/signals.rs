@@ -1,10 +1,14 @@
 //! SIGINT, SIGTERM and SIGHUP: each asks the runs to stop after their current step, so
 //! that what they did is written; the process then exits with 128 + the signal's number
-//! (130, 143, 129), as shells expect of an interrupted command.
+//! (130, 143, 129), as shells expect of an interrupted command. A terminal UI leaves at its
+//! next frame; if it cannot (its terminal closed under it), the process ends a few seconds
+//! later all the same.
 
-use std::sync::atomic::{AtomicI32, Ordering};
+use std::io::Write;
+use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use std::sync::mpsc::{self, Receiver};
 use std::thread;
+use std::time::Duration;
 
 use anyhow::{Context, Result};
 use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
@@ -14,6 +18,18 @@ use crate::trainer::Command;
 
 /// The first signal received, 0 before any.
 static RECEIVED: AtomicI32 = AtomicI32::new(0);
+
+/// A terminal UI is on screen: it leaves on a signal at its next frame, but a terminal that
+/// went away (SIGHUP when its window closes) can hold the UI in its read for ever.
+static INTERACTIVE: AtomicBool = AtomicBool::new(false);
+
+/// How long a terminal UI has to leave by itself after a signal before the process ends.
+const UI_GRACE: Duration = Duration::from_secs(3);
+
+/// Says whether a terminal UI is on screen (see [`stop_on_signals`]).
+pub fn set_interactive(on: bool) {
+    INTERACTIVE.store(on, Ordering::SeqCst);
+}
 
 /// Starts listening: every signal sends [`Command::Stop`] on the returned channel. The
 /// listening thread keeps the sender for the life of the process.
@@ -26,7 +42,19 @@ pub fn stop_on_signals() -> Result<Receiver<Command>> {
         .spawn(move || {
             for signal in signals.forever() {
                 if RECEIVED.swap(signal, Ordering::SeqCst) == 0 {
-                    eprintln!("\n{}: finishing the current step", name(signal));
+                    // stderr may be a terminal that is gone: never panic on it.
+                    let _ = writeln!(
+                        std::io::stderr(),
+                        "\n{}: finishing the current step",
+                        name(signal)
+                    );
+                    if INTERACTIVE.load(Ordering::SeqCst) {
+                        thread::spawn(move || {
+                            thread::sleep(UI_GRACE);
+                            ratatui::restore();
+                            std::process::exit(i32::from(exit_code(signal)));
+                        });
+                    }
                 }
                 let _ = sender.send(Command::Stop);
             }

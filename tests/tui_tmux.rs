@@ -144,3 +144,41 @@ fn sigterm_leaves_the_dashboard_with_the_terminal_restored() {
         "raw mode was left on:\n{screen}"
     );
 }
+
+#[test]
+fn closing_the_terminal_ends_the_dashboard() {
+    if Command::new("tmux").arg("-V").output().is_err() {
+        eprintln!("tmux is not installed: the hang-up test is skipped (.ci/run installs it)");
+        return;
+    }
+    let library = Path::new(env!("CARGO_MANIFEST_DIR")).join("saved_policies");
+    let command = format!(
+        "{} --library {} --seed 4343",
+        env!("CARGO_BIN_EXE_sapnet"),
+        library.display()
+    );
+    let pattern = format!("^{command}$");
+    let session = Session::start(120, 40, &command);
+    session.wait_for(&["SAP-Net graph", "RUNNING"]);
+    // The window closes under the dashboard: its terminal hangs up (SIGHUP).
+    drop(session);
+    let started = Instant::now();
+    loop {
+        let alive = Command::new("pgrep")
+            .args(["-f", &pattern])
+            .output()
+            .expect("running pgrep")
+            .status
+            .success();
+        if !alive {
+            break;
+        }
+        if started.elapsed() > Duration::from_secs(15) {
+            let _ = Command::new("pkill")
+                .args(["-KILL", "-f", &pattern])
+                .status();
+            panic!("the dashboard outlived its terminal by 15 s");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}

@@ -35,6 +35,7 @@ struct TerminalGuard;
 
 impl Drop for TerminalGuard {
     fn drop(&mut self) {
+        crate::signals::set_interactive(false);
         ratatui::restore();
     }
 }
@@ -43,7 +44,10 @@ impl Drop for TerminalGuard {
 /// half-way, raw mode is undone here (nothing else was changed yet).
 fn open_terminal() -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
     match ratatui::try_init() {
-        Ok(terminal) => Ok((terminal, TerminalGuard)),
+        Ok(terminal) => {
+            crate::signals::set_interactive(true);
+            Ok((terminal, TerminalGuard))
+        }
         Err(err) => {
             let _ = crossterm::terminal::disable_raw_mode();
             Err(err).context(
