@@ -44,7 +44,8 @@ pub struct RunArgs {
     #[arg(long)]
     pub force: bool,
 
-    /// A smoke run of about a minute: the protocol cut to 1/20 of its episodes and at most
+    /// A smoke run (seconds for the paper's protocol, about a minute for the comparison of
+    /// assets/reuse_cartpole.ron): the protocol cut to 1/20 of its episodes and at most
     /// 2 runs per method (on the same source library).
     #[arg(long)]
     pub quick: bool,

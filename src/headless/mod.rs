@@ -4,8 +4,8 @@
 //! Runs are spread over `jobs` threads (one per core by default). Files in the output
 //! directory, each written as results arrive, so a stopped experiment keeps what it did:
 //! - `episodes.csv`: one row per training episode (`run, method, episode, reward, steps,
-//!   loss, statistic_loss, epsilon, policy, wall_s`; `policy` is the policy SAP-Net
-//!   selected most in the episode);
+//!   loss, statistic_loss, epsilon, policy, wall_s`; `policy` is the source that acted
+//!   most in the episode, for methods that reuse the library);
 //! - `tests.csv`: the greedy test returns of each run (`run, method, test, return, policy`);
 //! - `activations.csv`: per episode of every run that reuses the library, each source's
 //!   score (SAP-Net: its activation), probability of being picked and steps acted;
@@ -13,9 +13,10 @@
 //! - `comparison.csv`: one row per method, the measures of [`comparison`];
 //! - `summary.json`: the config, the source library, each run's totals and test returns;
 //! - `policies/<method>-run<r>.{safetensors,ron}` (e.g. `dqn-100-100-run0`, `sapnet-run0`):
-//!   each trained network — SAP-Net's chosen policy after training — in the policy
-//!   library's format;
-//! - `learning_curve.png`/`.svg`, `tests.png`, `activations.png`: the paper's Fig. 5–8.
+//!   each trained network — a reusing method's chosen source after fine-tuning — in the
+//!   policy library's format;
+//! - `learning_curve.png`/`.svg`, `tests.png`, `activations.png`: the paper's Fig. 5–8;
+//!   `selections.png`: who acted, per reusing method.
 //!
 //! Each run of a reusing method that finishes also adds its chosen source, fine-tuned, to
 //! the policy library, as `<library>/<target task>/chosen/<out dir>-<method>-run<r>`
@@ -29,8 +30,7 @@ mod replot;
 mod results;
 
 use std::collections::BTreeMap;
-use std::path::Path;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::mpsc::Receiver;
 use std::time::Instant;
 
