@@ -74,7 +74,7 @@ fn a_signalled_library_training_changes_nothing_and_exits_143() {
         "(sources: (count: 2, hidden_layers: (1, 1), units: (4, 4), training_episodes: 1000000))",
     )
     .unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sapnet"))
         .args(["sources", "--config"])
         .arg(&config)
         .arg("--library")
@@ -83,13 +83,30 @@ fn a_signalled_library_training_changes_nothing_and_exits_143() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let started = Instant::now();
-    signal_when(&child, "TERM", || {
-        started.elapsed() > Duration::from_millis(800)
+    // Signal once training has begun (its first progress line), not before the handlers
+    // are in place; stderr is read to its end on a thread of its own.
+    let (begun_tx, begun) = std::sync::mpsc::channel();
+    let pipe = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        use std::io::BufRead;
+        let mut all = String::new();
+        for line in std::io::BufReader::new(pipe).lines() {
+            let line = line.unwrap();
+            if line.contains("started") {
+                let _ = begun_tx.send(());
+            }
+            all.push_str(&line);
+            all.push('\n');
+        }
+        all
     });
-    let output = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert_eq!(output.status.code(), Some(143), "{stderr}");
+    begun
+        .recv_timeout(Duration::from_secs(60))
+        .expect("training began");
+    signal_when(&child, "TERM", || true);
+    let status = child.wait().unwrap();
+    let stderr = reader.join().unwrap();
+    assert_eq!(status.code(), Some(143), "{stderr}");
     assert!(stderr.contains("nothing in"), "{stderr}");
     assert!(!library.join("cartpole/source-0.ron").exists());
 }
