@@ -102,18 +102,31 @@ pub struct Prql {
     /// The episode in progress: its policy and ψ_h.
     current: Option<Pick>,
     psi: f64,
+    /// The largest `P(Π_k)` of a source, kept because W and τ change only between episodes
+    /// while the run asks for it at every step.
+    top_source: f64,
 }
 
 impl Prql {
     pub fn new(n: usize, knobs: &PrqlKnobs) -> Self {
-        Self {
+        let mut prql = Self {
             knobs: knobs.clone(),
             w: vec![0.0; n + 1],
             u: vec![0; n + 1],
             tau: knobs.tau0,
             current: None,
             psi: knobs.psi,
-        }
+            top_source: 0.0,
+        };
+        prql.top_source = prql.top_source_probability();
+        prql
+    }
+
+    fn top_source_probability(&self) -> f64 {
+        self.probabilities()[1..]
+            .iter()
+            .copied()
+            .fold(0.0, f64::max)
     }
 
     /// `P(Π_j)` over the learner (index 0) and the sources.
@@ -186,6 +199,7 @@ impl Selector for Prql {
         self.w[j] = (self.w[j] * self.u[j] as f64 + end.discounted_return) / (self.u[j] + 1) as f64;
         self.u[j] += 1;
         self.tau += self.knobs.delta_tau;
+        self.top_source = self.top_source_probability();
     }
 
     /// Scores: W of each source (the learner's is not a source's).
@@ -201,7 +215,7 @@ impl Selector for Prql {
     }
 
     fn top_probability(&self) -> Option<f64> {
-        self.probabilities()[1..].iter().copied().reduce(f64::max)
+        Some(self.top_source)
     }
 
     /// The learner is the result.
