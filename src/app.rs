@@ -116,7 +116,7 @@ fn run_experiment(cli: &Cli) -> Result<()> {
         jobs: cli.run.jobs.unwrap_or_else(|| {
             std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
         }),
-        library: cli.run.library.clone(),
+        library: cli.run.library_root(),
         trace: cli.run.trace,
     };
     let summary = headless::run(&config, &output, &options, &on_interrupt()?)?;
@@ -190,7 +190,7 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
             .or_else(|| ids.iter().find(|m| m.kind.reuses()))
             .cloned(),
     };
-    let plan = experiment::plan(config, &cli.run.library, &on_interrupt()?)?;
+    let plan = experiment::plan(config, &cli.run.library_root(), &on_interrupt()?)?;
     let followable: Vec<_> = plan
         .specs
         .iter()
@@ -228,8 +228,12 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
 
 fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
     let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
-    let dir =
-        crate::sources::train_library(&config, &cli.run.library, args.retrain, &on_interrupt()?)?;
+    let dir = crate::sources::train_library(
+        &config,
+        &cli.run.library_path(),
+        args.retrain,
+        &on_interrupt()?,
+    )?;
     eprintln!(
         "{} source policies in {}",
         config.sources.count,

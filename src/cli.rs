@@ -72,13 +72,37 @@ pub struct RunArgs {
     pub jobs: Option<usize>,
 
     /// The policy library's root directory: SAP-Net reuses <LIBRARY>/<source task>/.
-    #[arg(
-        long,
-        value_name = "DIR",
-        default_value = "saved_policies",
-        global = true
-    )]
-    pub library: PathBuf,
+    /// Default: saved_policies (trained on first use if missing). A library given here
+    /// must exist, unless --train-library.
+    #[arg(long, value_name = "DIR", global = true)]
+    pub library: Option<PathBuf>,
+
+    /// Train the source library first if --library holds none (or finish one whose
+    /// training was interrupted), as the default library is.
+    #[arg(long)]
+    pub train_library: bool,
+}
+
+/// The library root when `--library` is not given.
+pub const DEFAULT_LIBRARY: &str = "saved_policies";
+
+impl RunArgs {
+    /// `--library`, or the default.
+    pub fn library_path(&self) -> PathBuf {
+        self.library
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(DEFAULT_LIBRARY))
+    }
+
+    /// Where runs find their library, and whether they may train a missing one: the
+    /// default library is trained on first use; one named by `--library` only with
+    /// `--train-library`, so that a typo does not start hours of training.
+    pub fn library_root(&self) -> crate::sources::LibraryRoot {
+        crate::sources::LibraryRoot {
+            path: self.library_path(),
+            train_if_missing: self.library.is_none() || self.train_library,
+        }
+    }
 }
 
 #[derive(Debug, Subcommand)]

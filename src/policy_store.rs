@@ -24,6 +24,9 @@ use crate::config::{parse_ron, ron_options, ConfigError};
 use crate::dqn::{Architecture, DqnError, QNet};
 use crate::env::EnvConfig;
 
+/// Not a policy name: `library.ron` is a source library's manifest.
+pub const RESERVED_NAME: &str = "library";
+
 /// The only activation the Q-networks use.
 pub const ACTIVATION: &str = "relu";
 
@@ -93,7 +96,7 @@ pub enum StoreError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("policy name {name:?} is not a plain file name")]
+    #[error("policy name {name:?} is not a plain file name (nor {RESERVED_NAME:?})")]
     InvalidName { name: String },
     #[error("policy metadata: {0}")]
     Metadata(#[from] ConfigError),
@@ -192,6 +195,20 @@ fn write_pair(
     rename(weights_tmp, weights_path)?;
     rename(metadata_tmp, metadata_path)?;
     Ok(metadata)
+}
+
+/// Writes `bytes` to `path` through a synced temporary sibling and one rename: a reader
+/// sees the old file or the new one, never a part.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
+    let tmp = temporary(path);
+    let written = write_synced(&tmp, bytes).and_then(|()| rename(&tmp, path));
+    if written.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    if let Some(dir) = path.parent().and_then(|d| fs::File::open(d).ok()) {
+        let _ = dir.sync_all();
+    }
+    written
 }
 
 /// Reads policy `name` from `dir`, checking the weights against the metadata.
@@ -328,6 +345,36 @@ pub fn list(dir: &Path) -> Result<Vec<String>, StoreError> {
     Ok(names)
 }
 
+/// Names of the weights files in `dir` that have no metadata beside them (a policy whose
+/// `.ron` was lost), sorted.
+pub fn orphan_weights(dir: &Path) -> Result<Vec<String>, StoreError> {
+    let entries = match fs::read_dir(dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(source) => {
+            return Err(StoreError::Read {
+                path: dir.to_path_buf(),
+                source,
+            })
+        }
+    };
+    let mut names = Vec::new();
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.extension().is_some_and(|e| e == "safetensors")
+            && !path.with_extension("ron").exists()
+        {
+            if let Some(stem) = path.file_stem().and_then(|s| s.to_str()) {
+                if check_name(stem).is_ok() {
+                    names.push(stem.to_string());
+                }
+            }
+        }
+    }
+    names.sort();
+    Ok(names)
+}
+
 /// SHA-256 of `bytes` as lowercase hex.
 pub fn sha256_hex(bytes: &[u8]) -> String {
     Sha256::digest(bytes)
@@ -338,6 +385,7 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 
 fn check_name(name: &str) -> Result<(), StoreError> {
     let plain = !name.is_empty()
+        && name != RESERVED_NAME
         && !name.starts_with('.')
         && !name.contains(['/', '\\'])
         && Path::new(name).file_name() == Some(name.as_ref());

@@ -65,7 +65,7 @@ fn a_signalled_headless_run_writes_what_it_did_and_exits_128_plus_the_signal() {
 }
 
 #[test]
-fn a_signalled_library_training_changes_nothing_and_exits_143() {
+fn a_signalled_library_training_keeps_it_unfinished_and_exits_143() {
     let tmp = tempfile::tempdir().unwrap();
     let library = tmp.path().join("lib");
     let config = tmp.path().join("sources.ron");
@@ -107,6 +107,11 @@ fn a_signalled_library_training_changes_nothing_and_exits_143() {
     let status = child.wait().unwrap();
     let stderr = reader.join().unwrap();
     assert_eq!(status.code(), Some(143), "{stderr}");
-    assert!(stderr.contains("nothing in"), "{stderr}");
+    assert!(
+        stderr.contains("0 of 2 policies are trained and kept in"),
+        "{stderr}"
+    );
     assert!(!library.join("cartpole/source-0.ron").exists());
+    let manifest = std::fs::read_to_string(library.join("cartpole/library.ron")).unwrap();
+    assert!(manifest.contains("complete: false"), "{manifest}");
 }

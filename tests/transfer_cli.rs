@@ -1,11 +1,11 @@
-//! `sapnet --headless` with SAP-Net in the protocol: the library is trained when missing,
-//! reused when present, refused with the file named when it does not fit; every result
-//! file is written.
+//! `sapnet --headless` with SAP-Net in the protocol: the library is trained when missing
+//! and asked for, reused when present, refused with the file named when it does not fit;
+//! every result file is written.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use sapnet::policy_store::{self, PolicyInfo, TrainingBudget};
+use sapnet::policy_store;
 
 fn config(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -44,6 +44,18 @@ fn transfer(library: &Path, out: &Path) -> Output {
     )
 }
 
+#[test]
+fn a_library_named_by_flag_that_does_not_exist_is_not_trained_unasked() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (library, out) = (tmp.path().join("typo"), tmp.path().join("out"));
+    let output = transfer(&library, &out);
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(message.contains("no source library in"), "{message}");
+    assert!(message.contains("--train-library"), "{message}");
+    assert!(!library.exists());
+}
+
 /// Trains the tiny library once for a test and returns its task directory.
 fn train_library(library: &Path) -> PathBuf {
     let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
@@ -64,7 +76,18 @@ fn train_library(library: &Path) -> PathBuf {
 fn a_missing_library_is_trained_then_every_result_is_written() {
     let tmp = tempfile::tempdir().unwrap();
     let (library, out) = (tmp.path().join("lib"), tmp.path().join("out"));
-    let output = transfer(&library, &out);
+    let output = sapnet(
+        &[
+            "--headless",
+            "--config",
+            &config("tiny_transfer.ron"),
+            "--jobs",
+            "2",
+            "--train-library",
+        ],
+        &library,
+        &out,
+    );
     assert!(output.status.success(), "{}", stderr(&output));
     let message = stderr(&output);
     assert!(message.contains("no source library in"), "{message}");
@@ -363,35 +386,31 @@ fn a_corrupted_policy_is_refused_by_name() {
 }
 
 #[test]
-fn a_policy_that_does_not_fit_the_task_is_refused_by_name() {
+fn a_library_that_does_not_fit_the_task_is_refused_by_name() {
     let tmp = tempfile::tempdir().unwrap();
     let library = tmp.path().join("lib");
-    let dir = train_library(&library);
-    // A MountainCar-sized network (2 inputs, 3 actions) among the CartPole sources.
-    let net = sapnet::dqn::QNet::new(
-        sapnet::dqn::Architecture::new(2, &[4], 3),
-        &mut <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(0),
-    )
-    .unwrap();
-    let info = PolicyInfo {
-        source_task: sapnet::env::EnvConfig::CartPole(Default::default()),
-        training: TrainingBudget {
-            episodes: 1,
-            steps: 1,
-        },
-        seed: 0,
-        final_score: None,
-        reused: None,
-    };
-    policy_store::save(&dir, "stray", &net, &info).unwrap();
-
-    let output = transfer(&library, &tmp.path().join("out"));
+    train_library(&library);
+    // MountainCar (2 inputs, 3 actions) reusing the CartPole sources (4 inputs, 2 actions).
+    let text = std::fs::read_to_string(config("tiny_transfer.ron"))
+        .unwrap()
+        .replace("env: CartPole(),", "env: MountainCar(),")
+        .replace(
+            "training_episodes: 3)",
+            "training_episodes: 3, env: Some(CartPole()))",
+        );
+    let other_task = tmp.path().join("mountain_car.ron");
+    std::fs::write(&other_task, text).unwrap();
+    let output = sapnet(
+        &["--headless", "--config", other_task.to_str().unwrap()],
+        &library,
+        &tmp.path().join("out"),
+    );
     assert_eq!(output.status.code(), Some(2));
     let message = stderr(&output);
-    assert!(message.contains("stray.ron"), "{message}");
+    assert!(message.contains("source-0.ron"), "{message}");
     assert!(message.contains("does not fit"), "{message}");
     assert!(
-        message.contains("takes 2 observation values, the task gives 4"),
+        message.contains("takes 4 observation values, the task gives 2"),
         "{message}"
     );
 }
@@ -418,7 +437,7 @@ fn a_library_of_another_source_task_is_refused() {
     );
     assert_eq!(output.status.code(), Some(2));
     let message = stderr(&output);
-    assert!(message.contains("source-0.ron was trained on"), "{message}");
+    assert!(message.contains("cartpole was trained on"), "{message}");
     assert!(message.contains("--retrain"), "{message}");
 }
 

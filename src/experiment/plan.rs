@@ -1,7 +1,6 @@
 //! What an experiment runs: one [`RunSpec`] per (method, run), each seeded from the run
 //! seed, over the source library when a method reuses one.
 
-use std::path::Path;
 use std::sync::mpsc::Receiver;
 use std::sync::Arc;
 
@@ -9,7 +8,7 @@ use anyhow::Result;
 
 use crate::config::Config;
 use crate::seeds;
-use crate::sources;
+use crate::sources::{self, LibraryRoot};
 use crate::trainer::{Command, MethodId, RunSpec, SourcePolicy, StreamOptions};
 
 /// The runs of a protocol and the library they reuse.
@@ -33,9 +32,9 @@ pub fn method_ids(config: &Config) -> Vec<MethodId> {
 }
 
 /// Loads the library if a method reuses one (training it first, with progress on stderr,
-/// if `<library>/<source task>/` holds none; `stop` ends that training), then plans every
-/// run.
-pub fn plan(config: &Config, library: &Path, stop: &Receiver<Command>) -> Result<Plan> {
+/// if `<library>/<source task>/` holds none or an unfinished one and `library` allows it;
+/// `stop` ends that training), then plans every run.
+pub fn plan(config: &Config, library: &LibraryRoot, stop: &Receiver<Command>) -> Result<Plan> {
     let reuses = config.protocol.methods.iter().any(|m| m.kind().reuses());
     let sources = if reuses {
         Some(Arc::new(sources::ensure_library(config, library, stop)?))

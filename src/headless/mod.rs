@@ -71,8 +71,8 @@ pub struct OutputOptions {
 pub struct RunOptions {
     /// Runs trained at the same time.
     pub jobs: usize,
-    /// Root of the policy library SAP-Net reuses (`<library>/<task>/`).
-    pub library: PathBuf,
+    /// The policy library SAP-Net reuses (`<library>/<task>/`).
+    pub library: crate::sources::LibraryRoot,
     /// Write every spread call of SAP-Net's runs to `trace.csv`.
     pub trace: bool,
 }
@@ -105,7 +105,7 @@ pub fn run(
     for spec in &mut plan.specs {
         spec.stream.trace = options.trace && spec.method.kind == MethodKind::SapNet;
     }
-    let copies = LibraryCopies::new(config, &output.dir, &options.library);
+    let copies = LibraryCopies::new(config, &output.dir, &options.library.path);
     let mut files =
         ResultFiles::create(config, output, plan.sources.as_deref(), &plan.specs, copies)?;
     if options.trace {

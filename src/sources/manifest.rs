@@ -1,0 +1,231 @@
+//! `<library>/<task>/library.ron`: what a source library holds and how it was trained.
+//!
+//! `sapnet sources` writes the manifest before it trains anything (`complete: false`), adds
+//! each policy's hashes as soon as the policy is on disk and sets `complete: true` last, so
+//! a library is usable only once whole, an interrupted training resumes where it stopped,
+//! and a run can tell a finished library from a half-written or hand-edited one.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::config::{parse_ron, ron_options, Config, DqnConfig};
+use crate::env::EnvConfig;
+use crate::policy_store::{self, PolicyMetadata, StoreError};
+
+/// The manifest's file name inside `<library>/<task>/`.
+pub const FILE: &str = "library.ron";
+
+/// The contents of `library.ron`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    /// False while `sapnet sources` is still training: runs refuse the library.
+    pub complete: bool,
+    /// The part of the config that decides the library's contents.
+    pub training: LibraryTraining,
+    /// The policies on disk, in the plan's order.
+    pub policies: Vec<ManifestEntry>,
+    /// The version of sapnet that wrote the manifest.
+    pub crate_version: String,
+}
+
+/// What `sapnet sources` reads from a config: equal trainings give equal libraries.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LibraryTraining {
+    pub source_task: EnvConfig,
+    pub count: usize,
+    pub hidden_layers: (usize, usize),
+    pub units: (usize, usize),
+    pub training_episodes: u32,
+    pub dqn: DqnConfig,
+    /// Greedy episodes that measure each policy's `final_score`.
+    pub test_episodes: u32,
+    pub seed: u64,
+}
+
+/// One policy of the library and the hashes of its two files.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ManifestEntry {
+    pub name: String,
+    pub hidden: Vec<usize>,
+    pub seed: u64,
+    pub weights_sha256: String,
+    pub metadata_sha256: String,
+}
+
+impl LibraryTraining {
+    /// The library `config` describes.
+    pub fn of(config: &Config) -> Self {
+        let s = &config.sources;
+        Self {
+            source_task: super::source_task(config).clone(),
+            count: s.count,
+            hidden_layers: s.hidden_layers,
+            units: s.units,
+            training_episodes: s.training_episodes,
+            dqn: s.dqn.clone().unwrap_or_else(|| config.dqn.clone()),
+            test_episodes: config.protocol.test_episodes,
+            seed: config.seed,
+        }
+    }
+
+    /// The settings in which `other` trains its sources differently, as `field: ours vs
+    /// theirs`. The seed, the test episodes, the count and the task are left out: a run
+    /// with another `--seed` reuses the same library on purpose, tests only measure, and a
+    /// run checks the count and the task itself.
+    pub fn differences(&self, other: &Self) -> Vec<String> {
+        self.compare(other, false)
+    }
+
+    /// Every setting in which `other` differs, the seed and the count included.
+    pub fn all_differences(&self, other: &Self) -> Vec<String> {
+        self.compare(other, true)
+    }
+
+    fn compare(&self, other: &Self, all: bool) -> Vec<String> {
+        let mut found = Vec::new();
+        let mut compare = |field: &str, ours: String, theirs: String| {
+            if ours != theirs {
+                found.push(format!("{field}: {ours} vs {theirs}"));
+            }
+        };
+        if all {
+            compare(
+                "source task",
+                ron(&self.source_task),
+                ron(&other.source_task),
+            );
+            compare(
+                "sources.count",
+                self.count.to_string(),
+                other.count.to_string(),
+            );
+        }
+        compare(
+            "sources.hidden_layers",
+            format!("{:?}", self.hidden_layers),
+            format!("{:?}", other.hidden_layers),
+        );
+        compare(
+            "sources.units",
+            format!("{:?}", self.units),
+            format!("{:?}", other.units),
+        );
+        compare(
+            "sources.training_episodes",
+            self.training_episodes.to_string(),
+            other.training_episodes.to_string(),
+        );
+        compare("the sources' dqn", ron(&self.dqn), ron(&other.dqn));
+        if all {
+            compare(
+                "protocol.test_episodes",
+                self.test_episodes.to_string(),
+                other.test_episodes.to_string(),
+            );
+            compare("seed", self.seed.to_string(), other.seed.to_string());
+        }
+        found
+    }
+}
+
+/// A config value as its RON text, for messages.
+fn ron<T: Serialize>(value: &T) -> String {
+    ron_options()
+        .to_string(value)
+        .unwrap_or_else(|e| format!("<{e}>"))
+}
+
+impl ManifestEntry {
+    /// Hashes policy `name` as it is on disk in `dir`, checking the pair on the way; with
+    /// the policy's metadata.
+    pub fn of_policy(dir: &Path, name: &str) -> Result<(Self, PolicyMetadata), StoreError> {
+        let policy = policy_store::load(dir, name)?;
+        let metadata_path = policy_store::paths(dir, name).1;
+        let bytes = fs::read(&metadata_path).map_err(|source| StoreError::Read {
+            path: metadata_path,
+            source,
+        })?;
+        let entry = Self {
+            name: name.to_string(),
+            hidden: policy.metadata.architecture.hidden.clone(),
+            seed: policy.metadata.seed,
+            weights_sha256: policy.metadata.weights_sha256.clone(),
+            metadata_sha256: policy_store::sha256_hex(&bytes),
+        };
+        Ok((entry, policy.metadata))
+    }
+}
+
+/// The manifest's path in `dir`.
+pub fn path(dir: &Path) -> PathBuf {
+    dir.join(FILE)
+}
+
+/// Reads `dir`'s manifest; `None` when there is none.
+pub fn read(dir: &Path) -> Result<Option<Manifest>, StoreError> {
+    let path = path(dir);
+    let text = match fs::read_to_string(&path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(source) => return Err(StoreError::Read { path, source }),
+    };
+    Ok(Some(parse_ron(&text, &path.display().to_string())?))
+}
+
+/// Replaces `dir`'s manifest in one rename, so a reader sees the old one or the new one.
+pub fn write(dir: &Path, manifest: &Manifest) -> Result<(), StoreError> {
+    let path = path(dir);
+    let pretty = ron::ser::PrettyConfig::default().compact_arrays(true);
+    let text = ron_options()
+        .to_string_pretty(manifest, pretty)
+        .map_err(|e| StoreError::Invalid {
+            path: path.clone(),
+            message: format!("cannot serialise the manifest: {e}"),
+        })?;
+    policy_store::write_atomically(&path, format!("{text}\n").as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_manifest_reads_back_as_written() {
+        let tmp = tempfile::tempdir().unwrap();
+        let manifest = Manifest {
+            complete: false,
+            training: LibraryTraining::of(&Config::default()),
+            policies: vec![ManifestEntry {
+                name: "source-0".into(),
+                hidden: vec![3, 4],
+                seed: 9,
+                weights_sha256: "ab".into(),
+                metadata_sha256: "cd".into(),
+            }],
+            crate_version: "0".into(),
+        };
+        assert_eq!(read(tmp.path()).unwrap(), None);
+        write(tmp.path(), &manifest).unwrap();
+        assert_eq!(read(tmp.path()).unwrap(), Some(manifest));
+    }
+
+    #[test]
+    fn differences_name_the_field_and_ignore_the_seed() {
+        let ours = LibraryTraining::of(&Config::default());
+        let mut theirs = ours.clone();
+        theirs.seed += 1;
+        theirs.test_episodes += 1;
+        assert!(ours.differences(&theirs).is_empty());
+        theirs.training_episodes = 3;
+        theirs.dqn.learning_rate *= 2.0;
+        let found = ours.differences(&theirs);
+        assert_eq!(found.len(), 2, "{found:?}");
+        assert_eq!(found[0], "sources.training_episodes: 5000 vs 3");
+        assert!(found[1].starts_with("the sources' dqn: "), "{found:?}");
+    }
+}

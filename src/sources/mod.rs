@@ -1,0 +1,520 @@
+//! `sapnet sources`: trains the library of source policies (paper III-B) — N DQNs of random
+//! architectures, "assuming that a person cannot manually design an optimal hidden layer" —
+//! and writes it to `<library>/<task>/source-<i>.{safetensors,ron}` with its manifest,
+//! `<library>/<task>/library.ron`.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::Receiver;
+
+use anyhow::{bail, Context, Result};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+use crate::config::Config;
+use crate::env::EnvConfig;
+use crate::experiment::{schedule, Observer};
+use crate::policy_store::{self, PolicyInfo, TrainingBudget};
+use crate::sapnet::PolicyDescription;
+use crate::seeds;
+use crate::trainer::{Command, Event, RunOutcome, RunSpec, SourcePolicy, TrainerError};
+
+pub mod manifest;
+pub use manifest::{LibraryTraining, Manifest, ManifestEntry};
+
+/// Stream key of the source library's seeds, apart from the experiments' `[method, run]`.
+const SOURCES_STREAM: u64 = u64::MAX;
+
+/// One source policy to train.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourcePlan {
+    pub name: String,
+    pub hidden: Vec<usize>,
+    pub seed: u64,
+}
+
+/// The source task: `sources.env` when given, else the target task.
+pub fn source_task(config: &Config) -> &EnvConfig {
+    config.sources.env.as_ref().unwrap_or(&config.env)
+}
+
+/// `<library>/<source task>`, where the library of `config` lives.
+pub fn library_dir(library: &Path, config: &Config) -> PathBuf {
+    library.join(source_task(config).task_name())
+}
+
+/// The N architectures and seeds, drawn from the run seed: the number of hidden layers and
+/// the units of each layer uniformly from the config's inclusive ranges.
+pub fn plan(config: &Config) -> Vec<SourcePlan> {
+    let s = &config.sources;
+    let mut rng = StdRng::seed_from_u64(seeds::derive(config.seed, &[SOURCES_STREAM]));
+    (0..s.count)
+        .map(|i| {
+            let layers = rng.random_range(s.hidden_layers.0..=s.hidden_layers.1);
+            let hidden = (0..layers)
+                .map(|_| rng.random_range(s.units.0..=s.units.1))
+                .collect();
+            SourcePlan {
+                name: format!("source-{i}"),
+                hidden,
+                seed: seeds::derive(config.seed, &[SOURCES_STREAM, i as u64]),
+            }
+        })
+        .collect()
+}
+
+/// Trains the library `config` describes into `<library>/<source task>/`, one policy at a
+/// time, each on disk (and in the manifest) as soon as it is trained: a stop or a kill
+/// costs at most the policy in training, and the same command resumes. A finished library
+/// is replaced only when `retrain` is set; policies on disk that the config does not
+/// describe are never silently mixed in.
+pub fn train_library(
+    config: &Config,
+    library: &Path,
+    retrain: bool,
+    stop: &Receiver<Command>,
+) -> Result<PathBuf> {
+    let dir = library_dir(library, config);
+    let training = LibraryTraining::of(config);
+    let plans = plan(config);
+    let kept = resumable(&dir, &training, &plans, retrain)?;
+    std::fs::create_dir_all(&dir)
+        .with_context(|| format!("creating the library folder {}", dir.display()))?;
+    remove_temporaries(&dir)?;
+    let mut manifest = Manifest {
+        complete: false,
+        training,
+        policies: kept,
+        crate_version: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    // Written before any policy: from here until `complete`, runs refuse the library.
+    manifest::write(&dir, &manifest)?;
+    let todo: Vec<&SourcePlan> = plans
+        .iter()
+        .filter(|p| !manifest.policies.iter().any(|e| e.name == p.name))
+        .collect();
+    if !manifest.policies.is_empty() {
+        eprintln!(
+            "{}: {} of {} policies already trained and checked; training {}",
+            dir.display(),
+            manifest.policies.len(),
+            plans.len(),
+            todo.len()
+        );
+    }
+
+    let mut progress = crate::headless::Progress::new(
+        u64::from(config.sources.training_episodes) * todo.len() as u64,
+    );
+    let source_dqn = &manifest.training.dqn;
+    for source in todo {
+        let i = plans
+            .iter()
+            .position(|p| p.name == source.name)
+            .unwrap_or(0);
+        let spec = RunSpec::scratch(
+            i as u32,
+            &source.name,
+            source_task(config).clone(),
+            source_dqn.clone(),
+            source.hidden.clone(),
+            config.sources.training_episodes,
+            config.protocol.test_episodes,
+            source.seed,
+        );
+        let mut training = SourceTraining {
+            progress: &mut progress,
+            outcome: None,
+        };
+        let stopped = schedule(vec![spec], 1, stop, &mut training)
+            .with_context(|| format!("training {}", source.name))?;
+        let outcome = training
+            .outcome
+            .expect("a run that neither failed nor was stopped has an outcome");
+        if stopped || outcome.record.stopped {
+            progress.finish(false);
+            bail!(
+                "stopped by the user: {} of {} policies are trained and kept in {}; the same \
+                 command trains the rest",
+                manifest.policies.len(),
+                plans.len(),
+                dir.display()
+            );
+        }
+        let returns = &outcome.record.test_returns;
+        let info = PolicyInfo {
+            source_task: source_task(config).clone(),
+            training: TrainingBudget {
+                episodes: u64::from(outcome.record.episodes),
+                steps: outcome.record.steps,
+            },
+            seed: source.seed,
+            final_score: (!returns.is_empty())
+                .then(|| returns.iter().sum::<f64>() / returns.len() as f64),
+            reused: None,
+        };
+        policy_store::save(&dir, &source.name, &outcome.net, &info)
+            .with_context(|| format!("writing {} to {}", source.name, dir.display()))?;
+        let (entry, _) = ManifestEntry::of_policy(&dir, &source.name)?;
+        manifest.policies.push(entry);
+        manifest
+            .policies
+            .sort_by_key(|e| plans.iter().position(|p| p.name == e.name));
+        manifest::write(&dir, &manifest)?;
+    }
+    progress.finish(true);
+
+    // A smaller library replaces a larger one: its extra sources must go before the
+    // library is declared whole.
+    for stale in policy_files(&dir)?
+        .iter()
+        .filter(|name| !plans.iter().any(|p| &p.name == *name))
+    {
+        let (weights, metadata) = policy_store::paths(&dir, stale);
+        for path in [metadata, weights] {
+            match std::fs::remove_file(&path) {
+                Err(err) if err.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(err)
+                        .with_context(|| format!("removing the old policy {}", path.display()));
+                }
+                _ => {}
+            }
+        }
+    }
+    manifest.complete = true;
+    manifest::write(&dir, &manifest)?;
+    Ok(dir)
+}
+
+/// The policies already in `dir` that a (resumed) training of `training` keeps: those of
+/// an unfinished training of the same config that still match their hashes, or, in a
+/// folder without a manifest (an older sapnet, or a kill before the first policy), those
+/// whose own metadata match the plan. Refuses to mix anything else in unless `retrain`.
+fn resumable(
+    dir: &Path,
+    training: &LibraryTraining,
+    plans: &[SourcePlan],
+    retrain: bool,
+) -> Result<Vec<ManifestEntry>> {
+    match manifest::read(dir)? {
+        Some(found) if &found.training == training => {
+            if found.complete && !retrain {
+                bail!(
+                    "{} already holds the {} policies this config describes; pass --retrain to \
+                     train them again",
+                    dir.display(),
+                    found.policies.len()
+                );
+            }
+            if found.complete {
+                return Ok(Vec::new());
+            }
+            Ok(found
+                .policies
+                .into_iter()
+                .filter(|e| ManifestEntry::of_policy(dir, &e.name).is_ok_and(|(now, _)| &now == e))
+                .collect())
+        }
+        Some(found) => {
+            if !retrain {
+                bail!(
+                    "{} holds a {} library trained with other settings ({}); pass --retrain to \
+                     replace it",
+                    dir.display(),
+                    if found.complete {
+                        "finished"
+                    } else {
+                        "partly trained"
+                    },
+                    found.training.all_differences(training).join("; ")
+                );
+            }
+            Ok(Vec::new())
+        }
+        None => {
+            let on_disk = policy_files(dir)?;
+            if retrain || on_disk.is_empty() {
+                return Ok(Vec::new());
+            }
+            let adopted: Vec<ManifestEntry> = plans
+                .iter()
+                .filter(|p| on_disk.contains(&p.name))
+                .filter_map(|p| {
+                    let (entry, metadata) = ManifestEntry::of_policy(dir, &p.name).ok()?;
+                    let planned = entry.seed == p.seed
+                        && entry.hidden == p.hidden
+                        && metadata.source_task == training.source_task
+                        && metadata.training.episodes == u64::from(training.training_episodes);
+                    planned.then_some(entry)
+                })
+                .collect();
+            let foreign: Vec<&String> = on_disk
+                .iter()
+                .filter(|name| !adopted.iter().any(|e| &e.name == *name))
+                .collect();
+            if !foreign.is_empty() {
+                bail!(
+                    "{} holds policies without a manifest that this config does not describe \
+                     ({}); pass --retrain to replace them",
+                    dir.display(),
+                    foreign
+                        .iter()
+                        .map(|n| n.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+            }
+            Ok(adopted)
+        }
+    }
+}
+
+/// Names of every policy in `dir` with at least one of its two files.
+fn policy_files(dir: &Path) -> Result<Vec<String>> {
+    let mut names = policy_store::list(dir)?;
+    for orphan in policy_store::orphan_weights(dir)? {
+        if !names.contains(&orphan) {
+            names.push(orphan);
+        }
+    }
+    Ok(names)
+}
+
+/// Removes the hidden `*.tmp` files an interrupted save leaves behind.
+fn remove_temporaries(dir: &Path) -> Result<()> {
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let path = entry?.path();
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name.starts_with('.') && name.ends_with(".tmp") && path.is_file() {
+            std::fs::remove_file(&path)
+                .with_context(|| format!("removing the leftover {}", path.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// Progress of one source's training, and its outcome.
+struct SourceTraining<'a> {
+    progress: &'a mut crate::headless::Progress,
+    outcome: Option<RunOutcome>,
+}
+
+impl Observer for SourceTraining<'_> {
+    fn on_event(&mut self, event: Event) -> Result<()> {
+        match event {
+            Event::RunStarted { method, .. } => self.progress.run_started(method.label(), 0),
+            Event::EpisodeEnded(record) => self.progress.episode(&record),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn on_finished(&mut self, _order: usize, _spec: &RunSpec, outcome: RunOutcome) -> Result<()> {
+        self.outcome = Some(outcome);
+        Ok(())
+    }
+
+    fn on_failed(&mut self, _spec: &RunSpec, err: TrainerError) -> anyhow::Error {
+        anyhow::Error::new(err)
+    }
+}
+
+/// Where a run finds its library, and whether it may train one that is missing.
+#[derive(Debug, Clone)]
+pub struct LibraryRoot {
+    /// `<library>`: the task's library is `<library>/<source task>/`.
+    pub path: PathBuf,
+    /// Train a missing or unfinished library before the run (the default library, or
+    /// `--train-library`). Otherwise a typo in `--library` is an error, not hours of
+    /// training.
+    pub train_if_missing: bool,
+}
+
+/// Reads the source library of `config` from `<library>/<source task>/` for reuse on the
+/// target task. The library must be whole: its manifest complete, of the config's source
+/// task and `sources.count`, every policy on disk with the hashes the manifest records and
+/// no policy beside them; every policy must fit the target task's sizes.
+pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>> {
+    let dir = library_dir(library, config);
+    let Some(found) = manifest::read(&dir)? else {
+        let on_disk = policy_files(&dir)?;
+        if on_disk.is_empty() {
+            bail!(
+                "the source library {} holds no policies; train it with `sapnet sources \
+                 --config <FILE>`",
+                dir.display()
+            );
+        }
+        bail!(
+            "{} holds {} policies but no manifest ({}): an older sapnet wrote them, or their \
+             training was interrupted; `sapnet sources --config <FILE> --library {}` checks \
+             them against the config, trains what is missing and writes the manifest",
+            dir.display(),
+            on_disk.len(),
+            manifest::FILE,
+            library.display()
+        );
+    };
+    let manifest_path = manifest::path(&dir);
+    let wanted = LibraryTraining::of(config);
+    if found.training.source_task != wanted.source_task {
+        bail!(
+            "the library {} was trained on {:?}, but the config's source task is {:?}; \
+             retrain the library with `sapnet sources --retrain` or use another --library",
+            dir.display(),
+            found.training.source_task,
+            wanted.source_task
+        );
+    }
+    if !found.complete {
+        let missing: Vec<String> = plan(config)
+            .into_iter()
+            .filter(|p| !found.policies.iter().any(|e| e.name == p.name))
+            .map(|p| p.name)
+            .collect();
+        bail!(
+            "the source library {} is unfinished: {} of {} policies trained (missing: {}); \
+             `sapnet sources --config <FILE>` trains the rest",
+            dir.display(),
+            found.policies.len(),
+            found.training.count,
+            missing.join(", ")
+        );
+    }
+    if found.policies.len() != wanted.count {
+        bail!(
+            "the library {} holds {} policies, the config's sources.count is {}; train one of \
+             {} with `sapnet sources --retrain` or set sources.count",
+            dir.display(),
+            found.policies.len(),
+            wanted.count,
+            wanted.count
+        );
+    }
+    for difference in wanted.differences(&found.training) {
+        eprintln!(
+            "warning: the library {} was trained with other settings than the config's \
+             ({difference}): it is reused as it is",
+            dir.display()
+        );
+    }
+    if let Some(stray) = policy_files(&dir)?
+        .into_iter()
+        .find(|name| !found.policies.iter().any(|e| &e.name == name))
+    {
+        bail!(
+            "{} holds policy {stray}, which its manifest {} does not list: remove it, or \
+             retrain the library with `sapnet sources --retrain`",
+            dir.display(),
+            manifest_path.display()
+        );
+    }
+
+    let env = crate::env::make(&config.env);
+    let mut sources = Vec::with_capacity(found.policies.len());
+    for entry in &found.policies {
+        let stored = policy_store::load_for_task(
+            &dir,
+            &entry.name,
+            env.observation_size(),
+            env.action_count(),
+        )?;
+        let metadata_path = policy_store::paths(&dir, &entry.name).1;
+        let metadata_sha256 = policy_store::sha256_hex(
+            &std::fs::read(&metadata_path)
+                .with_context(|| format!("reading {}", metadata_path.display()))?,
+        );
+        if stored.metadata.weights_sha256 != entry.weights_sha256
+            || metadata_sha256 != entry.metadata_sha256
+        {
+            bail!(
+                "policy {} is not the one {} records (its files changed after the library was \
+                 written); retrain the library with `sapnet sources --retrain`",
+                metadata_path.display(),
+                manifest_path.display()
+            );
+        }
+        if stored.metadata.source_task != wanted.source_task {
+            bail!(
+                "policy {} was trained on {:?}, but the config's source task is {:?}; retrain \
+                 the library with `sapnet sources --retrain` or use another --library",
+                metadata_path.display(),
+                stored.metadata.source_task,
+                wanted.source_task
+            );
+        }
+        sources.push(SourcePolicy {
+            description: PolicyDescription {
+                hidden: stored.metadata.architecture.hidden.clone(),
+                activation: stored.metadata.activation.clone(),
+                source_task: stored.metadata.source_task_name.clone(),
+            },
+            final_score: stored.metadata.final_score,
+            net: stored.net,
+            name: entry.name.clone(),
+        });
+    }
+    Ok(sources)
+}
+
+/// The library of `config`, trained first (or its training finished) if `root` allows it
+/// and `<library>/<task>/` holds none or an unfinished one, with progress on stderr
+/// (`stop` ends it), then loaded.
+pub fn ensure_library(
+    config: &Config,
+    root: &LibraryRoot,
+    stop: &Receiver<Command>,
+) -> Result<Vec<SourcePolicy>> {
+    let dir = library_dir(&root.path, config);
+    let unfinished = match manifest::read(&dir)? {
+        Some(found) => !found.complete,
+        None => policy_files(&dir)?.is_empty(),
+    };
+    if unfinished {
+        let state = if dir.exists() {
+            "an unfinished source library"
+        } else {
+            "no source library"
+        };
+        if !root.train_if_missing {
+            bail!(
+                "{state} in {}: train it with `sapnet sources --config <FILE> --library {}`, \
+                 or pass --train-library to train it before this run",
+                dir.display(),
+                root.path.display()
+            );
+        }
+        eprintln!(
+            "{state} in {}: training {} source policies first ({} episodes each)",
+            dir.display(),
+            config.sources.count,
+            config.sources.training_episodes
+        );
+        train_library(config, &root.path, false, stop)?;
+    }
+    load_library(config, &root.path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plans_stay_in_range_and_follow_the_seed() {
+        let mut config = Config::default();
+        config.sources.count = 50;
+        let plans = plan(&config);
+        assert_eq!(plans.len(), 50);
+        for p in &plans {
+            assert!((1..=3).contains(&p.hidden.len()), "{p:?}");
+            assert!(p.hidden.iter().all(|u| (50..=150).contains(u)), "{p:?}");
+        }
+        // All three depths occur among 50 draws (a failure here is a broken draw, not luck:
+        // P(a depth missing) < 3·(2/3)^50 ≈ 5e-9).
+        for layers in 1..=3 {
+            assert!(plans.iter().any(|p| p.hidden.len() == layers));
+        }
+        assert_eq!(plans, plan(&config));
+        config.seed = 1;
+        assert_ne!(plans, plan(&config));
+    }
+}
