@@ -87,6 +87,9 @@ fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
 }
 
 fn run_experiment(cli: &Cli) -> Result<()> {
+    if cli.run.resume {
+        return resume_experiment(cli);
+    }
     let mut config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
     if cli.run.quick {
         config.quick();
@@ -112,17 +115,42 @@ fn run_experiment(cli: &Cli) -> Result<()> {
         force: cli.run.force,
     };
 
-    let options = RunOptions {
+    let options = run_options(cli);
+    let summary = headless::run(&config, &output, &options, &on_interrupt()?)?;
+    report(&summary, &output.dir)
+}
+
+/// `--headless --resume --out DIR`.
+fn resume_experiment(cli: &Cli) -> Result<()> {
+    if !cli.run.headless {
+        anyhow::bail!("--resume continues a --headless protocol: add --headless");
+    }
+    let dir = cli
+        .run
+        .out
+        .as_deref()
+        .context("--resume needs --out DIR, the results to continue")?;
+    let summary = headless::resume(dir, &run_options(cli), &on_interrupt()?)?;
+    report(&summary, dir)
+}
+
+fn run_options(cli: &Cli) -> RunOptions {
+    RunOptions {
         jobs: cli.run.jobs.unwrap_or_else(|| {
             std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
         }),
         library: cli.run.library_root(),
         trace: cli.run.trace,
-    };
-    let summary = headless::run(&config, &output, &options, &on_interrupt()?)?;
-    let dir = output.dir.display();
+    }
+}
+
+/// What a headless protocol did: where its files are, each run on stderr, the comparison
+/// on stdout.
+fn report(summary: &headless::Summary, dir: &Path) -> Result<()> {
+    let config = &summary.config;
+    let dir = dir.display();
     if summary.stopped() {
-        eprintln!("stopped by the user: what was done so far is in {dir} (episodes.csv, tests.csv, summary.json, plots)");
+        eprintln!("stopped by the user: what was done so far is in {dir} (episodes.csv, tests.csv, summary.json, plots); `sapnet --headless --resume --out {dir}` finishes it");
     } else {
         eprintln!("results in {dir}: episodes.csv, tests.csv, activations.csv, comparison.csv, summary.json, policies/, learning_curve.png, learning_curve.svg, tests.png, activations.png, selections.png");
     }

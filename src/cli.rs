@@ -44,6 +44,16 @@ pub struct RunArgs {
     #[arg(long)]
     pub force: bool,
 
+    /// With --headless --out DIR: continue the stopped, failed or killed protocol in DIR,
+    /// with the config it began with. Finished runs are kept; the others run again from
+    /// their seeds, giving the numbers an uninterrupted protocol gives.
+    #[arg(
+        long,
+        requires = "out",
+        conflicts_with_all = ["config", "seed", "quick", "episodes", "force", "trace"]
+    )]
+    pub resume: bool,
+
     /// A smoke run (seconds for the paper's protocol, about a minute for the comparison of
     /// assets/reuse_cartpole.ron): the protocol cut to 1/20 of its episodes and at most
     /// 2 runs per method (on the same source library).

@@ -37,8 +37,18 @@ fn signal_when(child: &Child, signal: &str, ready: impl Fn() -> bool) {
     assert!(status.success());
 }
 
+/// Episodes written so far by every run, finished or in progress (`runs/*/episodes.csv`,
+/// `runs/.*.partial/episodes.csv`).
 fn episodes_written(out: &Path) -> usize {
-    std::fs::read_to_string(out.join("episodes.csv")).map_or(0, |t| t.lines().count())
+    std::fs::read_dir(out.join("runs")).map_or(0, |entries| {
+        entries
+            .flatten()
+            .map(|e| {
+                std::fs::read_to_string(e.path().join("episodes.csv"))
+                    .map_or(0, |t| t.lines().count().saturating_sub(1))
+            })
+            .sum()
+    })
 }
 
 #[test]
@@ -59,7 +69,15 @@ fn a_signalled_headless_run_writes_what_it_did_and_exits_128_plus_the_signal() {
         let summary: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
                 .unwrap();
+        assert_eq!(summary["status"], "stopped", "{signal}");
         assert_eq!(summary["runs"][0]["stopped"], true, "{signal}");
+        assert!(
+            std::fs::read_to_string(out.join("episodes.csv"))
+                .unwrap()
+                .lines()
+                .count()
+                > 3
+        );
         assert!(out.join("learning_curve.png").exists());
     }
 }

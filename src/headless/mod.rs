@@ -1,8 +1,10 @@
 //! Headless mode: runs what the config's protocol lists, with progress on stderr and
 //! results on disk, consuming the trainer's event stream.
 //!
-//! Runs are spread over `jobs` threads (one per core by default). Files in the output
-//! directory, each written as results arrive, so a stopped experiment keeps what it did:
+//! Runs are spread over `jobs` threads (one per core by default). Each run writes its own
+//! record as it trains and renames it into `runs/<method>-run<r>/` when it ends
+//! ([`records`]); the files below are put together from those records in a fixed order
+//! when the protocol ends, is stopped, or is found killed ([`assemble`]):
 //! - `episodes.csv`: one row per training episode (`run, method, episode, reward, steps,
 //!   loss, statistic_loss, epsilon, policy, wall_s`; `policy` is the source that acted
 //!   most in the episode, for methods that reuse the library);
@@ -11,21 +13,29 @@
 //!   score (SAP-Net: its activation), probability of being picked and steps acted;
 //! - `trace.csv` (with `--trace`): every `spread` call of SAP-Net's activations;
 //! - `comparison.csv`: one row per method, the measures of [`comparison`];
-//! - `summary.json`: the config, the source library, each run's totals and test returns;
+//! - `summary.json`: the status (`running`, `complete`, `stopped`, `failed`,
+//!   `interrupted`), the runs not finished, the config, the source library, each run's
+//!   totals and test returns; written when the protocol starts and after every run;
 //! - `policies/<method>-run<r>.{safetensors,ron}` (e.g. `dqn-100-100-run0`, `sapnet-run0`):
 //!   each trained network — a reusing method's chosen source after fine-tuning — in the
 //!   policy library's format;
 //! - `learning_curve.png`/`.svg`, `tests.png`, `activations.png`: the paper's Fig. 5–8;
 //!   `selections.png`: who acted, per reusing method.
 //!
+//! `--resume` ([`resume`]) continues a stopped, failed or killed protocol: finished runs
+//! are kept, the others run again from their seeds, giving the numbers an uninterrupted
+//! protocol gives.
+//!
 //! Each run of a reusing method that finishes also adds its chosen source, fine-tuned, to
 //! the policy library, as `<library>/<target task>/chosen/<out dir>-<method>-run<r>`
 //! (Algorithm 3's last step); the sources beside it are never touched, and no policy
 //! already there is replaced.
 
+mod assemble;
 pub mod comparison;
 mod plots;
 mod progress;
+mod records;
 mod replot;
 mod results;
 
@@ -39,16 +49,16 @@ use anyhow::{bail, Context, Result};
 use crate::config::{Config, MethodKind};
 use crate::experiment::{self, policy_info, LibraryCopies, Observer};
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
-use crate::trainer::{
-    self, Command, Divergence, Event, MethodId, RunOutcome, RunSpec, SourcePolicy, TrainerError,
-};
+use crate::trainer::{Command, Divergence, Event, MethodId, RunOutcome, RunSpec, TrainerError};
 
+use assemble::{assemble, Ending};
 pub(crate) use progress::Progress;
+use records::{run_name, RunWriter};
 pub use replot::replot;
-pub use results::{RunSummary, Summary};
+pub use results::{RunSummary, Status, Summary};
 
 /// Entries that mark a directory as holding results already.
-const RESULT_FILES: [&str; 7] = [
+const RESULT_FILES: [&str; 8] = [
     "episodes.csv",
     "tests.csv",
     "activations.csv",
@@ -56,8 +66,20 @@ const RESULT_FILES: [&str; 7] = [
     "comparison.csv",
     "summary.json",
     "policies",
+    records::RUNS,
 ];
 
+/// Files a run draws, replaced with the results.
+const PLOT_FILES: [&str; 5] = [
+    "learning_curve.png",
+    "learning_curve.svg",
+    "tests.png",
+    "activations.png",
+    "selections.png",
+];
+
+/// Where `--force` moves the results it replaces until the new ones are written.
+const REPLACED: &str = ".replaced";
 /// Where results go and whether old ones may be replaced.
 #[derive(Debug, Clone)]
 pub struct OutputOptions {
@@ -78,211 +100,194 @@ pub struct RunOptions {
 }
 
 /// Runs the protocol of `config`: trains the source library if SAP-Net needs one that is
-/// not there, then every (method, run). `commands` carries [`Command::Stop`] (from
-/// Ctrl-C): the runs in progress then end early, no new ones start, and everything written
-/// so far is kept.
+/// not there (and `options` allow it), then every (method, run). `commands` carries
+/// [`Command::Stop`] (from Ctrl-C): the runs in progress then end early, no new ones
+/// start, and everything written so far is kept.
 pub fn run(
     config: &Config,
     output: &OutputOptions,
     options: &RunOptions,
     commands: &Receiver<Command>,
 ) -> Result<Summary> {
-    prepare_output(output)?;
-    let mut summary = Summary::new(config);
-    let mut plan = experiment::plan(config, &options.library, commands)?;
-    if let Some(sources) = &plan.sources {
-        summary.library = Some(
-            sources
-                .iter()
-                .map(|s| results::LibraryEntry {
-                    name: s.name.clone(),
-                    hidden: s.description.hidden.clone(),
-                    final_score: s.final_score,
+    let replaced = prepare_output(output)?;
+    let summary = protocol(config, &output.dir, options, None, commands);
+    // Delete last: the old results go only once the new ones are written.
+    if let (Ok(_), Some(replaced)) = (&summary, &replaced) {
+        if let Err(err) = std::fs::remove_dir_all(replaced) {
+            eprintln!(
+                "warning: the results --force replaced could not all be deleted from {}: {err}",
+                replaced.display()
+            );
+        }
+    }
+    summary.map_err(|err| match &replaced {
+        Some(replaced) => err.context(format!(
+            "the results --force replaced are kept in {}",
+            replaced.display()
+        )),
+        None => err,
+    })
+}
+
+/// Continues the protocol whose results are in `dir` (a stopped, failed or killed one):
+/// with the config and `--trace` it began with, its finished runs kept, the others run
+/// again from their seeds. `options.trace` is ignored.
+pub fn resume(dir: &Path, options: &RunOptions, commands: &Receiver<Command>) -> Result<Summary> {
+    let header = replot::read_header(dir)?;
+    match header.status {
+        None | Some(Status::Complete) => bail!(
+            "{} holds a finished protocol (summary.json: status {}): nothing to resume",
+            dir.display(),
+            header
+                .status
+                .map_or("absent, written before --resume existed".into(), |s| {
+                    format!("{s:?}").to_lowercase()
                 })
-                .collect(),
+        ),
+        Some(_) => {}
+    }
+    let options = RunOptions {
+        trace: header.trace,
+        ..options.clone()
+    };
+    protocol(
+        &header.config,
+        dir,
+        &options,
+        Some(header.library.as_deref()),
+        commands,
+    )
+}
+
+/// The protocol into `out`. `resumed` is `None` for a new protocol, else the library the
+/// protocol began with (which must be the one loaded now).
+fn protocol(
+    config: &Config,
+    out: &Path,
+    options: &RunOptions,
+    resumed: Option<Option<&[results::LibraryEntry]>>,
+    commands: &Receiver<Command>,
+) -> Result<Summary> {
+    let mut plan = experiment::plan(config, &options.library, commands)?;
+    let library: Option<Vec<results::LibraryEntry>> = plan.sources.as_ref().map(|sources| {
+        sources
+            .iter()
+            .map(|s| results::LibraryEntry {
+                name: s.name.clone(),
+                hidden: s.description.hidden.clone(),
+                final_score: s.final_score,
+            })
+            .collect()
+    });
+    let mut kept = Vec::new();
+    if let Some(began_with) = resumed {
+        if began_with != library.as_deref() {
+            bail!(
+                "the source library in {} is not the one {} began with (summary.json lists \
+                 its names, architectures and scores): resume with the same --library",
+                crate::sources::library_dir(&options.library.path, config).display(),
+                out.display()
+            );
+        }
+        let found = records::read(out, config)?;
+        records::clear_unfinished(out, &found)?;
+        kept = found
+            .into_iter()
+            .filter(|f| !f.summary.record.stopped)
+            .collect();
+        plan.specs.retain(|spec| {
+            !kept
+                .iter()
+                .any(|f| f.summary.record.method == spec.method && f.summary.record.run == spec.run)
+        });
+        eprintln!(
+            "resuming {}: {} runs finished before, {} to run",
+            out.display(),
+            kept.len(),
+            plan.specs.len()
         );
     }
     for spec in &mut plan.specs {
         spec.stream.trace = options.trace && spec.method.kind == MethodKind::SapNet;
     }
-    let copies = LibraryCopies::new(config, &output.dir, &options.library.path);
-    let mut files =
-        ResultFiles::create(config, output, plan.sources.as_deref(), &plan.specs, copies)?;
-    if options.trace {
-        files.trace_to(&output.dir.join("trace.csv"))?;
-    }
-    let started = Instant::now();
 
+    // On disk before the first run, so that even a killed protocol says what it was.
+    let runs_dir = out.join(records::RUNS);
+    std::fs::create_dir_all(&runs_dir)
+        .with_context(|| format!("creating {}", runs_dir.display()))?;
+    let mut summary = Summary::new(config, options.trace);
+    summary.library.clone_from(&library);
+    summary.unfinished = records::unfinished(config, &kept);
+    summary.runs = kept.into_iter().map(|f| f.summary).collect();
+    results::write_json(&out.join("summary.json"), &summary)?;
+
+    let names = plan
+        .sources
+        .as_ref()
+        .map(|s| s.iter().map(|p| p.name.clone()).collect())
+        .unwrap_or_default();
+    let copies = LibraryCopies::new(config, out, &options.library.path);
+    let planned = plan.specs.iter().map(|s| u64::from(s.episodes)).sum();
+    let mut files = ResultFiles {
+        out: out.to_path_buf(),
+        config: config.clone(),
+        names,
+        progress: Progress::new(planned),
+        writers: BTreeMap::new(),
+        summary,
+        copies,
+    };
+    let started = Instant::now();
     let outcome = experiment::schedule(plan.specs, options.jobs, commands, &mut files);
-    let trace_flushed = files
-        .trace
-        .as_mut()
-        .map_or(Ok(()), results::TraceWriter::flush);
     files.progress.finish(matches!(outcome, Ok(false)));
-    if let Err(err) = outcome {
-        summary.error = Some(format!("{err:#}"));
-    }
-    if let Err(err) = &trace_flushed {
-        summary.error.get_or_insert_with(|| format!("{err:#}"));
-    }
-    summary.runs = std::mem::take(&mut files.finished).into_values().collect();
-    summary.wall_s = started.elapsed().as_secs_f64();
-    let library = summary.library.as_deref().unwrap_or_default();
-    summary.comparison = comparison::compare(config, library, &summary.runs, &files.rewards);
-    comparison::write_csv(&output.dir.join("comparison.csv"), &summary.comparison)?;
-    results::write_summary(&output.dir.join("summary.json"), &summary)?;
+    let ending = match outcome {
+        Ok(false) => Ending {
+            status: Status::Complete,
+            error: None,
+            wall_s: started.elapsed().as_secs_f64(),
+        },
+        Ok(true) => Ending {
+            status: Status::Stopped,
+            error: None,
+            wall_s: started.elapsed().as_secs_f64(),
+        },
+        Err(err) => Ending {
+            status: Status::Failed,
+            error: Some(format!("{err:#}")),
+            wall_s: started.elapsed().as_secs_f64(),
+        },
+    };
+    let summary = assemble(out, config, library, options.trace, ending)?;
     if let Some(error) = &summary.error {
         bail!("{error}");
     }
-    plots::write_all(&output.dir, &files.plot_data(config))
-        .with_context(|| format!("drawing the plots in {}", output.dir.display()))?;
     Ok(summary)
 }
 
-/// Everything the event stream writes: the CSV files, progress, and what the plots and
-/// the summary need.
+/// What the event stream writes: each run's record, progress, and `summary.json` after
+/// every run.
 struct ResultFiles {
-    output: OutputOptions,
+    out: PathBuf,
     config: Config,
-    episodes: results::EpisodeWriter,
-    tests: results::TestsWriter,
-    activations: Option<results::ActivationsWriter>,
-    trace: Option<results::TraceWriter>,
-    progress: Progress,
-    /// Training returns per (method, run).
-    rewards: BTreeMap<(MethodId, u32), Vec<f64>>,
-    /// Reusing runs: the latest snapshot of each, and the selections counted before the
-    /// current episode.
-    snapshots: BTreeMap<(MethodId, u32), (trainer::ActivationSnapshot, Vec<u64>)>,
-    /// Reusing runs: scores and the steps each source acted, at the end of every episode.
-    histories: BTreeMap<(MethodId, u32), plots::SelectionHistory>,
+    /// The sources' names (none without a library).
     names: Vec<String>,
-    finished: BTreeMap<usize, RunSummary>,
-    tested: BTreeMap<MethodId, Vec<Vec<f64>>>,
-    window: usize,
+    progress: Progress,
+    /// The record of every run in progress.
+    writers: BTreeMap<(MethodId, u32), RunWriter>,
+    /// Runs finished so far, rewritten to `summary.json` as each ends.
+    summary: Summary,
     /// Where the chosen policies join the library.
     copies: LibraryCopies,
 }
 
 impl ResultFiles {
-    fn create(
-        config: &Config,
-        output: &OutputOptions,
-        sources: Option<&Vec<SourcePolicy>>,
-        specs: &[RunSpec],
-        copies: LibraryCopies,
-    ) -> Result<Self> {
-        let dir = &output.dir;
-        let names: Vec<String> = sources
-            .map(|s| s.iter().map(|p| p.name.clone()).collect())
-            .unwrap_or_default();
-        let activations = match sources {
-            Some(_) => Some(results::ActivationsWriter::create(
-                &dir.join("activations.csv"),
-                &names,
-            )?),
-            None => None,
-        };
-        let planned = specs.iter().map(|s| u64::from(s.episodes)).sum();
-        Ok(Self {
-            output: output.clone(),
-            config: config.clone(),
-            episodes: results::EpisodeWriter::create(&dir.join("episodes.csv"))?,
-            tests: results::TestsWriter::create(&dir.join("tests.csv"))?,
-            activations,
-            trace: None,
-            progress: Progress::new(planned),
-            rewards: BTreeMap::new(),
-            snapshots: BTreeMap::new(),
-            histories: BTreeMap::new(),
-            names,
-            finished: BTreeMap::new(),
-            tested: BTreeMap::new(),
-            window: config.protocol.moving_average,
-            copies,
-        })
-    }
-
-    /// Writes SAP-Net's trace events to `path` (nothing to write without a library).
-    fn trace_to(&mut self, path: &Path) -> Result<()> {
-        if self.activations.is_some() {
-            self.trace = Some(results::TraceWriter::create(path, &self.names)?);
-        }
-        Ok(())
-    }
-
-    /// The row of `activations.csv` for an episode that just ended, from the snapshot the
-    /// trainer sends right before `EpisodeEnded`.
-    fn write_activations(&mut self, method: &MethodId, run: u32, episode: u32) -> Result<()> {
+    fn writer(&mut self, method: &MethodId, run: u32) -> Result<&mut RunWriter> {
         let key = (method.clone(), run);
-        let (Some(writer), Some((snapshot, counted))) =
-            (&mut self.activations, self.snapshots.get_mut(&key))
-        else {
-            return Ok(());
-        };
-        let selected: Vec<u64> = snapshot
-            .selections
-            .iter()
-            .zip(counted.iter())
-            .map(|(now, before)| now - before)
-            .collect();
-        writer.write(
-            run,
-            method,
-            episode,
-            &snapshot.activations,
-            &snapshot.probabilities,
-            &selected,
-        )?;
-        counted.clone_from(&snapshot.selections);
-        let history = self.histories.entry(key).or_default();
-        history.scores.push(snapshot.activations.clone());
-        history.acted.push(selected);
-        Ok(())
-    }
-
-    fn plot_data(&self, config: &Config) -> plots::PlotData {
-        let mut curves = Vec::new();
-        let mut activations = Vec::new();
-        let mut acted = Vec::new();
-        for method in experiment::method_ids(config) {
-            let runs: Vec<Vec<f64>> = self
-                .rewards
-                .iter()
-                .filter(|((m, _), _)| *m == method)
-                .map(|(_, r)| r.clone())
-                .collect();
-            if !runs.is_empty() {
-                curves.push(plots::Curve {
-                    label: method.label().to_string(),
-                    sapnet: method.kind == MethodKind::SapNet,
-                    returns: runs,
-                    tests: self.tested.get(&method).cloned().unwrap_or_default(),
-                });
-            }
-            let histories: Vec<&plots::SelectionHistory> = self
-                .histories
-                .iter()
-                .filter(|((m, _), _)| *m == method)
-                .map(|(_, h)| h)
-                .collect();
-            if histories.is_empty() {
-                continue;
-            }
-            if method.kind == MethodKind::SapNet && activations.is_empty() {
-                activations = histories.iter().map(|h| h.scores.clone()).collect();
-            }
-            let runs = histories.iter().map(|h| h.acted.clone()).collect();
-            acted.push((method.label().to_string(), runs));
+        if !self.writers.contains_key(&key) {
+            let writer = RunWriter::create(&self.out, method, run, &self.names)?;
+            self.writers.insert(key.clone(), writer);
         }
-        plots::PlotData {
-            task: crate::env::make(&config.env).id().to_string(),
-            window: self.window,
-            curves,
-            policy_names: self.names.clone(),
-            activations,
-            acted,
-        }
+        Ok(self.writers.get_mut(&key).expect("inserted above"))
     }
 }
 
@@ -291,33 +296,23 @@ impl Observer for ResultFiles {
         match event {
             Event::RunStarted { run, method, .. } => {
                 self.progress.run_started(method.label(), run);
+                self.writer(&method, run)?;
             }
             Event::Activations(snapshot) => {
-                let key = (snapshot.method.clone(), snapshot.run);
-                let counted = self
-                    .snapshots
-                    .remove(&key)
-                    .map_or_else(|| vec![0; snapshot.selections.len()], |(_, c)| c);
-                self.snapshots.insert(key, (snapshot, counted));
+                let (method, run) = (snapshot.method.clone(), snapshot.run);
+                self.writer(&method, run)?.snapshot(snapshot);
             }
             Event::EpisodeEnded(record) => {
-                self.episodes.write(&record)?;
+                self.writer(&record.method, record.run)?.episode(&record)?;
                 self.progress.episode(&record);
-                self.rewards
-                    .entry((record.method.clone(), record.run))
-                    .or_default()
-                    .push(record.reward);
-                if record.method.kind.reuses() {
-                    self.write_activations(&record.method, record.run, record.episode)?;
-                    if let Some(trace) = &mut self.trace {
-                        trace.flush()?;
-                    }
-                }
             }
             Event::Trace(record) => {
-                if let Some(trace) = &mut self.trace {
-                    trace.write(&record)?;
-                }
+                let names = std::mem::take(&mut self.names);
+                let written = self
+                    .writer(&record.method, record.run)
+                    .and_then(|w| w.trace(&record, &names));
+                self.names = names;
+                written?;
             }
             // A failure is reported from the run's thread when it is joined.
             Event::Step(_) | Event::RunEnded(_) | Event::RunFailed { .. } => {}
@@ -325,20 +320,15 @@ impl Observer for ResultFiles {
         Ok(())
     }
 
-    fn on_finished(&mut self, order: usize, _spec: &RunSpec, outcome: RunOutcome) -> Result<()> {
+    fn on_finished(&mut self, _order: usize, _spec: &RunSpec, outcome: RunOutcome) -> Result<()> {
         let record = outcome.record;
         let mut library_copy = None;
         // A run stopped before its first step trained nothing worth keeping.
         if record.steps > 0 {
-            let name = policy_file_name(record.method.label(), record.run);
+            let name = run_name(record.method.label(), record.run);
             let info = policy_info(&self.config, &record);
-            policy_store::save(
-                &self.output.dir.join("policies"),
-                &name,
-                &outcome.net,
-                &info,
-            )
-            .with_context(|| format!("saving the trained {}", record.method))?;
+            policy_store::save(&self.out.join("policies"), &name, &outcome.net, &info)
+                .with_context(|| format!("saving the trained {}", record.method))?;
             // Only a finished reuse's choice, tested, is worth reusing. The results hold
             // it already, so a library that cannot take it costs a warning, not the run.
             if record.chosen.is_some() && !record.stopped {
@@ -350,26 +340,28 @@ impl Observer for ResultFiles {
                         record.method,
                         record.run + 1,
                         self.copies.dir.display(),
-                        self.output.dir.join("policies").display()
+                        self.out.join("policies").display()
                     )),
                 }
             }
         }
-        self.tests.write(&record)?;
-        if !record.test_returns.is_empty() {
-            self.tested
-                .entry(record.method.clone())
-                .or_default()
-                .push(record.test_returns.clone());
-        }
-        let rewards = self
-            .rewards
-            .get(&(record.method.clone(), record.run))
-            .map_or(&[][..], Vec::as_slice);
-        let mut summary = RunSummary::new(record, rewards, self.window);
+        let key = (record.method.clone(), record.run);
+        self.writer(&record.method, record.run)?;
+        let writer = self.writers.remove(&key).expect("created above");
+        let mut summary =
+            RunSummary::new(record, &writer.rewards, self.config.protocol.moving_average);
         summary.library_copy = library_copy;
-        self.finished.insert(order, summary);
-        Ok(())
+        writer.finish(&self.out, &summary)?;
+
+        let runs = &mut self.summary.runs;
+        runs.push(summary);
+        runs.sort_by_key(|r| (r.record.method.index, r.record.run));
+        self.summary.unfinished.retain(|k| {
+            !runs.iter().any(|r| {
+                !r.record.stopped && r.record.run == k.run && r.record.method.label() == k.method
+            })
+        });
+        results::write_json(&self.out.join("summary.json"), &self.summary)
     }
 
     /// Keeps what a failed run left (its last good weights) and says what happened.
@@ -399,8 +391,8 @@ impl Observer for ResultFiles {
             final_score: None,
             reused: None,
         };
-        let policies = self.output.dir.join("policies");
-        let name = policy_file_name(spec.method.label(), run);
+        let policies = self.out.join("policies");
+        let name = run_name(spec.method.label(), run);
         let kept = match policy_store::save(&policies, &name, &last_good, &info) {
             Ok(_) => format!(
                 "its last good weights are in {}",
@@ -412,54 +404,64 @@ impl Observer for ResultFiles {
     }
 }
 
-/// `dqn[100,100]`, run 0 → `dqn-100-100-run0`: a plain file name.
-fn policy_file_name(method: &str, run: u32) -> String {
-    let plain: String = method
-        .chars()
-        .filter(|&c| c != ']')
-        .map(|c| if c == '[' || c == ',' { '-' } else { c })
-        .collect();
-    format!("{plain}-run{run}")
-}
-
-/// Creates the output directory and refuses to mix new results with old ones.
-fn prepare_output(output: &OutputOptions) -> Result<()> {
-    std::fs::create_dir_all(&output.dir)
-        .with_context(|| format!("creating the output directory {}", output.dir.display()))?;
+/// Creates the output directory and refuses to mix new results with old ones. With
+/// `force`, the old results are moved into `<dir>/.replaced/` (returned), to be deleted
+/// once the new ones are written: a directory where nothing can be written loses nothing.
+fn prepare_output(output: &OutputOptions) -> Result<Option<PathBuf>> {
+    let dir = &output.dir;
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("creating the output directory {}", dir.display()))?;
     let existing: Vec<&str> = RESULT_FILES
         .into_iter()
-        .filter(|f| output.dir.join(f).exists())
+        .filter(|f| dir.join(f).exists())
         .collect();
-    if !existing.is_empty() && !output.force {
+    if existing.is_empty() {
+        return Ok(None);
+    }
+    if !output.force {
         bail!(
-            "the output directory {} already holds results ({}); choose another --out or pass --force to replace them",
-            output.dir.display(),
+            "the output directory {} already holds results ({}); choose another --out, pass \
+             --force to replace them, or --resume to finish them",
+            dir.display(),
             existing.join(", ")
         );
     }
-    // Old files must not sit beside new results as if this run had made them.
-    let policies = output.dir.join("policies");
-    if policies.exists() {
-        std::fs::remove_dir_all(&policies)
-            .with_context(|| format!("removing the old results in {}", policies.display()))?;
+    let replaced = dir.join(REPLACED);
+    if replaced.exists() {
+        // A replacement that never finished: its results were replaced already.
+        std::fs::remove_dir_all(&replaced)
+            .with_context(|| format!("removing {}", replaced.display()))?;
     }
-    for stale in [
-        "activations.csv",
-        "trace.csv",
-        "learning_curve.png",
-        "learning_curve.svg",
-        "tests.png",
-        "activations.png",
-        "selections.png",
-        "comparison.csv",
-    ] {
-        let path = output.dir.join(stale);
-        if path.exists() {
-            std::fs::remove_file(&path)
-                .with_context(|| format!("removing the old result {}", path.display()))?;
+    std::fs::create_dir(&replaced).with_context(|| {
+        format!(
+            "cannot replace the results in {}: creating {}",
+            dir.display(),
+            replaced.display()
+        )
+    })?;
+    let mut moved = Vec::new();
+    for name in RESULT_FILES.iter().chain(PLOT_FILES.iter()) {
+        let (from, to) = (dir.join(name), replaced.join(name));
+        if !from.exists() {
+            continue;
         }
+        if let Err(err) = std::fs::rename(&from, &to) {
+            // Put back what moved: the old results stay as they were.
+            for (from, to) in moved.iter().rev() {
+                let _ = std::fs::rename(to, from);
+            }
+            let _ = std::fs::remove_dir(&replaced);
+            return Err(err).with_context(|| {
+                format!(
+                    "cannot replace the results in {}: moving {} aside; nothing was changed",
+                    dir.display(),
+                    from.display()
+                )
+            });
+        }
+        moved.push((from, to));
     }
-    Ok(())
+    Ok(Some(replaced))
 }
 
 #[cfg(test)]
@@ -467,9 +469,28 @@ mod tests {
     use super::*;
 
     #[test]
-    fn policy_file_names_are_plain() {
-        assert_eq!(policy_file_name("dqn[100,100]", 0), "dqn-100-100-run0");
-        assert_eq!(policy_file_name("dqn[16]", 3), "dqn-16-run3");
-        assert_eq!(policy_file_name("sapnet", 1), "sapnet-run1");
+    fn forced_results_move_aside_until_the_new_ones_are_written() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
+        std::fs::write(dir.join("episodes.csv"), "old").unwrap();
+        std::fs::create_dir(dir.join("policies")).unwrap();
+        std::fs::write(dir.join("policies/p.ron"), "old").unwrap();
+        let refused = prepare_output(&OutputOptions {
+            dir: dir.clone(),
+            force: false,
+        });
+        assert!(format!("{:#}", refused.unwrap_err()).contains("--resume"));
+
+        let replaced = prepare_output(&OutputOptions {
+            dir: dir.clone(),
+            force: true,
+        })
+        .unwrap()
+        .unwrap();
+        assert!(!dir.join("episodes.csv").exists());
+        assert_eq!(
+            std::fs::read_to_string(replaced.join("policies/p.ron")).unwrap(),
+            "old"
+        );
     }
 }

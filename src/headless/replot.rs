@@ -1,7 +1,9 @@
 //! `sapnet plot DIR`: draws a results directory's plots again from its files —
 //! `summary.json` (the config: task, methods, moving-average window), `episodes.csv`,
 //! `tests.csv` and `activations.csv` — exactly as the run that wrote them drew them.
-//! For a run stopped before its plots, or plots of an older version.
+//! For a run stopped before its plots, or plots of an older version. A directory whose
+//! protocol was killed (`summary.json` still says `running`) is first put together from
+//! its finished runs and marked `interrupted`.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -10,7 +12,8 @@ use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 
 use super::plots::{self, Curve, PlotData, SelectionHistory};
-use crate::config::{Config, MethodKind};
+use super::results::{Status, SummaryHeader};
+use crate::config::MethodKind;
 
 #[derive(Deserialize)]
 struct EpisodeRow {
@@ -31,13 +34,38 @@ struct TestRow {
 
 /// Reads `dir`'s results and writes its plots (replacing those there).
 pub fn replot(dir: &Path) -> Result<()> {
+    let header = read_header(dir)?;
+    if header.status == Some(Status::Running) {
+        let summary = super::assemble::assemble(
+            dir,
+            &header.config,
+            header.library,
+            header.trace,
+            super::assemble::Ending {
+                status: Status::Interrupted,
+                error: None,
+                wall_s: 0.0,
+            },
+        )?;
+        eprintln!(
+            "{}: the protocol was interrupted; its {} finished runs are put together (`sapnet \
+             --headless --resume --out {}` runs the other {})",
+            dir.display(),
+            summary.runs.len(),
+            dir.display(),
+            summary.unfinished.len()
+        );
+        if !summary.runs.is_empty() {
+            return Ok(());
+        }
+    }
     let data = read(dir)?;
     plots::write_all(dir, &data).with_context(|| format!("drawing the plots in {}", dir.display()))
 }
 
 /// The plots' data, from the files of a results directory.
 pub fn read(dir: &Path) -> Result<PlotData> {
-    let config = read_config(&dir.join("summary.json"))?;
+    let config = read_header(dir)?.config;
     let returns = by_run(
         rows::<EpisodeRow>(&dir.join("episodes.csv"))?
             .into_iter()
@@ -127,16 +155,12 @@ fn by_run(rows: impl IntoIterator<Item = (String, u32, u32, f64)>) -> ByRun {
         .collect()
 }
 
-fn read_config(path: &Path) -> Result<Config> {
-    #[derive(Deserialize)]
-    struct Summary {
-        config: Config,
-    }
-    let text = std::fs::read_to_string(path)
+/// What `summary.json` says of the protocol: its status, config and library.
+pub fn read_header(dir: &Path) -> Result<SummaryHeader> {
+    let path = dir.join("summary.json");
+    let text = std::fs::read_to_string(&path)
         .with_context(|| format!("reading {} (is this a results directory?)", path.display()))?;
-    let summary: Summary = serde_json::from_str(&text)
-        .with_context(|| format!("reading {}: field `config`", path.display()))?;
-    Ok(summary.config)
+    serde_json::from_str(&text).with_context(|| format!("reading {}", path.display()))
 }
 
 fn rows<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {

@@ -5,10 +5,24 @@ use std::io::Write;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::config::Config;
 use crate::trainer::{EpisodeRecord, MethodId, RunRecord, TraceRecord};
+
+/// The columns of `episodes.csv`, as [`EpisodeRecord`] serialises.
+pub const EPISODES_HEADER: [&str; 10] = [
+    "run",
+    "method",
+    "episode",
+    "reward",
+    "steps",
+    "loss",
+    "statistic_loss",
+    "epsilon",
+    "policy",
+    "wall_s",
+];
 
 /// `episodes.csv`, one row per episode, flushed row by row so that an interrupted run
 /// keeps every finished episode.
@@ -19,9 +33,8 @@ pub struct EpisodeWriter {
 
 impl EpisodeWriter {
     pub fn create(path: &Path) -> Result<Self> {
-        let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
         Ok(Self {
-            csv: csv::Writer::from_writer(file),
+            csv: with_header(path, &EPISODES_HEADER)?,
             path: path.display().to_string(),
         })
     }
@@ -214,33 +227,77 @@ fn number(x: &f64) -> String {
 }
 
 /// A source policy as `summary.json` lists it.
-#[derive(Debug, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LibraryEntry {
     pub name: String,
     pub hidden: Vec<usize>,
     pub final_score: Option<f64>,
 }
 
+/// Where a protocol stands, the first field of `summary.json`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// A process is running it (or was killed: `sapnet plot` and `--resume` then say
+    /// `interrupted`).
+    Running,
+    /// Every planned run finished.
+    Complete,
+    /// Stopped by the user or a signal; `--resume` finishes it.
+    Stopped,
+    /// A run failed (`error` says why); `--resume` retries the unfinished runs.
+    Failed,
+    /// The process died without saying so (SIGKILL, power loss); `--resume` finishes it.
+    Interrupted,
+}
+
+/// A run of the protocol, by method label and 0-based index.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct RunKey {
+    pub method: String,
+    pub run: u32,
+}
+
 /// `summary.json`.
 #[derive(Debug, Serialize)]
 pub struct Summary {
+    pub status: Status,
+    /// Planned runs without a finished record: not started, stopped or killed.
+    pub unfinished: Vec<RunKey>,
     pub crate_version: &'static str,
     pub config: Config,
+    /// Whether SAP-Net's spread calls are traced (`--trace`): a resumed protocol goes on
+    /// as it began.
+    pub trace: bool,
     /// The source library the reusing methods drew on (absent without one).
     pub library: Option<Vec<LibraryEntry>>,
+    /// Finished (and stopped) runs, ordered by method as the protocol lists them, then run.
     pub runs: Vec<RunSummary>,
     /// The methods side by side (`comparison.csv`).
     pub comparison: Vec<super::comparison::MethodComparison>,
+    /// Seconds this process spent (a resumed protocol: since the resume).
     pub wall_s: f64,
     /// Why the experiment ended early, if it failed (the runs above finished before).
     pub error: Option<String>,
 }
 
-/// One run in `summary.json`.
-#[derive(Debug, Serialize)]
-pub struct RunSummary {
+/// What `--resume` and `sapnet plot` read back from `summary.json`.
+#[derive(Debug, Deserialize)]
+pub struct SummaryHeader {
+    /// Absent in results written before the field existed: complete or stopped, never
+    /// resumable.
+    pub status: Option<Status>,
+    pub config: Config,
+    #[serde(default)]
+    pub trace: bool,
+    pub library: Option<Vec<LibraryEntry>>,
+}
+
+/// One run in `summary.json` (and in `runs/<run>/run.json`); `M` as in [`RunRecord`].
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RunSummary<M = MethodId> {
     #[serde(flatten)]
-    pub record: RunRecord,
+    pub record: RunRecord<M>,
     /// Mean of the greedy test returns (absent when the run was stopped before testing).
     pub mean_test_return: Option<f64>,
     /// Moving average of the last `window` training returns.
@@ -251,15 +308,18 @@ pub struct RunSummary {
     pub best_moving_average_episode: Option<u32>,
     /// Where the chosen source, fine-tuned, was added to the policy library (its metadata
     /// file).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub library_copy: Option<std::path::PathBuf>,
 }
 
 impl Summary {
-    pub fn new(config: &Config) -> Self {
+    pub fn new(config: &Config, trace: bool) -> Self {
         Self {
+            status: Status::Running,
+            unfinished: Vec::new(),
             crate_version: env!("CARGO_PKG_VERSION"),
             config: config.clone(),
+            trace,
             library: None,
             runs: Vec::new(),
             comparison: Vec::new(),
@@ -268,13 +328,23 @@ impl Summary {
         }
     }
 
-    pub fn push(&mut self, run: RunSummary) {
-        self.runs.push(run);
-    }
-
     /// Some run was stopped by the user.
     pub fn stopped(&self) -> bool {
-        self.runs.iter().any(|r| r.record.stopped)
+        self.status == Status::Stopped
+    }
+}
+
+impl RunSummary<String> {
+    /// The summary read back from disk, its method known again by its id.
+    pub fn with_method(self, method: MethodId) -> RunSummary {
+        RunSummary {
+            record: self.record.with_method(method),
+            mean_test_return: self.mean_test_return,
+            final_moving_average: self.final_moving_average,
+            best_moving_average: self.best_moving_average,
+            best_moving_average_episode: self.best_moving_average_episode,
+            library_copy: self.library_copy,
+        }
     }
 }
 
@@ -313,8 +383,8 @@ pub fn moving_average(values: &[f64], window: usize) -> Vec<f64> {
         .collect()
 }
 
-/// Writes `summary.json` atomically: a reader never sees half a file.
-pub fn write_summary(path: &Path, summary: &Summary) -> Result<()> {
+/// Writes `summary` (or a run's `run.json`) atomically: a reader never sees half a file.
+pub fn write_json(path: &Path, summary: &impl Serialize) -> Result<()> {
     let tmp = path.with_extension("json.tmp");
     let write = || -> std::io::Result<()> {
         let mut file = File::create(&tmp)?;

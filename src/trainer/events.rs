@@ -12,7 +12,9 @@ use std::fmt;
 use std::sync::Arc;
 use std::time::Duration;
 
-use serde::{Serialize, Serializer};
+use std::borrow::Cow;
+
+use serde::{Deserialize, Serialize, Serializer};
 
 use crate::config::{Method, MethodKind};
 use crate::sapnet::{PolicyDescription, SapNet, TraceStep};
@@ -81,7 +83,7 @@ pub struct EpisodeRecord {
 
 /// The source a reusing run ends with: for SAP-Net the highest activation (Algorithm 3),
 /// for the other selectors what [`crate::reuse::Selector::chosen`] says.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ChosenPolicy {
     pub index: usize,
     /// Its name in the source library, e.g. `source-3`.
@@ -90,14 +92,15 @@ pub struct ChosenPolicy {
     /// Its score under the selector when the run ended (SAP-Net: its activation A).
     pub score: f64,
     /// What the score is (`A`, `mean`, `score`…).
-    pub score_name: &'static str,
+    pub score_name: Cow<'static, str>,
 }
 
-/// How a run ended.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct RunRecord {
+/// How a run ended. `M` is how the method is known: a [`MethodId`] in a process, its label
+/// when read back from a results directory (see [`RunRecord::with_method`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord<M = MethodId> {
     pub run: u32,
-    pub method: MethodId,
+    pub method: M,
     /// The seed of this run's random streams, derived from the config's run seed, the
     /// method's index and the run's index (`seeds::derive(seed, &[method, run])`).
     pub seed: u64,
@@ -119,6 +122,26 @@ pub struct RunRecord {
     /// Stopped by the user before the planned episodes were done.
     pub stopped: bool,
     pub wall_s: f64,
+}
+
+impl RunRecord<String> {
+    /// The record read back from disk, its method known again by its id in the protocol.
+    pub fn with_method(self, method: MethodId) -> RunRecord {
+        RunRecord {
+            run: self.run,
+            method,
+            seed: self.seed,
+            episodes: self.episodes,
+            steps: self.steps,
+            updates: self.updates,
+            chosen: self.chosen,
+            source_steps: self.source_steps,
+            lock_in_step: self.lock_in_step,
+            test_returns: self.test_returns,
+            stopped: self.stopped,
+            wall_s: self.wall_s,
+        }
+    }
 }
 
 /// A source policy as front ends show it.

@@ -495,7 +495,7 @@ pub fn train(
                 name: spec.sources[chosen].name.clone(),
                 hidden: spec.sources[chosen].description.hidden.clone(),
                 score: view.scores[chosen],
-                score_name: view.score_name,
+                score_name: view.score_name.into(),
             });
             learners.agents.swap_remove(chosen).into_online()
         }

@@ -159,7 +159,7 @@ pub fn sapnet_end(episodes: u32) -> Event {
             name: "source-6".into(),
             hidden: HIDDEN[6].to_vec(),
             score: 3117.0,
-            score_name: "A",
+            score_name: "A".into(),
         }),
         source_steps: Vec::new(),
         lock_in_step: None,

@@ -1,0 +1,138 @@
+//! The results directory's top-level files, put together from the run records in `runs/`
+//! in the protocol's order (method as listed, then run, then episode), so the same config
+//! and seed give the same files whatever `--jobs` and however often the protocol was
+//! stopped and resumed: `episodes.csv`, `tests.csv`, `activations.csv`, `trace.csv`,
+//! `comparison.csv`, `summary.json` and the plots.
+
+use std::collections::BTreeMap;
+use std::fs::{File, OpenOptions};
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use serde::Deserialize;
+
+use super::records::{self, RunFolder};
+use super::results::{self, LibraryEntry, Status, Summary};
+use super::{comparison, plots, replot};
+use crate::config::Config;
+use crate::trainer::MethodId;
+
+/// How the protocol ended, for `summary.json`.
+pub struct Ending {
+    pub status: Status,
+    pub error: Option<String>,
+    pub wall_s: f64,
+}
+
+/// Writes every top-level file of `out` from its run records and returns the summary.
+pub fn assemble(
+    out: &Path,
+    config: &Config,
+    library: Option<Vec<LibraryEntry>>,
+    trace: bool,
+    ending: Ending,
+) -> Result<Summary> {
+    let folders = records::read(out, config)?;
+    let parts = |file: &str| -> Vec<PathBuf> {
+        folders
+            .iter()
+            .map(|f| f.dir.join(file))
+            .filter(|p| p.exists())
+            .collect()
+    };
+    concatenate(&out.join("episodes.csv"), &parts("episodes.csv"), |p| {
+        results::EpisodeWriter::create(p).map(drop)
+    })?;
+    concatenate(&out.join("tests.csv"), &parts("tests.csv"), |p| {
+        results::TestsWriter::create(p).map(drop)
+    })?;
+    if let Some(library) = &library {
+        let names: Vec<String> = library.iter().map(|e| e.name.clone()).collect();
+        concatenate(
+            &out.join("activations.csv"),
+            &parts("activations.csv"),
+            |p| results::ActivationsWriter::create(p, &names).map(drop),
+        )?;
+        if trace {
+            concatenate(&out.join("trace.csv"), &parts("trace.csv"), |p| {
+                results::TraceWriter::create(p, &names).map(drop)
+            })?;
+        }
+    }
+
+    let rewards = rewards(&folders)?;
+    let mut summary = Summary::new(config, trace);
+    summary.status = ending.status;
+    summary.error = ending.error;
+    summary.wall_s = ending.wall_s;
+    summary.unfinished = records::unfinished(config, &folders);
+    summary.runs = folders.into_iter().map(|f| f.summary).collect();
+    summary.comparison = comparison::compare(
+        config,
+        library.as_deref().unwrap_or_default(),
+        &summary.runs,
+        &rewards,
+    );
+    summary.library = library;
+    comparison::write_csv(&out.join("comparison.csv"), &summary.comparison)?;
+    results::write_json(&out.join("summary.json"), &summary)?;
+    if !summary.runs.is_empty() {
+        let data = replot::read(out)?;
+        plots::write_all(out, &data)
+            .with_context(|| format!("drawing the plots in {}", out.display()))?;
+    }
+    Ok(summary)
+}
+
+/// Writes `path` as a header (`create` makes an empty file with it) followed by the rows of
+/// every part, in order, each part's own header skipped; through a temporary file renamed
+/// into place.
+fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<()>) -> Result<()> {
+    let tmp = path.with_extension("csv.tmp");
+    create(&tmp)?;
+    let mut file = OpenOptions::new()
+        .append(true)
+        .open(&tmp)
+        .with_context(|| format!("writing {}", tmp.display()))?;
+    for part in parts {
+        let mut reader = BufReader::new(
+            File::open(part).with_context(|| format!("reading {}", part.display()))?,
+        );
+        let mut header = Vec::new();
+        reader
+            .read_until(b'\n', &mut header)
+            .with_context(|| format!("reading {}", part.display()))?;
+        std::io::copy(&mut reader, &mut file)
+            .with_context(|| format!("copying {} into {}", part.display(), path.display()))?;
+    }
+    file.flush()
+        .and_then(|()| file.sync_all())
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// Each run's training returns, from its own `episodes.csv`.
+fn rewards(folders: &[RunFolder]) -> Result<BTreeMap<(MethodId, u32), Vec<f64>>> {
+    #[derive(Deserialize)]
+    struct Row {
+        reward: f64,
+    }
+    let mut rewards = BTreeMap::new();
+    for folder in folders {
+        let path = folder.dir.join("episodes.csv");
+        let mut reader =
+            csv::Reader::from_path(&path).with_context(|| format!("reading {}", path.display()))?;
+        let returns = reader
+            .deserialize::<Row>()
+            .enumerate()
+            .map(|(i, row)| {
+                row.map(|r| r.reward)
+                    .with_context(|| format!("{}: row {}", path.display(), i + 2))
+            })
+            .collect::<Result<Vec<f64>>>()?;
+        let record = &folder.summary.record;
+        rewards.insert((record.method.clone(), record.run), returns);
+    }
+    Ok(rewards)
+}

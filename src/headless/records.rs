@@ -1,0 +1,264 @@
+//! `runs/<method>-run<r>/`: each run's own record, written while it trains into a hidden
+//! `runs/.<method>-run<r>.partial/` and renamed into place when it ends, so a folder in
+//! `runs/` is always whole: `episodes.csv`, `tests.csv`, `activations.csv` (a run that
+//! reuses the library), `trace.csv` (traced SAP-Net runs) and `run.json` (its summary).
+//! The top-level files are put together from these ([`super::assemble`]); `--resume` keeps
+//! the finished ones and runs the rest again.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+
+use super::results::{self, RunKey, RunSummary};
+use crate::config::Config;
+use crate::experiment;
+use crate::trainer::{self, EpisodeRecord, MethodId, RunRecord, TraceRecord};
+
+/// The folder of all run records in a results directory.
+pub const RUNS: &str = "runs";
+
+/// `dqn[100,100]`, run 0 → `dqn-100-100-run0`: a plain file name, of the run's folder and
+/// of its trained policy.
+pub fn run_name(method: &str, run: u32) -> String {
+    let plain: String = method
+        .chars()
+        .filter(|&c| c != ']')
+        .map(|c| if c == '[' || c == ',' { '-' } else { c })
+        .collect();
+    format!("{plain}-run{run}")
+}
+
+fn finished_dir(out: &Path, name: &str) -> PathBuf {
+    out.join(RUNS).join(name)
+}
+
+fn partial_dir(out: &Path, name: &str) -> PathBuf {
+    out.join(RUNS).join(format!(".{name}.partial"))
+}
+
+/// One run's files while it trains.
+pub struct RunWriter {
+    name: String,
+    partial: PathBuf,
+    episodes: results::EpisodeWriter,
+    activations: Option<results::ActivationsWriter>,
+    trace: Option<results::TraceWriter>,
+    /// Training returns so far, for the run's moving averages.
+    pub rewards: Vec<f64>,
+    /// The latest selector snapshot, and the selections counted before this episode.
+    snapshot: Option<(trainer::ActivationSnapshot, Vec<u64>)>,
+}
+
+impl RunWriter {
+    /// Opens the record of `method`'s run `run` in `out`, replacing any partial one a
+    /// killed process left. `names` are the library's sources, for a reusing run.
+    pub fn create(out: &Path, method: &MethodId, run: u32, names: &[String]) -> Result<Self> {
+        let name = run_name(method.label(), run);
+        let partial = partial_dir(out, &name);
+        if partial.exists() {
+            std::fs::remove_dir_all(&partial)
+                .with_context(|| format!("removing the partial record {}", partial.display()))?;
+        }
+        std::fs::create_dir_all(&partial)
+            .with_context(|| format!("creating {}", partial.display()))?;
+        let activations = if method.kind.reuses() && !names.is_empty() {
+            Some(results::ActivationsWriter::create(
+                &partial.join("activations.csv"),
+                names,
+            )?)
+        } else {
+            None
+        };
+        Ok(Self {
+            name,
+            episodes: results::EpisodeWriter::create(&partial.join("episodes.csv"))?,
+            activations,
+            trace: None,
+            rewards: Vec::new(),
+            snapshot: None,
+            partial,
+        })
+    }
+
+    /// Keeps the selector's latest state, for the row of the episode it ends.
+    pub fn snapshot(&mut self, snapshot: trainer::ActivationSnapshot) {
+        let counted = self
+            .snapshot
+            .take()
+            .map_or_else(|| vec![0; snapshot.selections.len()], |(_, c)| c);
+        self.snapshot = Some((snapshot, counted));
+    }
+
+    /// An episode's row, and for a reusing run its row of `activations.csv` from the
+    /// snapshot the trainer sends right before `EpisodeEnded`.
+    pub fn episode(&mut self, record: &EpisodeRecord) -> Result<()> {
+        self.episodes.write(record)?;
+        self.rewards.push(record.reward);
+        if let (Some(writer), Some((snapshot, counted))) =
+            (&mut self.activations, &mut self.snapshot)
+        {
+            let selected: Vec<u64> = snapshot
+                .selections
+                .iter()
+                .zip(counted.iter())
+                .map(|(now, before)| now - before)
+                .collect();
+            writer.write(
+                record.run,
+                &record.method,
+                record.episode,
+                &snapshot.activations,
+                &snapshot.probabilities,
+                &selected,
+            )?;
+            counted.clone_from(&snapshot.selections);
+        }
+        if let Some(trace) = &mut self.trace {
+            trace.flush()?;
+        }
+        Ok(())
+    }
+
+    /// One positive activation's spread calls.
+    pub fn trace(&mut self, record: &TraceRecord, names: &[String]) -> Result<()> {
+        if self.trace.is_none() {
+            self.trace = Some(results::TraceWriter::create(
+                &self.partial.join("trace.csv"),
+                names,
+            )?);
+        }
+        match &mut self.trace {
+            Some(trace) => trace.write(record),
+            None => Ok(()),
+        }
+    }
+
+    /// Writes the run's tests and summary and renames its folder into place.
+    pub fn finish(mut self, out: &Path, summary: &RunSummary) -> Result<()> {
+        let mut tests = results::TestsWriter::create(&self.partial.join("tests.csv"))?;
+        tests.write(&summary.record)?;
+        if let Some(trace) = &mut self.trace {
+            trace.flush()?;
+        }
+        results::write_json(&self.partial.join("run.json"), summary)?;
+        let finished = finished_dir(out, &self.name);
+        if finished.exists() {
+            std::fs::remove_dir_all(&finished)
+                .with_context(|| format!("replacing {}", finished.display()))?;
+        }
+        std::fs::rename(&self.partial, &finished)
+            .with_context(|| format!("renaming {} into place", self.partial.display()))
+    }
+}
+
+/// A run's record on disk.
+pub struct RunFolder {
+    pub dir: PathBuf,
+    pub summary: RunSummary,
+}
+
+/// The finished (and stopped) runs recorded in `out`, by the protocol's order: method as
+/// `config` lists them, then run. Partial folders are not records.
+pub fn read(out: &Path, config: &Config) -> Result<Vec<RunFolder>> {
+    let dir = out.join(RUNS);
+    let entries = match std::fs::read_dir(&dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", dir.display())),
+    };
+    let ids: BTreeMap<String, MethodId> = experiment::method_ids(config)
+        .into_iter()
+        .map(|id| (id.label().to_string(), id))
+        .collect();
+    let mut folders = Vec::new();
+    for entry in entries {
+        let path = entry
+            .with_context(|| format!("reading {}", dir.display()))?
+            .path();
+        let hidden = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .is_none_or(|n| n.starts_with('.'));
+        if hidden || !path.is_dir() {
+            continue;
+        }
+        let json = path.join("run.json");
+        let text = std::fs::read_to_string(&json)
+            .with_context(|| format!("reading the run record {}", json.display()))?;
+        let stored: RunSummary<String> = serde_json::from_str(&text)
+            .with_context(|| format!("reading the run record {}", json.display()))?;
+        let Some(id) = ids.get(&stored.record.method) else {
+            bail!(
+                "{}: method {:?} is not in the protocol of this results directory",
+                json.display(),
+                stored.record.method
+            );
+        };
+        folders.push(RunFolder {
+            summary: stored.with_method(id.clone()),
+            dir: path,
+        });
+    }
+    folders.sort_by_key(|f| (f.summary.record.method.index, f.summary.record.run));
+    Ok(folders)
+}
+
+/// The planned runs of `config` that `finished` does not hold as finished (not stopped).
+pub fn unfinished(config: &Config, finished: &[RunFolder]) -> Vec<RunKey> {
+    let done = |method: &MethodId, run: u32| {
+        finished.iter().any(|f| {
+            let r: &RunRecord = &f.summary.record;
+            &r.method == method && r.run == run && !r.stopped
+        })
+    };
+    let ids = experiment::method_ids(config);
+    let mut keys = Vec::new();
+    for id in &ids {
+        for run in 0..config.protocol.runs {
+            if !done(id, run) {
+                keys.push(RunKey {
+                    method: id.label().to_string(),
+                    run,
+                });
+            }
+        }
+    }
+    keys
+}
+
+/// Removes what a resumed protocol runs again: partial records (a killed process's) and
+/// the records of stopped runs.
+pub fn clear_unfinished(out: &Path, finished: &[RunFolder]) -> Result<()> {
+    let dir = out.join(RUNS);
+    if let Ok(entries) = std::fs::read_dir(&dir) {
+        for entry in entries.flatten() {
+            let path = entry.path();
+            let partial = path
+                .file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with('.') && n.ends_with(".partial"));
+            if partial {
+                std::fs::remove_dir_all(&path)
+                    .with_context(|| format!("removing {}", path.display()))?;
+            }
+        }
+    }
+    for folder in finished.iter().filter(|f| f.summary.record.stopped) {
+        std::fs::remove_dir_all(&folder.dir)
+            .with_context(|| format!("removing {}", folder.dir.display()))?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn run_names_are_plain() {
+        assert_eq!(run_name("dqn[100,100]", 0), "dqn-100-100-run0");
+        assert_eq!(run_name("dqn[16]", 3), "dqn-16-run3");
+        assert_eq!(run_name("sapnet", 1), "sapnet-run1");
+    }
+}
