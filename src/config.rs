@@ -303,10 +303,11 @@ impl Default for ProtocolConfig {
 /// A config that could not be read: where, and what was expected.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
-    #[error("reading config {}: {source}", path.display())]
+    // The OS error is part of the message, not a `source`: a chain prints it once.
+    #[error("reading config {}: {cause}", path.display())]
     Io {
         path: PathBuf,
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     #[error("{0}")]
     Parse(Box<ParseError>),
@@ -385,7 +386,7 @@ impl Config {
     pub fn from_file(path: &Path) -> Result<Self, ConfigError> {
         let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
             path: path.to_path_buf(),
-            source,
+            cause: source,
         })?;
         Self::from_ron(&text, &path.display().to_string())
     }
@@ -503,13 +504,39 @@ impl Config {
     }
 }
 
-fn check(ok: bool, field: &str, expected: &str, got: impl fmt::Display) -> Result<(), String> {
+fn check(ok: bool, field: &str, expected: &str, got: impl Shown) -> Result<(), String> {
     if ok {
         Ok(())
     } else {
-        Err(format!("field `{field}`: expected {expected}, got {got}"))
+        Err(format!(
+            "field `{field}`: expected {expected}, got {}",
+            got.shown()
+        ))
     }
 }
+
+/// A value as an error message shows it: numbers in their shortest form (`1e308`, not 309
+/// digits).
+pub trait Shown {
+    fn shown(&self) -> String;
+}
+
+impl Shown for f64 {
+    fn shown(&self) -> String {
+        format!("{self:?}")
+    }
+}
+
+macro_rules! shown_as_displayed {
+    ($($t:ty),*) => {$(
+        impl Shown for $t {
+            fn shown(&self) -> String {
+                self.to_string()
+            }
+        }
+    )*};
+}
+shown_as_displayed!(u32, u64, usize, i64, String, &str);
 
 /// The ranges of a DQN config found at `prefix` (`dqn`, `sources.dqn`).
 fn check_dqn(d: &DqnConfig, prefix: &str) -> Result<(), String> {

@@ -86,20 +86,22 @@ pub struct StoredPolicy {
 pub enum StoreError {
     #[error("policy file {} does not exist", path.display())]
     Missing { path: PathBuf },
-    #[error("reading policy file {}: {source}", path.display())]
+    // The OS error is part of the message, not a `source`, so that a chain of errors
+    // prints it once.
+    #[error("reading policy file {}: {cause}", path.display())]
     Read {
         path: PathBuf,
-        source: std::io::Error,
+        cause: std::io::Error,
     },
-    #[error("writing policy file {}: {source}", path.display())]
+    #[error("writing policy file {}: {cause}", path.display())]
     Write {
         path: PathBuf,
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     #[error("policy name {name:?} is not a plain file name (nor {RESERVED_NAME:?})")]
     InvalidName { name: String },
     #[error("policy metadata: {0}")]
-    Metadata(#[from] ConfigError),
+    Metadata(ConfigError),
     #[error("policy file {}: {message}", path.display())]
     Invalid { path: PathBuf, message: String },
     #[error("policy weights {} do not match their metadata {}: {mismatch}", weights.display(), metadata.display())]
@@ -110,6 +112,12 @@ pub enum StoreError {
     },
     #[error("policy {} does not fit the task: {mismatch}", path.display())]
     DoesNotFit { path: PathBuf, mismatch: String },
+}
+
+impl From<ConfigError> for StoreError {
+    fn from(error: ConfigError) -> Self {
+        StoreError::Metadata(error)
+    }
 }
 
 /// The two files of policy `name` in `dir`: `(weights, metadata)`.
@@ -131,7 +139,7 @@ pub fn save(
     check_name(name)?;
     fs::create_dir_all(dir).map_err(|source| StoreError::Write {
         path: dir.to_path_buf(),
-        source,
+        cause: source,
     })?;
     let (weights_path, metadata_path) = paths(dir, name);
     let weights_tmp = temporary(&weights_path);
@@ -322,7 +330,7 @@ pub fn list(dir: &Path) -> Result<Vec<String>, StoreError> {
         Err(source) => {
             return Err(StoreError::Read {
                 path: dir.to_path_buf(),
-                source,
+                cause: source,
             })
         }
     };
@@ -330,7 +338,7 @@ pub fn list(dir: &Path) -> Result<Vec<String>, StoreError> {
     for entry in entries {
         let entry = entry.map_err(|source| StoreError::Read {
             path: dir.to_path_buf(),
-            source,
+            cause: source,
         })?;
         let path = entry.path();
         if path.extension().is_some_and(|e| e == "ron") {
@@ -354,7 +362,7 @@ pub fn orphan_weights(dir: &Path) -> Result<Vec<String>, StoreError> {
         Err(source) => {
             return Err(StoreError::Read {
                 path: dir.to_path_buf(),
-                source,
+                cause: source,
             })
         }
     };
@@ -414,7 +422,7 @@ fn read(path: &Path) -> Result<Vec<u8>, StoreError> {
         },
         _ => StoreError::Read {
             path: path.to_path_buf(),
-            source,
+            cause: source,
         },
     })
 }
@@ -427,13 +435,13 @@ fn write_synced(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
     };
     write().map_err(|source| StoreError::Write {
         path: path.to_path_buf(),
-        source,
+        cause: source,
     })
 }
 
 fn rename(from: &Path, to: &Path) -> Result<(), StoreError> {
     fs::rename(from, to).map_err(|source| StoreError::Write {
         path: to.to_path_buf(),
-        source,
+        cause: source,
     })
 }

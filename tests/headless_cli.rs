@@ -216,3 +216,60 @@ fn output_flags_without_headless_are_refused_before_the_dashboard_opens() {
     }
     assert!(!Path::new("somewhere").exists());
 }
+
+/// Issue 13: an OS error was printed twice (once by the error, once by its source) and
+/// numbers in messages took 300 digits.
+#[test]
+fn errors_say_their_cause_once_with_numbers_in_their_shortest_form() {
+    let tmp = tempfile::tempdir().unwrap();
+    let output = sapnet(&["--headless", "--config", "no/such/file.ron"]);
+    let message = stderr(&output);
+    assert_eq!(message.matches("No such file").count(), 1, "{message}");
+
+    let huge = tmp.path().join("huge.ron");
+    std::fs::write(&huge, "(dqn: (gamma: 1e300))").unwrap();
+    let output = sapnet(&["--headless", "--config", huge.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(message.contains("got 1e300"), "{message}");
+    assert!(!message.contains("0000000000"), "{message}");
+}
+
+/// Issue 13: a training run with `sapnet.coefficient: 1e308` wrote NaN probabilities to
+/// activations.csv with exit 0. It is refused before any run trains, and said once.
+#[test]
+fn a_coefficient_that_would_overflow_is_refused_before_any_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    let trained = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args([
+            "sources",
+            "--config",
+            &config("tiny_sources.ron"),
+            "--library",
+        ])
+        .arg(&library)
+        .output()
+        .unwrap();
+    assert!(trained.status.success(), "{}", stderr(&trained));
+    let big = tmp.path().join("big.ron");
+    let text = std::fs::read_to_string(config("tiny_transfer.ron"))
+        .unwrap()
+        .replace("seed: 5,", "seed: 5, sapnet: (coefficient: 1e308),");
+    std::fs::write(&big, text).unwrap();
+    let out = tmp.path().join("out");
+    let output = sapnet(&[
+        "--headless",
+        "--config",
+        big.to_str().unwrap(),
+        "--library",
+        library.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert_eq!(message.matches("too large").count(), 1, "{message}");
+    assert!(message.contains("method sapnet"), "{message}");
+    assert!(!out.join("runs").exists(), "no run started");
+}

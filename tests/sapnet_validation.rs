@@ -194,3 +194,38 @@ fn a_graph_whose_walks_would_explode_is_refused() {
     let hub = Graph::from_edges(n, (1..n).map(|j| (0, j, 0.95))).unwrap();
     assert!(SapNet::new(hub, SapNetParams::default()).is_ok());
 }
+
+/// Fig. 2's graph: the lightest edge 0.4, the largest degree 3, T_ω = 1, so one activation
+/// makes at most 3 + 9 = 12 deposits of at most 𝒜/0.4 each: it adds at most 31·𝒜 to an
+/// activation, and 10¹² activations stay below f64::MAX for 𝒜 ≤ f64::MAX / (31·10¹²).
+#[test]
+fn an_activated_coefficient_that_could_overflow_the_activations_is_refused() {
+    let fig2 = || Graph::from_edges(4, [(0, 1, 0.4), (0, 2, 0.4), (1, 2, 0.4), (1, 3, 0.4)]);
+    let most = f64::MAX / (31.0 * 1e12);
+    let with = |coefficient: f64| {
+        SapNet::new(
+            fig2().unwrap(),
+            SapNetParams {
+                coefficient,
+                ..SapNetParams::default()
+            },
+        )
+    };
+    assert!(with(most).is_ok());
+    assert!(with(-most).is_ok());
+    let err = with(most * 1.001).unwrap_err();
+    assert!(
+        matches!(err, SapNetError::ActivationOverflow { most: m, .. } if m == most),
+        "{err:?}"
+    );
+    let err = with(1e308).unwrap_err().to_string();
+    assert!(err.contains("𝒜 = 1e308 is too large"), "{err}");
+    assert!(err.contains("expected |𝒜| ≤ 5.799e294"), "{err}");
+    // Activations that start high leave less room.
+    let high = SapNet::with_activations(
+        fig2().unwrap(),
+        SapNetParams::default(),
+        vec![f64::MAX, 0.0, 0.0, 0.0],
+    );
+    assert!(matches!(high, Err(SapNetError::ActivationOverflow { .. })));
+}

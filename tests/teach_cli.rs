@@ -138,3 +138,32 @@ fn the_interactive_view_is_not_there_yet() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--headless"));
 }
+
+/// Issue 13: `coefficient: 1e308` printed inf and NaN (and panicked in the interactive
+/// view); it is refused at its field, before anything is activated.
+#[test]
+fn a_coefficient_that_would_overflow_is_refused_at_its_field() {
+    let tmp = tempfile::tempdir().unwrap();
+    let lesson = tmp.path().join("big.ron");
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/teach_fig2.ron"),
+    )
+    .unwrap()
+    .replace("coefficient: 1.0", "coefficient: 1e308");
+    std::fs::write(&lesson, text).unwrap();
+    let output = sapnet(&[
+        "teach",
+        "--headless",
+        "--config",
+        lesson.to_str().unwrap(),
+        "--activate",
+        "1",
+        "--activate",
+        "1",
+    ]);
+    assert_eq!(output.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("field `coefficient`"), "{stderr}");
+    assert!(stderr.contains("1e308"), "{stderr}");
+    assert!(output.stdout.is_empty());
+}

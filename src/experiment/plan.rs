@@ -4,7 +4,7 @@
 use std::sync::mpsc::Receiver;
 use std::sync::Arc;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 
 use crate::config::Config;
 use crate::seeds;
@@ -42,6 +42,14 @@ pub fn plan(config: &Config, library: &LibraryRoot, stop: &Receiver<Command>) ->
         None
     };
     let specs = run_specs(config, sources.as_ref());
+    // A selector that cannot be built fails every run of its method: say so before any
+    // run trains.
+    for spec in specs
+        .iter()
+        .filter(|s| s.run == 0 && s.method.kind.reuses())
+    {
+        crate::trainer::selector(spec).with_context(|| format!("method {}", spec.method))?;
+    }
     Ok(Plan { specs, sources })
 }
 

@@ -10,6 +10,7 @@
 //! After the episode, `W_k ← (W_k·U_k + R)/(U_k + 1)`, `U_k ← U_k + 1`, where R is the
 //! episode's discounted return, and `τ ← τ + Δτ`. The result of a run is the learner.
 
+use crate::config::Shown;
 use rand::rngs::StdRng;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
@@ -57,16 +58,17 @@ impl PrqlKnobs {
 
     /// The ranges serde cannot check; `field` is where the knobs sit in the config.
     pub fn validate(&self, field: &str) -> Result<(), String> {
-        let fail = |name: &str, expected: &str, got: &dyn std::fmt::Display| {
+        let fail = |name: &str, expected: &str, got: &dyn Shown| {
             Err(format!(
-                "field `{field}.{name}`: expected {expected}, got {got}"
+                "field `{field}.{name}`: expected {expected}, got {}",
+                got.shown()
             ))
         };
         if self.hidden.is_empty() || self.hidden.contains(&0) {
             return fail(
                 "hidden",
                 "a non-empty list of layer sizes > 0",
-                &format!("{:?}", self.hidden),
+                &format!("{:?}", self.hidden).as_str(),
             );
         }
         if !(0.0..=1.0).contains(&self.psi) {

@@ -84,7 +84,7 @@ impl SapNetKnobs {
         }
         if !(self.decay > 0.0 && self.decay <= 1.0) {
             return Err(format!(
-                "field `{field}.decay`: expected λ in (0, 1], got {}",
+                "field `{field}.decay`: expected λ in (0, 1], got {:?}",
                 self.decay
             ));
         }
@@ -377,7 +377,7 @@ mod tests {
         });
         assert_eq!(
             decay,
-            "field `protocol.methods[1].decay`: expected λ in (0, 1], got 0"
+            "field `protocol.methods[1].decay`: expected λ in (0, 1], got 0.0"
         );
         assert!(bad(SapNetKnobs {
             decay: 1.5,

@@ -32,7 +32,7 @@ impl Schedule {
         for (name, value) in [("from", from), ("to", to)] {
             if !(value > 0.0 && value.is_finite()) {
                 return Err(format!(
-                    "field `{field}.{name}`: expected a finite number > 0, got {value}"
+                    "field `{field}.{name}`: expected a finite number > 0, got {value:?}"
                 ));
             }
         }
@@ -81,7 +81,7 @@ mod tests {
             .unwrap_err();
         assert_eq!(
             err,
-            "field `protocol.methods[1].temperature.to`: expected a finite number > 0, got 0"
+            "field `protocol.methods[1].temperature.to`: expected a finite number > 0, got 0.0"
         );
         let s = Schedule::Exponential {
             from: 1.0,

@@ -5,7 +5,7 @@
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SapNetError {
     #[error(
-        "edge ({i}, {j}) weighs {weight}: every edge weight must be a finite number > 0, \
+        "edge ({i}, {j}) weighs {weight:?}: every edge weight must be a finite number > 0, \
          or spreading would never end"
     )]
     BadWeight { i: usize, j: usize, weight: f64 },
@@ -27,15 +27,21 @@ pub enum SapNetError {
     SelfLoop { i: usize },
     #[error("edge ({i}, {j}) is listed twice")]
     DuplicateEdge { i: usize, j: usize },
-    #[error("parameter `{name}` is {value}: expected {expected}")]
+    #[error("parameter `{name}` is {value:?}: expected {expected}")]
     BadParameter {
         name: String,
         value: f64,
         expected: &'static str,
     },
+    #[error(
+        "the activated coefficient 𝒜 = {coefficient:?} is too large: 10^12 activations over \
+         this graph could take an activation past the largest number an f64 holds (it would \
+         read inf, and the probabilities NaN); expected |𝒜| ≤ {most:.3e}"
+    )]
+    ActivationOverflow { coefficient: f64, most: f64 },
     #[error("{got} initial activations given for {n} policies")]
     ActivationCount { n: usize, got: usize },
-    #[error("initial activation of policy {i} is {value}: expected a finite number")]
+    #[error("initial activation of policy {i} is {value:?}: expected a finite number")]
     BadActivation { i: usize, value: f64 },
     #[error("policy {i} does not exist: there are {n} policies, numbered from 0")]
     NoSuchPolicy { i: usize, n: usize },

@@ -27,25 +27,32 @@ pub use error::SapNetError;
 pub use graph::Graph;
 pub use judgment::judge;
 pub use policy::PolicyDescription;
-pub use spreading::{Call, NoTrace, Spreader, Spreading, TraceSink, TraceStep};
+pub use spreading::{Call, NoTrace, SpreadState, Spreader, Spreading, TraceSink, TraceStep};
 
 /// Most depositing `spread` calls one activation may make. Positive weights make every
 /// walk end (eq. 10), but a light graph under a high threshold can still take longer than
 /// anyone will wait; refuse it rather than hang.
 pub const MAX_SPREAD_CALLS: f64 = 1e7;
 
+/// Activations a SAP-Net is built to take with every activation staying a finite number:
+/// more than any run makes (10¹² steps at a microsecond each are eleven days).
+pub const MAX_ACTIVATIONS: f64 = 1e12;
+
 /// Bounds the depositing calls of one activation: a call at hop h has Ω ≥ h·w_min and
 /// deposits only while Ω < T_ω, so deposits happen at most H = ⌊T_ω / w_min⌋ hops deep
 /// (⌊⌋ rather than ⌈⌉ − 1 allows for rounding in Ω's sum), at most Σ_{h=1..H} d^h of them
 /// for the largest degree d. Calls the threshold stops are not made unless a trace asks
 /// for them (at most d per deposit more).
-fn check_spreading_bound(graph: &Graph, threshold: f64) -> Result<(), SapNetError> {
+///
+/// Returns how much one activation with 𝒜 = 1 can add to one policy's activation at most:
+/// 1 for eq. 8, and each deposit η/(h·Ω) ≤ 1/w_min (η ≤ 𝒜, h ≥ 1, Ω ≥ w_min).
+fn check_spreading_bound(graph: &Graph, threshold: f64) -> Result<f64, SapNetError> {
     let lightest = (0..graph.len())
         .map(|i| graph.lightest(i))
         .fold(f64::INFINITY, f64::min);
     let degree = (0..graph.len()).map(|i| graph.degree(i)).max().unwrap_or(0);
     if !lightest.is_finite() || degree == 0 {
-        return Ok(());
+        return Ok(1.0);
     }
     let hops = (threshold / lightest).floor();
     let d = degree as f64;
@@ -63,7 +70,24 @@ fn check_spreading_bound(graph: &Graph, threshold: f64) -> Result<(), SapNetErro
             degree,
         });
     }
-    Ok(())
+    Ok(1.0 + calls / lightest)
+}
+
+/// Refuses an 𝒜 with which [`MAX_ACTIVATIONS`] activations, each adding at most
+/// `gain`·|𝒜| (see [`check_spreading_bound`]), could take an activation past the largest
+/// f64 from where `activations` start: activations stay finite by construction.
+fn check_activation_bound(
+    gain: f64,
+    coefficient: f64,
+    activations: &[f64],
+) -> Result<(), SapNetError> {
+    let start = activations.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+    let most = (f64::MAX - start) / (MAX_ACTIVATIONS * gain);
+    if coefficient.abs() <= most {
+        Ok(())
+    } else {
+        Err(SapNetError::ActivationOverflow { coefficient, most })
+    }
 }
 
 /// A SAP-Net with its activations 𝔸: what the transfer loop selects from and activates.
@@ -99,8 +123,9 @@ impl SapNet {
         activations: Vec<f64>,
     ) -> Result<Self, SapNetError> {
         params.validate()?;
-        check_spreading_bound(&graph, params.threshold)?;
+        let gain = check_spreading_bound(&graph, params.threshold)?;
         check_activations(graph.len(), &activations)?;
+        check_activation_bound(gain, params.coefficient, &activations)?;
         let selection = SelectionTerms::new(&activations, params.temperature);
         Ok(Self {
             graph,

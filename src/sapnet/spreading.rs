@@ -223,6 +223,46 @@ pub struct Spreader<'g> {
     path: Vec<usize>,
 }
 
+/// A suspended [`Spreader`]: the pending calls and the path, without the graph.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpreadState {
+    spreading: Spreading,
+    skip_stopped: bool,
+    pending: Vec<Call>,
+    path: Vec<usize>,
+}
+
+/// A finished walk: nothing pending (a placeholder while the real state is resumed).
+impl Default for SpreadState {
+    fn default() -> Self {
+        SpreadState {
+            spreading: Spreading {
+                threshold: 0.0,
+                paths: Paths::Literal,
+            },
+            skip_stopped: false,
+            pending: Vec::new(),
+            path: Vec::new(),
+        }
+    }
+}
+
+impl SpreadState {
+    /// The pending calls, the next one last.
+    pub fn pending(&self) -> &[Call] {
+        &self.pending
+    }
+
+    pub fn is_done(&self) -> bool {
+        self.pending.is_empty()
+    }
+
+    /// See [`Spreader::path`].
+    pub fn path(&self) -> &[usize] {
+        &self.path
+    }
+}
+
 impl<'g> Spreader<'g> {
     /// Algorithm 1 up to its loop: `A[i] += 𝒜` (eq. 8), then one pending call
     /// `spread(j, 1, M_ij, 𝒜/k, i)` per neighbour j (eq. 9). Every later call, stopped ones
@@ -297,6 +337,28 @@ impl<'g> Spreader<'g> {
             self.queue_neighbours(to, h + 1, omega, eta / self.graph.degree(to) as f64);
         }
         Some(step)
+    }
+
+    /// Lets go of the graph, keeping where the walk stands: a front end that makes one
+    /// call per key keeps the state and [`resume`](Self::resume)s it, in O(1).
+    pub fn suspend(self) -> SpreadState {
+        SpreadState {
+            spreading: self.spreading,
+            skip_stopped: self.skip_stopped,
+            pending: self.pending,
+            path: self.path,
+        }
+    }
+
+    /// The walk `state` describes, over the graph it was started on.
+    pub fn resume(graph: &'g Graph, state: SpreadState) -> Self {
+        Spreader {
+            graph,
+            spreading: state.spreading,
+            skip_stopped: state.skip_stopped,
+            pending: state.pending,
+            path: state.path,
+        }
     }
 
     /// The pending calls, the next one last.

@@ -148,7 +148,7 @@ impl ManifestEntry {
         let metadata_path = policy_store::paths(dir, name).1;
         let bytes = fs::read(&metadata_path).map_err(|source| StoreError::Read {
             path: metadata_path,
-            source,
+            cause: source,
         })?;
         let entry = Self {
             name: name.to_string(),
@@ -172,7 +172,12 @@ pub fn read(dir: &Path) -> Result<Option<Manifest>, StoreError> {
     let text = match fs::read_to_string(&path) {
         Ok(text) => text,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(source) => return Err(StoreError::Read { path, source }),
+        Err(source) => {
+            return Err(StoreError::Read {
+                path,
+                cause: source,
+            })
+        }
     };
     Ok(Some(parse_ron(&text, &path.display().to_string())?))
 }

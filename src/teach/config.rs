@@ -84,7 +84,7 @@ impl TeachConfig {
             Some(path) => {
                 let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
                     path: path.to_path_buf(),
-                    source,
+                    cause: source,
                 })?;
                 Self::lesson_from_ron(&text, &path.display().to_string())
             }
@@ -132,6 +132,8 @@ impl TeachConfig {
             SapNetError::UnboundedSpreading { .. } => {
                 format!("fields `edges` and `threshold`: {e}")
             }
+            SapNetError::ActivationOverflow { .. } => in_field("coefficient")(e),
+            SapNetError::BadParameter { ref name, .. } => format!("field `{name}`: {e}"),
             other => in_field("initial")(other),
         })?;
         let names = if self.names.is_empty() {

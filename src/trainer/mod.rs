@@ -16,7 +16,7 @@ pub use events::{
     ActivationSnapshot, ChosenPolicy, Command, EpisodeRecord, Event, MethodId, RunRecord,
     SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
 };
-pub use run::{test_greedy, train, RunSpec, SourcePolicy, LOCK_IN};
+pub use run::{selector, test_greedy, train, RunSpec, SourcePolicy, LOCK_IN};
 
 use crate::dqn::{DqnError, QNet};
 use crate::reuse::ReuseError;
@@ -26,11 +26,18 @@ use crate::reuse::ReuseError;
 pub enum TrainerError {
     #[error(transparent)]
     Dqn(#[from] DqnError),
+    // Not a `source`: the message says it, and a chain prints it once.
     #[error("building the selector over the source policies: {0}")]
-    Reuse(#[from] ReuseError),
+    Reuse(ReuseError),
     /// The loss or a gradient became NaN or infinite.
     #[error("policy {} (run {}) diverged: {}", .0.method, .0.run, .0.source)]
     Diverged(Box<Divergence>),
+}
+
+impl From<ReuseError> for TrainerError {
+    fn from(error: ReuseError) -> Self {
+        TrainerError::Reuse(error)
+    }
 }
 
 /// A run that diverged: what it had done, and the weights before the update that failed.

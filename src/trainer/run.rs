@@ -221,6 +221,21 @@ fn library_start(
     }))
 }
 
+/// The selector of `spec`'s method over its sources: a run's first step, and a check a
+/// front end makes before starting any run (an 𝒜 the graph cannot take, a best source
+/// without scores).
+pub fn selector(spec: &RunSpec) -> Result<Box<dyn reuse::Selector>, TrainerError> {
+    let descriptions: Vec<PolicyDescription> =
+        spec.sources.iter().map(|s| s.description.clone()).collect();
+    let scores: Vec<Option<f64>> = spec.sources.iter().map(|s| s.final_score).collect();
+    let library = reuse::Library {
+        descriptions: &descriptions,
+        scores: &scores,
+        return_range: spec.env.return_range(),
+    };
+    Ok(reuse::build(&spec.reuse, library, &spec.sapnet)?)
+}
+
 /// Trains `spec` for its episodes (or `spec.max_steps` steps, whichever comes first), then
 /// tests the result greedily: the chosen source, or the method's own learner. Sends the
 /// events of `spec.stream` and obeys `commands` (see [`Command`]); a [`Command::Stop`] (or
@@ -238,13 +253,7 @@ pub fn train(
     let mut env = env::make(&spec.env);
     let descriptions: Vec<PolicyDescription> =
         spec.sources.iter().map(|s| s.description.clone()).collect();
-    let scores: Vec<Option<f64>> = spec.sources.iter().map(|s| s.final_score).collect();
-    let library = reuse::Library {
-        descriptions: &descriptions,
-        scores: &scores,
-        return_range: spec.env.return_range(),
-    };
-    let mut selector = reuse::build(&spec.reuse, library, &spec.sapnet)?;
+    let mut selector = selector(spec)?;
     let learning = selector.learning();
     let n = spec.sources.len();
     let agents = match learning {

@@ -388,6 +388,9 @@ impl Dashboard {
 
     /// Records the step count at `now` for the steps/s figure (over the last 2 s).
     pub fn tick(&mut self, now: Instant) {
+        if let Some(teach) = &mut self.teach {
+            teach.advance(super::teach::CALLS_PER_FRAME);
+        }
         // A count that went back belongs to a new run (`m`): measure it afresh.
         if self
             .speedometer
@@ -539,7 +542,7 @@ pub fn apply_teach_key(teach: &mut Teach, key: KeyEvent) -> bool {
         KeyCode::Char('s') => {
             teach.step();
         }
-        KeyCode::Char('r') => teach.run_to_end(),
+        KeyCode::Char('r') => teach.run(),
         KeyCode::Char('u') => teach.undo(),
         KeyCode::Char('c') => teach.reset(),
         _ => return false,

@@ -180,10 +180,17 @@ pub fn run_teach(mut teach: Teach) -> Result<()> {
         if crate::signals::received().is_some() {
             return Ok(());
         }
+        // A long `r` runs in slices between frames: keys are read between them.
+        teach.advance(teach::CALLS_PER_FRAME);
         terminal
             .draw(|frame| view::draw_teach(frame, &teach, help, theme))
             .context("drawing teach mode")?;
-        if !term::poll(FRAME).context("reading the keyboard")? {
+        let wait = if teach.is_running() {
+            Duration::ZERO
+        } else {
+            FRAME
+        };
+        if !term::poll(wait).context("reading the keyboard")? {
             continue;
         }
         let term::Event::Key(key) = term::read().context("reading the keyboard")? else {

@@ -1,12 +1,16 @@
 //! Teach mode's state: one activation's spreading recursion, stepped a `spread` call at a
 //! time (Algorithms 1 and 2), with undo.
 //!
-//! A [`Spreader`] borrows the graph, so the state keeps what is needed to rebuild it
-//! instead: the activations before the activation started and how many calls were made.
-//! Stepping, undoing and redrawing replay the calls from there; a teaching graph makes a
-//! few dozen, so a replay costs microseconds.
+//! The walk keeps the recursion's state ([`SpreadState`]: the pending calls and the path)
+//! and its own activations, so a step costs O(1) whatever the walk's length. Undo rebuilds
+//! the walk from its start, one call fewer. `r` runs the rest in slices of
+//! [`Teach::advance`], so a walk of millions of calls leaves the screen and the keys
+//! responsive.
 
-use crate::sapnet::{Call, SapNet, Spreader, TraceStep};
+use crate::sapnet::{Call, SapNet, SpreadState, Spreader, TraceStep};
+
+/// Calls `r` makes between two frames: a few milliseconds' worth.
+pub const CALLS_PER_FRAME: usize = 50_000;
 
 /// Where teach mode stands: which policy is picked, and the activation in progress.
 #[derive(Debug, Clone)]
@@ -18,6 +22,8 @@ pub struct Teach {
     /// The policy the arrows point at.
     cursor: usize,
     walk: Option<Walk>,
+    /// `r` was pressed: the front end calls [`Teach::advance`] between frames.
+    running: bool,
     /// Category of each policy, to draw related policies together.
     groups: Option<Vec<usize>>,
 }
@@ -30,18 +36,22 @@ struct Walk {
     before: Vec<f64>,
     /// The calls made so far, in order.
     trace: Vec<TraceStep>,
+    /// The recursion after those calls.
+    state: SpreadState,
+    /// The activations after those calls (the net's, once synced).
+    activations: Vec<f64>,
 }
 
 /// What a front end draws of the walk in progress.
 #[derive(Debug, Clone, PartialEq)]
-pub struct WalkView {
+pub struct WalkView<'a> {
     pub policy: usize,
     /// The calls made so far.
-    pub trace: Vec<TraceStep>,
+    pub trace: &'a [TraceStep],
     /// The pending calls, the next one last (the recursion's stack).
-    pub pending: Vec<Call>,
+    pub pending: &'a [Call],
     /// The walk from the activated policy to the last call's target.
-    pub path: Vec<usize>,
+    pub path: &'a [usize],
     pub done: bool,
 }
 
@@ -54,6 +64,7 @@ impl Teach {
             initial,
             cursor: 0,
             walk: None,
+            running: false,
             groups: None,
         }
     }
@@ -94,89 +105,138 @@ impl Teach {
     /// its deposits are not lost.
     pub fn activate(&mut self) {
         self.run_to_end();
-        self.walk = Some(Walk {
-            policy: self.cursor,
-            before: self.net.activations().to_vec(),
-            trace: Vec::new(),
-        });
-        self.replay();
+        let before = self.net.activations().to_vec();
+        let walk = self.start(self.cursor, before);
+        self.walk = Some(walk);
+        self.sync();
     }
 
     /// `s`: makes the next `spread` call. Returns it, or `None` when there is nothing to
     /// step.
     pub fn step(&mut self) -> Option<TraceStep> {
-        let (mut spreader, mut activations) = self.replayed(self.walk.as_ref()?);
-        let call = spreader.step(&mut activations)?;
-        self.walk.as_mut()?.trace.push(call);
-        self.set_activations(activations);
-        Some(call)
+        self.running = false;
+        let call = self.call();
+        self.sync();
+        call
     }
 
     /// `r`: makes every remaining call of the walk in progress.
     pub fn run_to_end(&mut self) {
-        while self.step().is_some() {}
+        self.running = false;
+        while self.call().is_some() {}
+        self.sync();
+    }
+
+    /// `r` in a front end: the remaining calls are made by [`advance`](Self::advance).
+    pub fn run(&mut self) {
+        self.running = self.walk.as_ref().is_some_and(|w| !w.state.is_done());
+    }
+
+    /// Whether `r` is still making calls.
+    pub fn is_running(&self) -> bool {
+        self.running
+    }
+
+    /// Makes up to `calls` of the remaining calls while running; returns how many.
+    pub fn advance(&mut self, calls: usize) -> usize {
+        if !self.running {
+            return 0;
+        }
+        let mut made = 0;
+        while made < calls && self.call().is_some() {
+            made += 1;
+        }
+        if made < calls {
+            self.running = false;
+        }
+        self.sync();
+        made
     }
 
     /// `u`: takes back the last call (or, before any, the activation itself).
     pub fn undo(&mut self) {
-        let Some(walk) = self.walk.as_mut() else {
+        self.running = false;
+        let Some(walk) = self.walk.take() else {
             return;
         };
-        if walk.trace.pop().is_none() {
-            let before = walk.before.clone();
-            self.walk = None;
-            self.set_activations(before);
+        let mut trace = walk.trace;
+        if trace.pop().is_none() {
+            self.set_activations(walk.before);
             return;
         }
-        self.replay();
+        let mut rebuilt = self.start(walk.policy, walk.before);
+        for _ in 0..trace.len() {
+            let mut spreader = Spreader::resume(self.net.graph(), rebuilt.state);
+            spreader.step(&mut rebuilt.activations);
+            rebuilt.state = spreader.suspend();
+        }
+        rebuilt.trace = trace;
+        self.walk = Some(rebuilt);
+        self.sync();
     }
 
     /// `c`: back to the activations the lesson started with.
     pub fn reset(&mut self) {
+        self.running = false;
         self.walk = None;
         self.set_activations(self.initial.clone());
     }
 
     /// The walk in progress, if any.
-    pub fn walk(&self) -> Option<WalkView> {
+    pub fn walk(&self) -> Option<WalkView<'_>> {
         let walk = self.walk.as_ref()?;
-        let (spreader, _) = self.replayed(walk);
         Some(WalkView {
             policy: walk.policy,
-            trace: walk.trace.clone(),
-            pending: spreader.pending().to_vec(),
-            path: spreader.path().to_vec(),
-            done: spreader.is_done(),
+            trace: &walk.trace,
+            pending: walk.state.pending(),
+            path: walk.state.path(),
+            done: walk.state.is_done(),
         })
     }
 
-    /// The walk's spreader and activations after its calls so far, rebuilt from its start.
-    fn replayed(&self, walk: &Walk) -> (Spreader<'_>, Vec<f64>) {
-        let mut activations = walk.before.clone();
-        let mut spreader = Spreader::activate(
+    /// A walk activating `policy` from the activations `before` (eq. 8, the first calls
+    /// queued).
+    fn start(&self, policy: usize, before: Vec<f64>) -> Walk {
+        let mut activations = before.clone();
+        let state = Spreader::activate(
             self.net.graph(),
             self.net.spreading(),
-            walk.policy,
+            policy,
             self.net.params().coefficient,
             &mut activations,
-        );
-        for _ in 0..walk.trace.len() {
-            spreader.step(&mut activations);
+        )
+        .suspend();
+        Walk {
+            policy,
+            before,
+            trace: Vec::new(),
+            state,
+            activations,
         }
-        (spreader, activations)
     }
 
-    /// Sets the activations to what the walk's calls so far leave.
-    fn replay(&mut self) {
+    /// The next call of the walk, on the walk's own activations; O(1).
+    fn call(&mut self) -> Option<TraceStep> {
+        let walk = self.walk.as_mut()?;
+        let state = std::mem::take(&mut walk.state);
+        let mut spreader = Spreader::resume(self.net.graph(), state);
+        let call = spreader.step(&mut walk.activations);
+        walk.state = spreader.suspend();
+        walk.trace.extend(call);
+        call
+    }
+
+    /// Shows the walk's activations on the net.
+    fn sync(&mut self) {
         if let Some(walk) = &self.walk {
-            let (_, activations) = self.replayed(walk);
+            let activations = walk.activations.clone();
             self.set_activations(activations);
         }
     }
 
     fn set_activations(&mut self, activations: Vec<f64>) {
-        // Spreading only adds finite deposits to finite activations, and the count is the
-        // graph's: `set_activations` cannot refuse these.
+        // The net's bounds keep every activation finite (see `SapNet::with_activations`)
+        // and the count is the graph's: `set_activations` cannot refuse these.
         self.net
             .set_activations(activations)
             .expect("activations from the same graph");
@@ -243,5 +303,42 @@ mod tests {
         teach.reset();
         assert_eq!(teach.net().activations(), &[0.0; 4]);
         assert!(teach.walk().is_none());
+    }
+
+    /// The graph of issue 13: 300 policies, every pair joined with weight 0.6. One
+    /// activation makes ~89,000 calls; replaying the walk at every step (as teach mode
+    /// once did) froze the screen for seconds in a release build.
+    fn complete(n: usize) -> SapNet {
+        let edges = (0..n).flat_map(|i| (i + 1..n).map(move |j| (i, j, 0.6)));
+        let graph = crate::sapnet::Graph::from_edges(n, edges).unwrap();
+        SapNet::new(graph, crate::sapnet::SapNetParams::default()).unwrap()
+    }
+
+    #[test]
+    fn a_long_walk_runs_in_slices_to_the_activation_in_one_go() {
+        let net = complete(300);
+        let names = (0..300).map(|i| format!("p{i}")).collect();
+        let mut teach = Teach::new(names, net.clone());
+        teach.activate();
+        teach.run();
+        let mut slices = 0;
+        while teach.is_running() {
+            assert!(teach.advance(CALLS_PER_FRAME) <= CALLS_PER_FRAME);
+            slices += 1;
+        }
+        let calls = teach.walk().unwrap().trace.len();
+        assert!(calls > 80_000, "{calls}");
+        assert!((calls.div_ceil(CALLS_PER_FRAME)..=calls / CALLS_PER_FRAME + 1).contains(&slices));
+        let mut whole = net;
+        whole.activate(0, true);
+        assert_eq!(teach.net().activations(), whole.activations());
+
+        // A key between slices stops the run where it is.
+        teach.undo();
+        assert_eq!(teach.walk().unwrap().trace.len(), calls - 1);
+        teach.run();
+        teach.step();
+        assert!(!teach.is_running());
+        assert_eq!(teach.net().activations(), whole.activations());
     }
 }
