@@ -707,7 +707,7 @@ fn draw_teach_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     );
 
     // The trace: the calls made so far, the latest last.
-    let trace_steps = walk.as_ref().map_or(&[][..], |w| &w.trace[..]);
+    let trace_steps = walk.as_ref().map_or(&[][..], |w| w.trace);
     let visible = trace.height.saturating_sub(3) as usize;
     let skip = trace_steps.len().saturating_sub(visible);
     let rows = trace_steps
