@@ -218,7 +218,8 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
             .or_else(|| ids.iter().find(|m| m.kind.reuses()))
             .cloned(),
     };
-    let plan = experiment::plan(config, &cli.run.library_root(), &on_interrupt()?)?;
+    // The followed run and the DQN baseline train side by side.
+    let plan = experiment::plan(config, &cli.run.library_root(), 2, &on_interrupt()?)?;
     let followable: Vec<_> = plan
         .specs
         .iter()

@@ -304,15 +304,55 @@ impl Default for ProtocolConfig {
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
     // The OS error is part of the message, not a `source`: a chain prints it once.
-    #[error("reading config {}: {cause}", path.display())]
+    #[error("reading {}: {cause}", path.display())]
     Io {
         path: PathBuf,
         cause: std::io::Error,
     },
+    #[error(
+        "{} is larger than {} bytes: not a config, lesson or policy file (those are a few \
+         kilobytes of RON text)",
+        path.display(),
+        MAX_TEXT_BYTES
+    )]
+    TooLarge { path: PathBuf },
+    #[error("{} is not UTF-8 text", path.display())]
+    NotText { path: PathBuf },
     #[error("{0}")]
     Parse(Box<ParseError>),
     #[error("config {}: {message}", origin)]
     Invalid { origin: String, message: String },
+}
+
+/// Most hidden layers a network may have: far deeper than these tasks need, and a bound on
+/// the names that results derive from a method's layers.
+pub const MAX_HIDDEN_LAYERS: usize = 64;
+
+/// The largest RON file read (configs, teach lessons, policy metadata, manifests): 16 MiB,
+/// room for a lesson listing every edge of a 1,000-policy graph, so that `--config
+/// /dev/zero` is an error, not a machine out of memory.
+pub const MAX_TEXT_BYTES: u64 = 16 << 20;
+
+/// Reads the RON text at `path`, refusing more than [`MAX_TEXT_BYTES`].
+pub fn read_text(path: &Path) -> Result<String, ConfigError> {
+    use std::io::Read;
+    let io = |cause| ConfigError::Io {
+        path: path.to_path_buf(),
+        cause,
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::new();
+    file.take(MAX_TEXT_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_TEXT_BYTES {
+        return Err(ConfigError::TooLarge {
+            path: path.to_path_buf(),
+        });
+    }
+    String::from_utf8(bytes).map_err(|_| ConfigError::NotText {
+        path: path.to_path_buf(),
+    })
 }
 
 /// A located syntax or type error in a RON file.
@@ -384,10 +424,7 @@ pub fn parse_ron<T: serde::de::DeserializeOwned>(
 impl Config {
     /// Reads and validates a config file.
     pub fn from_file(path: &Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
-            path: path.to_path_buf(),
-            cause: source,
-        })?;
+        let text = read_text(path)?;
         Self::from_ron(&text, &path.display().to_string())
     }
 
@@ -442,6 +479,12 @@ impl Config {
             format!("{:?}", src.hidden_layers),
         )?;
         check(
+            src.hidden_layers.1 <= MAX_HIDDEN_LAYERS,
+            "sources.hidden_layers",
+            &format!("at most {MAX_HIDDEN_LAYERS} hidden layers"),
+            format!("{:?}", src.hidden_layers),
+        )?;
+        check(
             src.units.0 >= 1 && src.units.0 <= src.units.1,
             "sources.units",
             "(min, max) with 1 <= min <= max",
@@ -477,6 +520,14 @@ impl Config {
         )?;
         for (i, method) in p.methods.iter().enumerate() {
             let field = format!("protocol.methods[{i}]");
+            if let Some(hidden) = method.learner_hidden() {
+                check(
+                    hidden.len() <= MAX_HIDDEN_LAYERS,
+                    &format!("{field}.hidden"),
+                    &format!("at most {MAX_HIDDEN_LAYERS} hidden layers"),
+                    format!("{} layers", hidden.len()),
+                )?;
+            }
             match method {
                 Method::Dqn { hidden } => check(
                     !hidden.is_empty() && hidden.iter().all(|&u| u > 0),

@@ -223,10 +223,12 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
 pub fn load(dir: &Path, name: &str) -> Result<StoredPolicy, StoreError> {
     check_name(name)?;
     let (weights_path, metadata_path) = paths(dir, name);
-    let text = String::from_utf8(read(&metadata_path)?).map_err(|_| StoreError::Invalid {
-        path: metadata_path.clone(),
-        message: "not UTF-8 text".to_string(),
-    })?;
+    if !metadata_path.exists() {
+        return Err(StoreError::Missing {
+            path: metadata_path,
+        });
+    }
+    let text = crate::config::read_text(&metadata_path)?;
     let metadata: PolicyMetadata = parse_ron(&text, &metadata_path.display().to_string())?;
     if metadata.activation != ACTIVATION {
         return Err(StoreError::Invalid {

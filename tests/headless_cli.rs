@@ -273,3 +273,52 @@ fn a_coefficient_that_would_overflow_is_refused_before_any_run() {
     assert!(message.contains("method sapnet"), "{message}");
     assert!(!out.join("runs").exists(), "no run started");
 }
+
+/// Issue 13: a network of 40 GB a copy tried to allocate (here 4 TB a copy, more than any
+/// machine running these tests), 5 M layers aborted and `--config /dev/zero` read without
+/// end. Each is refused before anything is allocated.
+#[test]
+fn sizes_that_cannot_fit_are_refused_before_allocating() {
+    let tmp = tempfile::tempdir().unwrap();
+    let huge = tmp.path().join("huge.ron");
+    std::fs::write(
+        &huge,
+        "(protocol: (methods: [Dqn(hidden: [1000000, 1000000])]))",
+    )
+    .unwrap();
+    let output = sapnet(
+        &["--headless", "--config", huge.to_str().unwrap(), "--out"]
+            .into_iter()
+            .chain([tmp.path().join("out").to_str().unwrap()])
+            .collect::<Vec<_>>(),
+    );
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(
+        message.contains("needs about 18.2 TiB per run"),
+        "{message}"
+    );
+    assert!(message.contains("this machine has"), "{message}");
+
+    let deep = tmp.path().join("deep.ron");
+    let layers = vec!["2"; 100_000].join(",");
+    std::fs::write(
+        &deep,
+        format!("(protocol: (methods: [Dqn(hidden: [{layers}])]))"),
+    )
+    .unwrap();
+    let output = sapnet(&["--headless", "--config", deep.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(
+        message.contains("at most 64 hidden layers, got 100000 layers"),
+        "{message}"
+    );
+    assert!(message.len() < 500, "{message}");
+
+    if std::path::Path::new("/dev/zero").exists() {
+        let output = sapnet(&["--headless", "--config", "/dev/zero"]);
+        assert_eq!(output.status.code(), Some(2));
+        assert!(stderr(&output).contains("larger than 16777216 bytes"));
+    }
+}

@@ -3,6 +3,7 @@
 //! ([`library_copy`]). The dashboard and headless mode only render and write.
 
 pub mod library_copy;
+pub mod memory;
 pub mod plan;
 pub mod schedule;
 

@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result};
 
+use super::memory;
 use crate::config::Config;
 use crate::seeds;
 use crate::sources::{self, LibraryRoot};
@@ -34,7 +35,16 @@ pub fn method_ids(config: &Config) -> Vec<MethodId> {
 /// Loads the library if a method reuses one (training it first, with progress on stderr,
 /// if `<library>/<source task>/` holds none or an unfinished one and `library` allows it;
 /// `stop` ends that training), then plans every run.
-pub fn plan(config: &Config, library: &LibraryRoot, stop: &Receiver<Command>) -> Result<Plan> {
+///
+/// Runs are refused, before the library is trained or anything allocated, if `jobs` of the
+/// largest could not fit in the machine's memory together ([`memory::check`]).
+pub fn plan(
+    config: &Config,
+    library: &LibraryRoot,
+    jobs: usize,
+    stop: &Receiver<Command>,
+) -> Result<Plan> {
+    memory::check(&run_specs(config, None), jobs)?;
     let reuses = config.protocol.methods.iter().any(|m| m.kind().reuses());
     let sources = if reuses {
         Some(Arc::new(sources::ensure_library(config, library, stop)?))
@@ -42,6 +52,7 @@ pub fn plan(config: &Config, library: &LibraryRoot, stop: &Receiver<Command>) ->
         None
     };
     let specs = run_specs(config, sources.as_ref());
+    memory::check(&specs, jobs)?;
     // A selector that cannot be built fails every run of its method: say so before any
     // run trains.
     for spec in specs

@@ -168,7 +168,7 @@ fn protocol(
     resumed: Option<Option<&[results::LibraryEntry]>>,
     commands: &Receiver<Command>,
 ) -> Result<Summary> {
-    let mut plan = experiment::plan(config, &options.library, commands)?;
+    let mut plan = experiment::plan(config, &options.library, options.jobs, commands)?;
     let library: Option<Vec<results::LibraryEntry>> = plan.sources.as_ref().map(|sources| {
         sources
             .iter()

@@ -19,14 +19,21 @@ use crate::trainer::{self, EpisodeRecord, MethodId, RunRecord, TraceRecord};
 pub const RUNS: &str = "runs";
 
 /// `dqn[100,100]`, run 0 → `dqn-100-100-run0`: a plain file name, of the run's folder and
-/// of its trained policy.
+/// of its trained policy. A label too long for a file name (a deep network's) is cut and
+/// told apart by a hash of the whole.
 pub fn run_name(method: &str, run: u32) -> String {
+    const LONGEST: usize = 120;
     let plain: String = method
         .chars()
         .filter(|&c| c != ']')
         .map(|c| if c == '[' || c == ',' { '-' } else { c })
         .collect();
-    format!("{plain}-run{run}")
+    if plain.len() <= LONGEST {
+        return format!("{plain}-run{run}");
+    }
+    let cut: String = plain.chars().take(LONGEST).collect();
+    let hash = &crate::policy_store::sha256_hex(method.as_bytes())[..12];
+    format!("{cut}-{hash}-run{run}")
 }
 
 fn finished_dir(out: &Path, name: &str) -> PathBuf {
@@ -260,5 +267,10 @@ mod tests {
         assert_eq!(run_name("dqn[100,100]", 0), "dqn-100-100-run0");
         assert_eq!(run_name("dqn[16]", 3), "dqn-16-run3");
         assert_eq!(run_name("sapnet", 1), "sapnet-run1");
+        let deep = format!("dqn[{}]", vec!["100"; 60].join(","));
+        let name = run_name(&deep, 0);
+        assert!(name.len() < 160, "{name}");
+        assert!(name.ends_with("-run0"));
+        assert_ne!(name, run_name(&deep.replace("[100,", "[101,"), 0));
     }
 }

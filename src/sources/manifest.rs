@@ -169,16 +169,10 @@ pub fn path(dir: &Path) -> PathBuf {
 /// Reads `dir`'s manifest; `None` when there is none.
 pub fn read(dir: &Path) -> Result<Option<Manifest>, StoreError> {
     let path = path(dir);
-    let text = match fs::read_to_string(&path) {
-        Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(source) => {
-            return Err(StoreError::Read {
-                path,
-                cause: source,
-            })
-        }
-    };
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = crate::config::read_text(&path)?;
     Ok(Some(parse_ron(&text, &path.display().to_string())?))
 }
 

@@ -76,6 +76,12 @@ pub fn train_library(
     let dir = library_dir(library, config);
     let training = LibraryTraining::of(config);
     let plans = plan(config);
+    let specs: Vec<RunSpec> = plans
+        .iter()
+        .enumerate()
+        .map(|(i, source)| source_spec(config, i, source))
+        .collect();
+    crate::experiment::memory::check(&specs, 1)?;
     let kept = resumable(&dir, &training, &plans, retrain)?;
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("creating the library folder {}", dir.display()))?;
@@ -105,22 +111,12 @@ pub fn train_library(
     let mut progress = crate::headless::Progress::new(
         u64::from(config.sources.training_episodes) * todo.len() as u64,
     );
-    let source_dqn = &manifest.training.dqn;
     for source in todo {
         let i = plans
             .iter()
             .position(|p| p.name == source.name)
             .unwrap_or(0);
-        let spec = RunSpec::scratch(
-            i as u32,
-            &source.name,
-            source_task(config).clone(),
-            source_dqn.clone(),
-            source.hidden.clone(),
-            config.sources.training_episodes,
-            config.protocol.test_episodes,
-            source.seed,
-        );
+        let spec = specs[i].clone();
         let mut training = SourceTraining {
             progress: &mut progress,
             outcome: None,
@@ -183,6 +179,21 @@ pub fn train_library(
     manifest.complete = true;
     manifest::write(&dir, &manifest)?;
     Ok(dir)
+}
+
+/// The run that trains `source`, the `i`-th of the plan: DQN from scratch on the source
+/// task, with the sources' DQN settings.
+fn source_spec(config: &Config, i: usize, source: &SourcePlan) -> RunSpec {
+    RunSpec::scratch(
+        i as u32,
+        &source.name,
+        source_task(config).clone(),
+        config.sources.dqn.as_ref().unwrap_or(&config.dqn).clone(),
+        source.hidden.clone(),
+        config.sources.training_episodes,
+        config.protocol.test_episodes,
+        source.seed,
+    )
 }
 
 /// The policies already in `dir` that a (resumed) training of `training` keeps: those of

@@ -82,10 +82,7 @@ impl TeachConfig {
     pub fn load(path: Option<&Path>) -> Result<Lesson, ConfigError> {
         match path {
             Some(path) => {
-                let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
-                    path: path.to_path_buf(),
-                    cause: source,
-                })?;
+                let text = crate::config::read_text(path)?;
                 Self::lesson_from_ron(&text, &path.display().to_string())
             }
             None => Self::lesson_from_ron(FIG2, "teach_fig2.ron (embedded)"),
