@@ -40,6 +40,9 @@ fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
         Some(path) => Config::from_file(path)?,
         None => Config::from_ron(embedded, label)?,
     };
+    for warning in config.warnings() {
+        eprintln!("warning: {warning}");
+    }
     if let Some(seed) = cli.run.seed {
         config.seed = seed;
     }

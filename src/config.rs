@@ -438,6 +438,20 @@ impl Config {
         Ok(config)
     }
 
+    /// What a valid config does that its author may not mean, to say on stderr.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut said = Vec::new();
+        if self.protocol.test_episodes == 0 {
+            said.push(
+                "protocol.test_episodes is 0: nothing is tested greedily, so tests.csv, \
+                 tests.png and the comparison's test column stay empty, and a library trained \
+                 with it has no scores (BestSource cannot pick)"
+                    .to_string(),
+            );
+        }
+        said
+    }
+
     /// Cuts the protocol for a smoke run: 1/20 of the episodes, at most 2 runs per method.
     /// The source library is the real one (a library trained on a cut budget would be
     /// reused by later full runs).
@@ -449,6 +463,10 @@ impl Config {
 
     /// Checks the values serde cannot: ranges and relations between fields.
     pub fn validate(&self) -> Result<(), String> {
+        self.env.validate("env")?;
+        if let Some(env) = &self.sources.env {
+            env.validate("sources.env")?;
+        }
         check_dqn(&self.dqn, "dqn")?;
         if let Some(sources) = &self.sources.dqn {
             check_dqn(sources, "sources.dqn")?;

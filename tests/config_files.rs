@@ -154,3 +154,56 @@ fn configs_that_cannot_work_are_refused_with_the_field() {
         );
     }
 }
+
+fn invalid(text: &str) -> String {
+    match Config::from_ron(text, "bad.ron") {
+        Err(err @ ConfigError::Invalid { .. }) => err.to_string(),
+        Err(other) => panic!("expected a validation error for {text:?}, got {other}"),
+        Ok(_) => panic!("expected an error for {text:?}"),
+    }
+}
+
+/// Issue 13: physics that make no sense are refused at their field, for the target task
+/// and for the sources' task alike; a negative push (CartPole's mirrored actions) is not.
+#[test]
+fn physics_that_make_no_sense_are_refused_at_their_field() {
+    for (text, field) in [
+        ("(env: CartPole(tau: 0.0))", "env.tau"),
+        ("(env: CartPole(tau: -0.02))", "env.tau"),
+        ("(env: CartPole(masspole: -0.1))", "env.masspole"),
+        ("(env: CartPole(gravity: inf))", "env.gravity"),
+        ("(env: CartPole(x_threshold: -2.4))", "env.x_threshold"),
+        (
+            "(env: CartPole(max_episode_steps: 0))",
+            "env.max_episode_steps",
+        ),
+        ("(env: MountainCar(max_speed: 0.0))", "env.max_speed"),
+        (
+            "(env: MountainCar(goal_position: 0.7))",
+            "env.goal_position",
+        ),
+        ("(env: Acrobot(link_mass_2: 0.0))", "env.link_mass_2"),
+        ("(env: Acrobot(dt: NaN))", "env.dt"),
+        (
+            "(sources: (env: Some(CartPole(length: 0.0))))",
+            "sources.env.length",
+        ),
+    ] {
+        let message = invalid(text);
+        assert!(
+            message.contains(&format!("field `{field}`")),
+            "{text}: {message}"
+        );
+    }
+    let mirrored = Config::from_ron("(env: CartPole(force_mag: -10.0))", "ok.ron").unwrap();
+    assert!(matches!(mirrored.env, EnvConfig::CartPole(ref p) if p.force_mag == -10.0));
+}
+
+#[test]
+fn no_greedy_tests_is_allowed_but_said() {
+    let config = Config::from_ron("(protocol: (test_episodes: 0))", "ok.ron").unwrap();
+    let warnings = config.warnings();
+    assert_eq!(warnings.len(), 1);
+    assert!(warnings[0].contains("test_episodes is 0"), "{warnings:?}");
+    assert!(Config::default().warnings().is_empty());
+}

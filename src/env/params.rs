@@ -52,6 +52,133 @@ impl EnvConfig {
     }
 }
 
+impl EnvConfig {
+    /// The physics serde cannot check: each constant finite, masses, lengths, time steps
+    /// and thresholds > 0, a time limit of at least one step. `field` is where the task
+    /// sits in the config (`env`, `sources.env`). A negative `force_mag` is allowed: it
+    /// mirrors CartPole's actions.
+    pub fn validate(&self, field: &str) -> Result<(), String> {
+        let mut rules = Rules::new(field, self.task_name());
+        match self {
+            EnvConfig::CartPole(p) => {
+                rules.time_limit(p.max_episode_steps);
+                rules.finite("gravity", p.gravity);
+                rules.finite("force_mag", p.force_mag);
+                for (name, value) in [
+                    ("masscart", p.masscart),
+                    ("masspole", p.masspole),
+                    ("length", p.length),
+                    ("tau", p.tau),
+                    ("theta_threshold_radians", p.theta_threshold_radians),
+                    ("x_threshold", p.x_threshold),
+                ] {
+                    rules.positive(name, value);
+                }
+            }
+            EnvConfig::MountainCar(p) => {
+                rules.time_limit(p.max_episode_steps);
+                for (name, value) in [
+                    ("min_position", p.min_position),
+                    ("max_position", p.max_position),
+                    ("goal_position", p.goal_position),
+                    ("goal_velocity", p.goal_velocity),
+                    ("force", p.force),
+                    ("gravity", p.gravity),
+                ] {
+                    rules.finite(name, value);
+                }
+                rules.positive("max_speed", p.max_speed);
+                rules.holds(
+                    "goal_position",
+                    p.min_position < p.goal_position && p.goal_position <= p.max_position,
+                    "min_position < goal_position <= max_position, or the flag cannot be \
+                     reached",
+                );
+            }
+            EnvConfig::Acrobot(p) => {
+                rules.time_limit(p.max_episode_steps);
+                for (name, value) in [
+                    ("dt", p.dt),
+                    ("link_length_1", p.link_length_1),
+                    ("link_length_2", p.link_length_2),
+                    ("link_mass_1", p.link_mass_1),
+                    ("link_mass_2", p.link_mass_2),
+                    ("link_moi", p.link_moi),
+                    ("max_vel_1", p.max_vel_1),
+                    ("max_vel_2", p.max_vel_2),
+                ] {
+                    rules.positive(name, value);
+                }
+                rules.finite("link_com_pos_1", p.link_com_pos_1);
+                rules.finite("link_com_pos_2", p.link_com_pos_2);
+                for torque in p.available_torque {
+                    rules.finite("available_torque", torque);
+                }
+                rules.holds(
+                    "torque_noise_max",
+                    p.torque_noise_max >= 0.0 && p.torque_noise_max.is_finite(),
+                    "a finite number >= 0",
+                );
+            }
+        }
+        rules.result()
+    }
+}
+
+/// The first broken rule of one task's physics, located.
+struct Rules<'a> {
+    field: &'a str,
+    task: &'a str,
+    broken: Option<String>,
+}
+
+impl<'a> Rules<'a> {
+    fn new(field: &'a str, task: &'a str) -> Self {
+        Self {
+            field,
+            task,
+            broken: None,
+        }
+    }
+
+    fn holds(&mut self, name: &str, ok: bool, expected: &str) {
+        if !ok && self.broken.is_none() {
+            self.broken = Some(format!(
+                "field `{}.{name}` ({}): expected {expected}",
+                self.field, self.task
+            ));
+        }
+    }
+
+    fn finite(&mut self, name: &str, value: f64) {
+        self.holds(
+            name,
+            value.is_finite(),
+            &format!("a finite number, got {value:?}"),
+        );
+    }
+
+    fn positive(&mut self, name: &str, value: f64) {
+        self.holds(
+            name,
+            value > 0.0 && value.is_finite(),
+            &format!("a finite number > 0, got {value:?}"),
+        );
+    }
+
+    fn time_limit(&mut self, steps: u32) {
+        self.holds(
+            "max_episode_steps",
+            steps >= 1,
+            "a time limit of at least 1 step, got 0",
+        );
+    }
+
+    fn result(self) -> Result<(), String> {
+        self.broken.map_or(Ok(()), Err)
+    }
+}
+
 /// CartPole's integrator (Gymnasium's `kinematics_integrator`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Integrator {
