@@ -155,7 +155,7 @@ fn report(summary: &headless::Summary, dir: &Path) -> Result<()> {
     if summary.stopped() {
         eprintln!("stopped by the user: what was done so far is in {dir} (episodes.csv, tests.csv, summary.json, plots); `sapnet --headless --resume --out {dir}` finishes it");
     } else {
-        eprintln!("results in {dir}: episodes.csv, tests.csv, activations.csv, comparison.csv, summary.json, policies/, learning_curve.png, learning_curve.svg, tests.png, activations.png, selections.png");
+        eprintln!("results in {dir}: episodes.csv, tests.csv, activations.csv, comparison.csv, summary.json, runs/, policies/, learning_curve.png, learning_curve.svg, tests.png, activations.png, selections.png");
     }
     for run in &summary.runs {
         let tests: Vec<String> = run
