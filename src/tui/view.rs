@@ -721,11 +721,13 @@ fn draw_teach_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         .max()
         .unwrap_or(2)
         .clamp(4, 9) as u16;
+    // Wide enough for the last call's number: long walks make hundreds of thousands.
+    let number_width = trace_steps.len().max(1).to_string().len().max(4) as u16;
     frame.render_widget(
         Table::new(
             rows,
             [
-                Constraint::Length(4),
+                Constraint::Length(number_width),
                 Constraint::Length(name_width),
                 Constraint::Length(name_width),
                 Constraint::Length(2),
