@@ -131,6 +131,12 @@ pub struct SourcesConfig {
     pub training_episodes: u32,
     /// The source task, when it differs from the target task (`None`: the same).
     pub env: Option<EnvConfig>,
+    /// A library over several source tasks (empty: all `count` policies on `env`): each
+    /// task with its physics and how many of the `count` policies train on it, in order.
+    pub tasks: Vec<SourceTaskConfig>,
+    /// The library's folder under `--library` (default: the source task's name, e.g.
+    /// `cartpole`); needed with `tasks`.
+    pub name: Option<String>,
     /// DQN settings for training the sources, when they differ from the experiment's `dqn`
     /// (`None`: the same; fields left out take Table I's defaults). The paper does not say
     /// how its sources were trained; with Table I's settings MountainCar sources never
@@ -146,9 +152,25 @@ impl Default for SourcesConfig {
             units: (50, 150),
             training_episodes: 5000,
             env: None,
+            tasks: Vec::new(),
+            name: None,
             dqn: None,
         }
     }
+}
+
+/// One source task of a library over several (`sources.tasks`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SourceTaskConfig {
+    /// The task with its physics, e.g. `CartPole(length: 1.0)`.
+    pub env: EnvConfig,
+    /// How many policies train on it.
+    pub count: usize,
+    /// Its name in results and on the graph (default: the task and what differs from its
+    /// defaults, e.g. `cartpole(length=1.0)`).
+    #[serde(default)]
+    pub label: Option<String>,
 }
 
 /// A learner an experiment compares (`protocol.methods`). Each reusing method's selector is
@@ -438,6 +460,71 @@ impl Config {
         Ok(config)
     }
 
+    /// `sources.tasks` and `sources.name`: tasks that make sense, as many policies as
+    /// `count`, a plain folder name.
+    fn check_source_tasks(&self) -> Result<(), String> {
+        let s = &self.sources;
+        if let Some(name) = &s.name {
+            let plain = !name.is_empty()
+                && !name.starts_with('.')
+                && !name.contains(['/', '\\'])
+                && name != "chosen";
+            check(
+                plain,
+                "sources.name",
+                "a plain folder name (not `chosen`, no `/`, not starting with `.`)",
+                format!("{name:?}"),
+            )?;
+        }
+        if s.tasks.is_empty() {
+            return Ok(());
+        }
+        check(
+            s.env.is_none(),
+            "sources.env",
+            "None with `sources.tasks` (give the source tasks one way)",
+            "Some(..)",
+        )?;
+        check(
+            s.name.is_some(),
+            "sources.name",
+            "the library's folder name, needed with `sources.tasks`",
+            "None",
+        )?;
+        for (i, task) in s.tasks.iter().enumerate() {
+            task.env.validate(&format!("sources.tasks[{i}].env"))?;
+            check(
+                task.count > 0,
+                &format!("sources.tasks[{i}].count"),
+                "at least 1",
+                task.count,
+            )?;
+        }
+        let total: usize = s.tasks.iter().map(|t| t.count).sum();
+        check(
+            total == s.count,
+            "sources.count",
+            &format!("the policies of sources.tasks together, {total}"),
+            s.count,
+        )?;
+        let labels: Vec<String> = s
+            .tasks
+            .iter()
+            .map(|t| t.label.clone().unwrap_or_else(|| t.env.label()))
+            .collect();
+        if let Some((i, twice)) = labels
+            .iter()
+            .enumerate()
+            .find(|(i, l)| labels[..*i].contains(l))
+        {
+            return Err(format!(
+                "field `sources.tasks[{i}]`: {twice} is listed a second time; give each task \
+                 once, with its count"
+            ));
+        }
+        Ok(())
+    }
+
     /// What a valid config does that its author may not mean, to say on stderr.
     pub fn warnings(&self) -> Vec<String> {
         let mut said = Vec::new();
@@ -467,6 +554,7 @@ impl Config {
         if let Some(env) = &self.sources.env {
             env.validate("sources.env")?;
         }
+        self.check_source_tasks()?;
         check_dqn(&self.dqn, "dqn")?;
         if let Some(sources) = &self.sources.dqn {
             check_dqn(sources, "sources.dqn")?;

@@ -43,6 +43,39 @@ impl EnvConfig {
         }
     }
 
+    /// The task and what differs from its defaults, e.g. `cartpole` or
+    /// `cartpole(force_mag=-10.0, length=1.0)` (fields in name order): tells variants of one
+    /// family apart in results and SAP-Net's `SourceTask` categories.
+    pub fn label(&self) -> String {
+        let defaults = match self {
+            EnvConfig::CartPole(_) => EnvConfig::CartPole(CartPoleParams::default()),
+            EnvConfig::MountainCar(_) => EnvConfig::MountainCar(MountainCarParams::default()),
+            EnvConfig::Acrobot(_) => EnvConfig::Acrobot(AcrobotParams::default()),
+        };
+        let fields = |env: &EnvConfig| -> serde_json::Map<String, serde_json::Value> {
+            match serde_json::to_value(env) {
+                Ok(serde_json::Value::Object(outer)) => outer
+                    .into_iter()
+                    .next()
+                    .and_then(|(_, inner)| inner.as_object().cloned())
+                    .unwrap_or_default(),
+                _ => serde_json::Map::new(),
+            }
+        };
+        let (mine, default) = (fields(self), fields(&defaults));
+        let mut changed: Vec<String> = mine
+            .iter()
+            .filter(|(name, value)| default.get(*name) != Some(value))
+            .map(|(name, value)| format!("{name}={}", value_text(value)))
+            .collect();
+        changed.sort();
+        if changed.is_empty() {
+            self.task_name().to_string()
+        } else {
+            format!("{}({})", self.task_name(), changed.join(", "))
+        }
+    }
+
     pub fn max_episode_steps(&self) -> u32 {
         match self {
             EnvConfig::CartPole(p) => p.max_episode_steps,
@@ -122,6 +155,18 @@ impl EnvConfig {
             }
         }
         rules.result()
+    }
+}
+
+/// A physics constant as a label shows it: numbers in their shortest form, names bare.
+fn value_text(value: &serde_json::Value) -> String {
+    match value {
+        serde_json::Value::Number(n) => match n.as_f64() {
+            Some(x) if n.is_f64() => format!("{x:?}"),
+            _ => n.to_string(),
+        },
+        serde_json::Value::String(s) => s.clone(),
+        other => other.to_string(),
     }
 }
 

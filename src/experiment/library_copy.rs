@@ -76,13 +76,10 @@ impl LibraryCopies {
 pub fn policy_info(config: &Config, record: &RunRecord) -> PolicyInfo {
     let final_score = (!record.test_returns.is_empty())
         .then(|| record.test_returns.iter().sum::<f64>() / record.test_returns.len() as f64);
-    let reused = record.chosen.as_ref().map(|chosen| {
-        format!(
-            "{}/{}",
-            sources::source_task(config).task_name(),
-            chosen.name
-        )
-    });
+    let reused = record
+        .chosen
+        .as_ref()
+        .map(|chosen| format!("{}/{}", sources::library_name(config), chosen.name));
     PolicyInfo {
         source_task: config.env.clone(),
         training: TrainingBudget {

@@ -316,6 +316,7 @@ mod tests {
         let entry = |s: Option<f64>| LibraryEntry {
             name: String::new(),
             hidden: vec![],
+            task: String::new(),
             final_score: s,
         };
         let library = [

@@ -175,6 +175,7 @@ fn protocol(
             .map(|s| results::LibraryEntry {
                 name: s.name.clone(),
                 hidden: s.description.hidden.clone(),
+                task: s.description.source_task.clone(),
                 final_score: s.final_score,
             })
             .collect()

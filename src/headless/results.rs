@@ -231,6 +231,9 @@ fn number(x: &f64) -> String {
 pub struct LibraryEntry {
     pub name: String,
     pub hidden: Vec<usize>,
+    /// The task it was trained on, with what differs from the task's defaults.
+    #[serde(default)]
+    pub task: String,
     pub final_score: Option<f64>,
 }
 

@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::SourceTask;
 use crate::config::{parse_ron, ron_options, Config, DqnConfig};
-use crate::env::EnvConfig;
 use crate::policy_store::{self, PolicyMetadata, StoreError};
 
 /// The manifest's file name inside `<library>/<task>/`.
@@ -35,8 +35,8 @@ pub struct Manifest {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LibraryTraining {
-    pub source_task: EnvConfig,
-    pub count: usize,
+    /// The source tasks, each with how many policies train on it, in the plan's order.
+    pub tasks: Vec<SourceTask>,
     pub hidden_layers: (usize, usize),
     pub units: (usize, usize),
     pub training_episodes: u32,
@@ -62,8 +62,7 @@ impl LibraryTraining {
     pub fn of(config: &Config) -> Self {
         let s = &config.sources;
         Self {
-            source_task: super::source_task(config).clone(),
-            count: s.count,
+            tasks: super::tasks(config),
             hidden_layers: s.hidden_layers,
             units: s.units,
             training_episodes: s.training_episodes,
@@ -71,6 +70,11 @@ impl LibraryTraining {
             test_episodes: config.protocol.test_episodes,
             seed: config.seed,
         }
+    }
+
+    /// N, the policies of every task.
+    pub fn count(&self) -> usize {
+        self.tasks.iter().map(|t| t.count).sum()
     }
 
     /// The settings in which `other` trains its sources differently, as `field: ours vs
@@ -94,16 +98,7 @@ impl LibraryTraining {
             }
         };
         if all {
-            compare(
-                "source task",
-                ron(&self.source_task),
-                ron(&other.source_task),
-            );
-            compare(
-                "sources.count",
-                self.count.to_string(),
-                other.count.to_string(),
-            );
+            compare("source tasks", tasks(&self.tasks), tasks(&other.tasks));
         }
         compare(
             "sources.hidden_layers",
@@ -131,6 +126,15 @@ impl LibraryTraining {
         }
         found
     }
+}
+
+/// `cartpole(length=1.0) ×3, cartpole ×2`.
+fn tasks(tasks: &[SourceTask]) -> String {
+    tasks
+        .iter()
+        .map(|t| format!("{} ×{}", t.label, t.count))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// A config value as its RON text, for messages.

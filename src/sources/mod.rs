@@ -9,6 +9,7 @@ use std::sync::mpsc::Receiver;
 use anyhow::{bail, Context, Result};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
+use serde::{Deserialize, Serialize};
 
 use crate::config::Config;
 use crate::env::EnvConfig;
@@ -30,22 +31,75 @@ pub struct SourcePlan {
     pub name: String,
     pub hidden: Vec<usize>,
     pub seed: u64,
+    /// Its task: an index into [`tasks`].
+    pub task: usize,
 }
 
-/// The source task: `sources.env` when given, else the target task.
+/// A task of the library and how many of its policies train on it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SourceTask {
+    pub env: EnvConfig,
+    pub count: usize,
+    /// Its name in results, on the graph, and as SAP-Net's `SourceTask` category.
+    pub label: String,
+}
+
+/// The source task: `sources.env` when given, else the target task. For a library over
+/// several tasks, the first.
 pub fn source_task(config: &Config) -> &EnvConfig {
-    config.sources.env.as_ref().unwrap_or(&config.env)
+    match config.sources.tasks.first() {
+        Some(task) => &task.env,
+        None => config.sources.env.as_ref().unwrap_or(&config.env),
+    }
 }
 
-/// `<library>/<source task>`, where the library of `config` lives.
+/// The library's tasks in order: `sources.tasks`, or all `count` policies on the source
+/// task.
+pub fn tasks(config: &Config) -> Vec<SourceTask> {
+    let s = &config.sources;
+    if s.tasks.is_empty() {
+        let env = source_task(config).clone();
+        return vec![SourceTask {
+            label: env.label(),
+            env,
+            count: s.count,
+        }];
+    }
+    s.tasks
+        .iter()
+        .map(|t| SourceTask {
+            label: t.label.clone().unwrap_or_else(|| t.env.label()),
+            env: t.env.clone(),
+            count: t.count,
+        })
+        .collect()
+}
+
+/// The library's folder name: `sources.name`, else the source task's (`cartpole`).
+pub fn library_name(config: &Config) -> String {
+    config
+        .sources
+        .name
+        .clone()
+        .unwrap_or_else(|| source_task(config).task_name().to_string())
+}
+
+/// `<library>/<library name>`, where the library of `config` lives.
 pub fn library_dir(library: &Path, config: &Config) -> PathBuf {
-    library.join(source_task(config).task_name())
+    library.join(library_name(config))
 }
 
 /// The N architectures and seeds, drawn from the run seed: the number of hidden layers and
-/// the units of each layer uniformly from the config's inclusive ranges.
+/// the units of each layer uniformly from the config's inclusive ranges; the first
+/// policies on the first task, and so on.
 pub fn plan(config: &Config) -> Vec<SourcePlan> {
     let s = &config.sources;
+    let task_of: Vec<usize> = tasks(config)
+        .iter()
+        .enumerate()
+        .flat_map(|(t, task)| std::iter::repeat_n(t, task.count))
+        .collect();
     let mut rng = StdRng::seed_from_u64(seeds::derive(config.seed, &[SOURCES_STREAM]));
     (0..s.count)
         .map(|i| {
@@ -57,6 +111,7 @@ pub fn plan(config: &Config) -> Vec<SourcePlan> {
                 name: format!("source-{i}"),
                 hidden,
                 seed: seeds::derive(config.seed, &[SOURCES_STREAM, i as u64]),
+                task: task_of.get(i).copied().unwrap_or(0),
             }
         })
         .collect()
@@ -138,7 +193,7 @@ pub fn train_library(
         }
         let returns = &outcome.record.test_returns;
         let info = PolicyInfo {
-            source_task: source_task(config).clone(),
+            source_task: manifest.training.tasks[source.task].env.clone(),
             training: TrainingBudget {
                 episodes: u64::from(outcome.record.episodes),
                 steps: outcome.record.steps,
@@ -181,13 +236,13 @@ pub fn train_library(
     Ok(dir)
 }
 
-/// The run that trains `source`, the `i`-th of the plan: DQN from scratch on the source
+/// The run that trains `source`, the `i`-th of the plan: DQN from scratch on its source
 /// task, with the sources' DQN settings.
 fn source_spec(config: &Config, i: usize, source: &SourcePlan) -> RunSpec {
     RunSpec::scratch(
         i as u32,
         &source.name,
-        source_task(config).clone(),
+        tasks(config)[source.task].env.clone(),
         config.sources.dqn.as_ref().unwrap_or(&config.dqn).clone(),
         source.hidden.clone(),
         config.sources.training_episodes,
@@ -253,7 +308,7 @@ fn resumable(
                     let (entry, metadata) = ManifestEntry::of_policy(dir, &p.name).ok()?;
                     let planned = entry.seed == p.seed
                         && entry.hidden == p.hidden
-                        && metadata.source_task == training.source_task
+                        && metadata.source_task == training.tasks[p.task].env
                         && metadata.training.episodes == u64::from(training.training_episodes);
                     planned.then_some(entry)
                 })
@@ -367,13 +422,19 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
     };
     let manifest_path = manifest::path(&dir);
     let wanted = LibraryTraining::of(config);
-    if found.training.source_task != wanted.source_task {
+    if found.training.tasks != wanted.tasks {
+        let tasks = |t: &[SourceTask]| -> String {
+            t.iter()
+                .map(|t| format!("{} ×{}", t.label, t.count))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
         bail!(
-            "the library {} was trained on {:?}, but the config's source task is {:?}; \
-             retrain the library with `sapnet sources --retrain` or use another --library",
+            "the library {} was trained on {}, but the config's source tasks are {}; retrain \
+             the library with `sapnet sources --retrain` or use another --library",
             dir.display(),
-            found.training.source_task,
-            wanted.source_task
+            tasks(&found.training.tasks),
+            tasks(&wanted.tasks)
         );
     }
     if !found.complete {
@@ -387,18 +448,18 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
              `sapnet sources --config <FILE>` trains the rest",
             dir.display(),
             found.policies.len(),
-            found.training.count,
+            found.training.count(),
             missing.join(", ")
         );
     }
-    if found.policies.len() != wanted.count {
+    if found.policies.len() != wanted.count() {
         bail!(
             "the library {} holds {} policies, the config's sources.count is {}; train one of \
              {} with `sapnet sources --retrain` or set sources.count",
             dir.display(),
             found.policies.len(),
-            wanted.count,
-            wanted.count
+            wanted.count(),
+            wanted.count()
         );
     }
     for difference in wanted.differences(&found.training) {
@@ -421,8 +482,10 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
     }
 
     let env = crate::env::make(&config.env);
+    let plans = plan(config);
     let mut sources = Vec::with_capacity(found.policies.len());
-    for entry in &found.policies {
+    for (entry, planned) in found.policies.iter().zip(&plans) {
+        let task = &wanted.tasks[planned.task];
         let stored = policy_store::load_for_task(
             &dir,
             &entry.name,
@@ -444,20 +507,21 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
                 manifest_path.display()
             );
         }
-        if stored.metadata.source_task != wanted.source_task {
+        if entry.name != planned.name || stored.metadata.source_task != task.env {
             bail!(
-                "policy {} was trained on {:?}, but the config's source task is {:?}; retrain \
-                 the library with `sapnet sources --retrain` or use another --library",
+                "policy {} was trained on {}, but the config puts {} on {}; retrain the library \
+                 with `sapnet sources --retrain` or use another --library",
                 metadata_path.display(),
-                stored.metadata.source_task,
-                wanted.source_task
+                stored.metadata.source_task.label(),
+                planned.name,
+                task.label
             );
         }
         sources.push(SourcePolicy {
             description: PolicyDescription {
                 hidden: stored.metadata.architecture.hidden.clone(),
                 activation: stored.metadata.activation.clone(),
-                source_task: stored.metadata.source_task_name.clone(),
+                source_task: task.label.clone(),
             },
             final_score: stored.metadata.final_score,
             net: stored.net,

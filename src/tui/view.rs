@@ -207,6 +207,12 @@ fn draw_policy_table(
     // Columns give way from the right of the wish list as the panel narrows: the graph
     // already shows categories, the counts matter least.
     let full = area.width >= 72;
+    // A library over several tasks shows each source's task where one task shows the
+    // number of hidden layers.
+    let tasks = view
+        .policies
+        .iter()
+        .any(|p| p.description.source_task != view.policies[0].description.source_task);
     let bar_width = 8;
     let rows = view.policies.iter().enumerate().map(|(i, p)| {
         let a = view.net.activations()[i];
@@ -218,7 +224,11 @@ fn draw_policy_table(
         let mut cells = vec![Cell::from(name)];
         if full {
             cells.push(Cell::from(format!("{:?}", p.description.hidden)));
-            cells.push(Cell::from(p.description.hidden.len().to_string()));
+            cells.push(Cell::from(if tasks {
+                p.description.source_task.clone()
+            } else {
+                p.description.hidden.len().to_string()
+            }));
         }
         cells.push(Cell::from(format_activation(a)));
         cells.push(Cell::from(probability_bar(probability, bar_width)));
@@ -242,7 +252,7 @@ fn draw_policy_table(
             vec![
                 "policy",
                 "hidden",
-                "cat",
+                if tasks { "task" } else { "cat" },
                 view.score_name,
                 "P(π)",
                 "acted",
@@ -251,7 +261,7 @@ fn draw_policy_table(
             vec![
                 Constraint::Length(9),
                 Constraint::Length(14),
-                Constraint::Length(3),
+                Constraint::Length(if tasks { 22 } else { 3 }),
                 Constraint::Length(9),
                 Constraint::Length(bar_width as u16 + 5),
                 Constraint::Length(6),
