@@ -33,6 +33,9 @@ pub struct MethodComparison {
     pub test_std: Option<f64>,
     /// Share of the acting steps (after the warm-up) taken by each source, over all runs.
     pub source_shares: Vec<f64>,
+    /// The same shares summed per source task, in the library's task order, for a library
+    /// over several tasks (empty otherwise): does a method learn to avoid a harmful task?
+    pub task_shares: Vec<(String, f64)>,
     /// Per run, the library rank (1 = best recorded score) of the chosen source, or of the
     /// most-used one for a method whose result is its own learner.
     pub ranks: Vec<usize>,
@@ -61,6 +64,7 @@ pub fn compare(
     let thresholds = config.protocol.thresholds(&config.env);
     let window = config.protocol.moving_average;
     let ranks = library_ranks(library);
+    let tasks = library_tasks(library);
     let mut out = Vec::new();
     for method in crate::experiment::method_ids(config) {
         let mine: Vec<&RunSummary> = runs.iter().filter(|r| r.record.method == method).collect();
@@ -109,6 +113,22 @@ pub fn compare(
         } else {
             steps.iter().map(|&s| s as f64 / all as f64).collect()
         };
+        let task_shares = if tasks.len() > 1 && !source_shares.is_empty() {
+            tasks
+                .iter()
+                .map(|task| {
+                    let share = library
+                        .iter()
+                        .zip(&source_shares)
+                        .filter(|(entry, _)| &entry.task == task)
+                        .map(|(_, s)| s)
+                        .sum::<f64>();
+                    (task.clone(), share)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         let ranks = mine
             .iter()
             .filter_map(|r| {
@@ -131,6 +151,7 @@ pub fn compare(
             test_mean: mean(&tests),
             test_std: std_dev(&tests),
             source_shares,
+            task_shares,
             ranks,
             lock_in_median: median(&locks),
             locked_runs: locks.len(),
@@ -138,6 +159,17 @@ pub fn compare(
         });
     }
     out
+}
+
+/// The library's task labels, each once, in the order the sources list them.
+fn library_tasks(library: &[LibraryEntry]) -> Vec<String> {
+    let mut tasks: Vec<String> = Vec::new();
+    for entry in library {
+        if !tasks.contains(&entry.task) {
+            tasks.push(entry.task.clone());
+        }
+    }
+    tasks
 }
 
 /// Rank of each source by recorded score, 1 for the best (ties share the better rank;
@@ -210,6 +242,12 @@ pub fn write_csv(path: &Path, rows: &[MethodComparison]) -> Result<()> {
         ]
         .map(String::from),
     );
+    let tasks: Vec<String> = rows
+        .iter()
+        .find(|r| !r.task_shares.is_empty())
+        .map(|r| r.task_shares.iter().map(|(t, _)| t.clone()).collect())
+        .unwrap_or_default();
+    header.extend(tasks.iter().map(|t| format!("share_{t}")));
     csv.write_record(&header)
         .with_context(|| format!("writing {}", path.display()))?;
     for row in rows {
@@ -233,6 +271,10 @@ pub fn write_csv(path: &Path, rows: &[MethodComparison]) -> Result<()> {
             row.locked_runs.to_string(),
             shares.join(" "),
         ]);
+        for task in &tasks {
+            let share = row.task_shares.iter().find(|(t, _)| t == task);
+            record.push(share.map_or(String::new(), |(_, s)| format!("{s:.4}")));
+        }
         csv.write_record(&record)
             .with_context(|| format!("writing {}", path.display()))?;
     }
@@ -249,6 +291,14 @@ pub fn table(rows: &[MethodComparison]) -> String {
         }
     }
     header.extend(["mean return", "test mean ± std", "ranks", "lock-in step"].map(String::from));
+    let tasks: Vec<String> = rows
+        .iter()
+        .find(|r| !r.task_shares.is_empty())
+        .map(|r| r.task_shares.iter().map(|(t, _)| t.clone()).collect())
+        .unwrap_or_default();
+    if !tasks.is_empty() {
+        header.push("% steps by task".into());
+    }
     let mut lines = vec![header];
     for row in rows {
         let mut line = vec![row.method.clone(), row.runs.to_string()];
@@ -274,6 +324,18 @@ pub fn table(rows: &[MethodComparison]) -> String {
             None if !row.lock_in_measured => "-".into(),
             None => format!("never (0/{})", row.runs),
         });
+        if !tasks.is_empty() {
+            let shares: Vec<String> = row
+                .task_shares
+                .iter()
+                .map(|(_, s)| format!("{:.0}", s * 100.0))
+                .collect();
+            line.push(if shares.is_empty() {
+                "-".into()
+            } else {
+                shares.join(" ")
+            });
+        }
         lines.push(line);
     }
     let widths: Vec<usize> = (0..lines[0].len())
@@ -293,6 +355,9 @@ pub fn table(rows: &[MethodComparison]) -> String {
             .map(|(text, &w)| format!("{text:<w$}"))
             .collect();
         let _ = writeln!(out, "{}", cells.join("  ").trim_end());
+    }
+    if !tasks.is_empty() {
+        let _ = writeln!(out, "% steps by task, in order: {}", tasks.join(", "));
     }
     out
 }
@@ -328,5 +393,47 @@ mod tests {
         assert_eq!(library_ranks(&library), [2, 1, 4, 2]);
         assert_eq!(most_used(&[0, 5, 5]), Some(1));
         assert_eq!(most_used(&[0, 0]), None);
+    }
+
+    #[test]
+    fn steps_are_summed_per_source_task_in_the_librarys_order() {
+        let entry = |task: &str| LibraryEntry {
+            name: String::new(),
+            hidden: vec![4],
+            task: task.into(),
+            final_score: Some(1.0),
+        };
+        let library = [entry("long"), entry("mirrored"), entry("long")];
+        let config = Config::from_ron("(protocol: (methods: [Ucb1], runs: 1))", "t.ron").unwrap();
+        let method = crate::experiment::method_ids(&config)[0].clone();
+        let record = crate::trainer::RunRecord {
+            run: 0,
+            method: method.clone(),
+            seed: 0,
+            episodes: 1,
+            steps: 10,
+            updates: 0,
+            chosen: None,
+            // 2 + 6 steps on the long poles, 2 mirrored.
+            source_steps: vec![2, 2, 6],
+            lock_in_step: None,
+            test_returns: vec![],
+            stopped: false,
+            wall_s: 0.0,
+        };
+        let runs = [RunSummary::new(record, &[1.0], 1)];
+        let rewards = BTreeMap::from([((method, 0), vec![1.0])]);
+        let rows = compare(&config, &library, &runs, &rewards);
+        assert_eq!(
+            rows[0].task_shares,
+            [("long".to_string(), 0.8), ("mirrored".to_string(), 0.2)]
+        );
+        let table = table(&rows);
+        assert!(table.contains("% steps by task"), "{table}");
+        assert!(table.contains("80 20"), "{table}");
+        assert!(
+            table.ends_with("% steps by task, in order: long, mirrored\n"),
+            "{table}"
+        );
     }
 }
