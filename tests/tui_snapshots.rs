@@ -197,3 +197,46 @@ fn another_selector_is_drawn_under_its_own_scores() {
         "{header}"
     );
 }
+
+#[test]
+fn a_library_over_several_tasks_is_grouped_and_labelled_by_task() {
+    // The scripted library with its ten sources spread over three source tasks, and the
+    // SourceTask prototype first: the graph groups by task and names each group, the
+    // table gives each source's task.
+    let tasks = ["cartpole(length=1.0)", "cartpole(length=0.25)", "mirrored"];
+    let descriptions: Vec<sapnet::sapnet::PolicyDescription> = tui_script::HIDDEN
+        .iter()
+        .enumerate()
+        .map(|(i, h)| sapnet::sapnet::PolicyDescription::new(h.to_vec(), tasks[i % 3]))
+        .collect();
+    let mut params = sapnet::config::Config::default().sapnet;
+    params.prototypes.insert(
+        0,
+        sapnet::sapnet::WeightedPrototype {
+            prototype: sapnet::sapnet::Prototype::SourceTask,
+            omega: 0.1,
+        },
+    );
+    let net = sapnet::sapnet::SapNet::from_policies(&descriptions, params).unwrap();
+    let mut start = tui_script::sapnet_start();
+    if let sapnet::trainer::Event::RunStarted { sapnet, .. } = &mut start {
+        let start = sapnet.as_mut().unwrap();
+        for (policy, description) in start.policies.iter_mut().zip(descriptions) {
+            policy.description = description;
+        }
+        start.net = net;
+    }
+    let mut d = Dashboard::new("CartPole-v1");
+    d.on_event(start);
+    d.on_event(tui_script::baseline_start());
+    let terminal = draw_dashboard(&d, (140, 40));
+    let text = format!("{}", terminal.backend());
+    // Variants of one family are named by what differs.
+    for task in ["length=1.0", "length=0.25", "mirrored"] {
+        assert!(
+            text.matches(task).count() >= 2,
+            "{task} in graph and table: {text}"
+        );
+    }
+    insta::assert_snapshot!("dashboard_tasks_140x40", terminal.backend());
+}

@@ -167,6 +167,29 @@ impl SapNetView {
             .collect()
     }
 
+    /// The name of each group of [`categories`](Self::categories) when the graph groups
+    /// by source task over a library of several tasks (the task labels), else none.
+    pub fn task_groups(&self) -> Vec<String> {
+        let by_task = self
+            .net
+            .params()
+            .prototypes
+            .first()
+            .is_some_and(|p| p.prototype == Prototype::SourceTask);
+        let mut names: Vec<String> = Vec::new();
+        for policy in &self.policies {
+            let task = super::graph_view::short_task(&policy.description.source_task);
+            if !names.iter().any(|n| n == task) {
+                names.push(task.to_string());
+            }
+        }
+        if by_task && names.len() > 1 {
+            names
+        } else {
+            Vec::new()
+        }
+    }
+
     /// Whether `policy`'s edges are still lit from a recent spread.
     pub fn glows(&self, policy: usize, step: u64) -> bool {
         matches!(self.spread, Some((p, at)) if p == policy && step.saturating_sub(at) < SPREAD_GLOW_STEPS)

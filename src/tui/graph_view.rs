@@ -22,6 +22,9 @@ pub struct Scene<'a> {
     pub names: &'a [String],
     /// Category of each policy, for grouping; `None` keeps index order in one group.
     pub groups: Option<&'a [usize]>,
+    /// A name per category, written outside its group (the source tasks of a library over
+    /// several tasks); empty for none.
+    pub group_names: &'a [String],
     pub cursor: Option<usize>,
     /// The policy acting now (dashboard) or the activated one (teach).
     pub active: Option<usize>,
@@ -42,6 +45,8 @@ pub fn draw(frame: &mut Frame, area: Rect, block: Block, scene: Scene, theme: Th
         .fold(0.0_f64, f64::max);
     let labels: Vec<String> = scene.names.iter().map(|n| short_label(n)).collect();
     let show_weights = scene.net.len() <= 6;
+    // The canvas's x units per terminal cell.
+    let cell = 2.7 / f64::from(area.width.saturating_sub(2).max(1));
     let canvas = Canvas::default()
         .block(block)
         .x_bounds([-1.35, 1.35])
@@ -64,6 +69,29 @@ pub fn draw(frame: &mut Frame, area: Rect, block: Block, scene: Scene, theme: Th
                 }
             }
             ctx.layer();
+            if let Some(groups) = scene.groups {
+                for (group, name) in scene.group_names.iter().enumerate() {
+                    let members: Vec<(f64, f64)> = (0..positions.len())
+                        .filter(|&i| groups[i] == group)
+                        .map(|i| positions[i])
+                        .collect();
+                    if members.is_empty() {
+                        continue;
+                    }
+                    let k = members.len() as f64;
+                    let (x, y) = members
+                        .iter()
+                        .fold((0.0, 0.0), |(sx, sy), (x, y)| (sx + x / k, sy + y / k));
+                    // Outside the circle, beyond the group's middle, inside the panel.
+                    let scale = 1.22 / (x * x + y * y).sqrt().max(1e-9);
+                    let width = cell * name.chars().count() as f64;
+                    ctx.print(
+                        (x * scale - width / 2.0).clamp(-1.35, 1.35 - width),
+                        y * scale,
+                        Span::styled(name.clone(), theme.dim()),
+                    );
+                }
+            }
             for (i, &(x, y)) in positions.iter().enumerate() {
                 let activation = scene.net.activations()[i];
                 let level = if top > 0.0 { activation / top } else { 0.0 };
@@ -145,6 +173,15 @@ pub fn positions(n: usize, groups: Option<&[usize]>) -> Vec<(f64, f64)> {
         slot += 1;
     }
     positions
+}
+
+/// `cartpole(length=1.0)` → `length=1.0`: a source task's label without its family, for a
+/// library whose tasks are variants of one; other labels stay as they are.
+pub fn short_task(label: &str) -> &str {
+    match label.split_once('(') {
+        Some((_, rest)) if rest.ends_with(')') => &rest[..rest.len() - 1],
+        _ => label,
+    }
 }
 
 /// `source-12` → `12`; short names stay as they are.

@@ -99,6 +99,7 @@ fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Th
         Some(view) => {
             let names: Vec<String> = view.policies.iter().map(|p| p.name.clone()).collect();
             let groups = view.categories();
+            let group_names = view.task_groups();
             let lit: Vec<(usize, usize)> = view
                 .spread
                 .filter(|&(p, _)| view.glows(p, dashboard.step))
@@ -114,6 +115,7 @@ fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Th
                 net: &view.net,
                 names: &names,
                 groups: Some(&groups),
+                group_names: &group_names,
                 cursor: Some(dashboard.cursor),
                 active: view.acting,
                 lit: &lit,
@@ -225,7 +227,7 @@ fn draw_policy_table(
         if full {
             cells.push(Cell::from(format!("{:?}", p.description.hidden)));
             cells.push(Cell::from(if tasks {
-                p.description.source_task.clone()
+                graph_view::short_task(&p.description.source_task).to_string()
             } else {
                 p.description.hidden.len().to_string()
             }));
@@ -261,7 +263,7 @@ fn draw_policy_table(
             vec![
                 Constraint::Length(9),
                 Constraint::Length(14),
-                Constraint::Length(if tasks { 22 } else { 3 }),
+                Constraint::Length(if tasks { 14 } else { 3 }),
                 Constraint::Length(9),
                 Constraint::Length(bar_width as u16 + 5),
                 Constraint::Length(6),
@@ -571,6 +573,7 @@ fn draw_teach_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         net: teach.net(),
         names: teach.names(),
         groups: teach.groups(),
+        group_names: &[],
         cursor: Some(teach.cursor()),
         active: walk.as_ref().map(|w| w.policy),
         lit: &lit,
