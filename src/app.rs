@@ -7,7 +7,7 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use anyhow::{Context, Result};
 
-use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, TeachArgs};
+use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, SweepCommand, TeachArgs};
 use crate::config::{Config, MethodKind};
 use crate::experiment;
 use crate::headless::{self, OutputOptions, RunOptions};
@@ -21,6 +21,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Env(args)) => run_env(&cli, args),
         Some(Command::Teach(args)) => run_teach(&cli, args),
         Some(Command::Sources(args)) => run_sources(&cli, args),
+        Some(Command::Sweep(args)) => run_sweep(&cli, &args.command),
         Some(Command::Plot(args)) => {
             headless::replot(&args.dir)?;
             eprintln!(
@@ -144,6 +145,7 @@ fn run_options(cli: &Cli) -> RunOptions {
         }),
         library: cli.run.library_root(),
         trace: cli.run.trace,
+        copy_chosen: true,
     }
 }
 
@@ -272,6 +274,88 @@ fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
         dir.display()
     );
     Ok(())
+}
+
+fn run_sweep(cli: &Cli, command: &SweepCommand) -> Result<()> {
+    use crate::sweep;
+    match command {
+        SweepCommand::Plan { grid, out } => {
+            let manifest = sweep::plan::plan(&sweep::plan::PlanOptions {
+                grid: grid.clone(),
+                config: cli.run.config.clone(),
+                out: out.clone(),
+                library: cli.run.library_path(),
+            })?;
+            eprintln!(
+                "{} cells in {}: `sapnet sweep run {} --all` runs them here; slurm.sbatch and \
+                 parallel.txt fan them out",
+                manifest.cells.len(),
+                out.display(),
+                out.display()
+            );
+            Ok(())
+        }
+        SweepCommand::Prepare { sweep } => sweep::run::prepare(sweep, &on_interrupt()?),
+        SweepCommand::Run { sweep, cell, all } => {
+            let jobs = cli.run.jobs.unwrap_or_else(|| {
+                std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+            });
+            if *all {
+                let _stop = on_interrupt()?;
+                let failed = sweep::run::run_all(sweep, jobs)?;
+                let states = sweep::status::states(sweep)?;
+                eprint!("{}", sweep::status::report(&states));
+                anyhow::ensure!(
+                    failed == 0,
+                    "{failed} cells failed: `sapnet sweep status {}` says why",
+                    sweep.display()
+                );
+                return Ok(());
+            }
+            let id = match cell {
+                Some(id) => *id,
+                None => sweep::run::cell_from_environment()?.context(
+                    "which cell? --cell K, $SLURM_ARRAY_TASK_ID or $JOB_COMPLETION_INDEX \
+                     (or --all)",
+                )?,
+            };
+            match sweep::run::run_cell(sweep, id, jobs, &on_interrupt()?)? {
+                sweep::run::CellRun::AlreadyDone => eprintln!("cell {id}: done already"),
+                sweep::run::CellRun::Finished => eprintln!("cell {id}: done"),
+                sweep::run::CellRun::Stopped => eprintln!("cell {id}: stopped; run it again"),
+            }
+            Ok(())
+        }
+        SweepCommand::Status { sweep } => {
+            print!("{}", sweep::status::report(&sweep::status::states(sweep)?));
+            Ok(())
+        }
+        SweepCommand::Merge { sweep } => {
+            let report = sweep::merge::merge(sweep)?;
+            if !report.missing.is_empty() {
+                let names: Vec<String> = report
+                    .missing
+                    .iter()
+                    .map(|&id| sweep::cell_name(id))
+                    .collect();
+                eprintln!(
+                    "{} cells are not done and are left out: {}",
+                    names.len(),
+                    names.join(", ")
+                );
+            }
+            let mut out = std::io::stdout().lock();
+            for (title, table) in &report.tables {
+                writeln!(out, "{title}\n{table}").context("writing to stdout")?;
+            }
+            eprintln!(
+                "merged {} cells into {}",
+                report.merged,
+                sweep.join("merged").display()
+            );
+            Ok(())
+        }
+    }
 }
 
 /// The trainer's command channel, on which SIGINT (Ctrl-C), SIGTERM and SIGHUP ask it to

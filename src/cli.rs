@@ -77,8 +77,8 @@ pub struct RunArgs {
     #[arg(long)]
     pub trace: bool,
 
-    /// Runs trained at the same time. Default: one per core.
-    #[arg(long, value_name = "N")]
+    /// Runs trained at the same time (`sweep run --all`: cells). Default: one per core.
+    #[arg(long, value_name = "N", global = true)]
     pub jobs: Option<usize>,
 
     /// The policy library's root directory: SAP-Net reuses <LIBRARY>/<source task>/.
@@ -128,6 +128,56 @@ pub enum Command {
     /// Draw a results directory's plots again from its files (summary.json, episodes.csv,
     /// tests.csv, activations.csv): for a run stopped before its plots, or older plots.
     Plot(PlotArgs),
+    /// Sweeps: a grid of configs as independent cells, run by Slurm array jobs, GNU
+    /// parallel or this machine, then merged (docs/SWEEPS.md).
+    Sweep(SweepArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    #[command(subcommand)]
+    pub command: SweepCommand,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum SweepCommand {
+    /// Expand a grid (a base config and axes over its fields) into SWEEP/cells/NNNN.ron,
+    /// a manifest, SWEEP/slurm.sbatch and SWEEP/parallel.txt. `--config` overrides the
+    /// grid's base; `--library` is the library the cells reuse, read-only.
+    Plan {
+        /// The grid file (see assets/sweep_example.ron).
+        #[arg(long, value_name = "FILE")]
+        grid: PathBuf,
+        /// The sweep's folder.
+        #[arg(long, value_name = "SWEEP")]
+        out: PathBuf,
+    },
+    /// Train the source libraries the cells reuse, once, before the cells run.
+    Prepare {
+        #[arg(value_name = "SWEEP")]
+        sweep: PathBuf,
+    },
+    /// Run one cell (`--cell K`, else $SLURM_ARRAY_TASK_ID or $JOB_COMPLETION_INDEX) into
+    /// SWEEP/results/NNNN, or with `--all` every cell not done, `--jobs` cells at a time.
+    Run {
+        #[arg(value_name = "SWEEP")]
+        sweep: PathBuf,
+        #[arg(long, value_name = "K", conflicts_with = "all")]
+        cell: Option<usize>,
+        #[arg(long)]
+        all: bool,
+    },
+    /// Which cells are done, running, failed (with the error's last line) or missing.
+    Status {
+        #[arg(value_name = "SWEEP")]
+        sweep: PathBuf,
+    },
+    /// Merge the finished cells into SWEEP/merged/: a comparison per axis value,
+    /// episodes.csv in long format, plots.
+    Merge {
+        #[arg(value_name = "SWEEP")]
+        sweep: PathBuf,
+    },
 }
 
 #[derive(Debug, Args)]

@@ -28,6 +28,7 @@ pub mod sapnet;
 pub mod seeds;
 pub mod signals;
 pub mod sources;
+pub mod sweep;
 pub mod teach;
 pub mod trainer;
 pub mod tui;

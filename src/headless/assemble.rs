@@ -113,7 +113,7 @@ fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<
 }
 
 /// Each run's training returns, from its own `episodes.csv`.
-fn rewards(folders: &[RunFolder]) -> Result<BTreeMap<(MethodId, u32), Vec<f64>>> {
+pub fn rewards(folders: &[RunFolder]) -> Result<BTreeMap<(MethodId, u32), Vec<f64>>> {
     #[derive(Deserialize)]
     struct Row {
         reward: f64,

@@ -223,6 +223,19 @@ fn cell(x: Option<f64>) -> String {
 pub fn write_csv(path: &Path, rows: &[MethodComparison]) -> Result<()> {
     let mut csv =
         csv::Writer::from_path(path).with_context(|| format!("creating {}", path.display()))?;
+    let (header, records) = csv_records(rows);
+    csv.write_record(&header)
+        .with_context(|| format!("writing {}", path.display()))?;
+    for record in records {
+        csv.write_record(&record)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    csv.flush()
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// The header and the rows of `comparison.csv`.
+pub fn csv_records(rows: &[MethodComparison]) -> (Vec<String>, Vec<Vec<String>>) {
     let mut header: Vec<String> = vec!["method".into(), "runs".into()];
     if let Some(first) = rows.first() {
         for t in &first.thresholds {
@@ -248,8 +261,7 @@ pub fn write_csv(path: &Path, rows: &[MethodComparison]) -> Result<()> {
         .map(|r| r.task_shares.iter().map(|(t, _)| t.clone()).collect())
         .unwrap_or_default();
     header.extend(tasks.iter().map(|t| format!("share_{t}")));
-    csv.write_record(&header)
-        .with_context(|| format!("writing {}", path.display()))?;
+    let mut records = Vec::new();
     for row in rows {
         let mut record = vec![row.method.clone(), row.runs.to_string()];
         for t in &row.thresholds {
@@ -275,11 +287,9 @@ pub fn write_csv(path: &Path, rows: &[MethodComparison]) -> Result<()> {
             let share = row.task_shares.iter().find(|(t, _)| t == task);
             record.push(share.map_or(String::new(), |(_, s)| format!("{s:.4}")));
         }
-        csv.write_record(&record)
-            .with_context(|| format!("writing {}", path.display()))?;
+        records.push(record);
     }
-    csv.flush()
-        .with_context(|| format!("writing {}", path.display()))
+    (header, records)
 }
 
 /// The comparison as a plain-text table, for stdout.

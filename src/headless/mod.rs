@@ -52,10 +52,12 @@ use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::trainer::{Command, Divergence, Event, MethodId, RunOutcome, RunSpec, TrainerError};
 
 use assemble::{assemble, Ending};
+pub use plots::{write_all as write_plots, Curve, PlotData};
 pub(crate) use progress::Progress;
-use records::{run_name, RunWriter};
+pub use records::run_name;
+use records::RunWriter;
 pub use replot::replot;
-pub use results::{RunSummary, Status, Summary};
+pub use results::{LibraryEntry, RunSummary, Status, Summary};
 
 /// Entries that mark a directory as holding results already.
 const RESULT_FILES: [&str; 8] = [
@@ -97,6 +99,9 @@ pub struct RunOptions {
     pub library: crate::sources::LibraryRoot,
     /// Write every spread call of SAP-Net's runs to `trace.csv`.
     pub trace: bool,
+    /// Add each reusing run's chosen policy to the library (Algorithm 3's last step).
+    /// Sweeps leave it off: their library is shared, read-only, by many processes.
+    pub copy_chosen: bool,
 }
 
 /// Runs the protocol of `config`: trains the source library if SAP-Net needs one that is
@@ -157,6 +162,28 @@ pub fn resume(dir: &Path, options: &RunOptions, commands: &Receiver<Command>) ->
         Some(header.library.as_deref()),
         commands,
     )
+}
+
+/// A finished results directory, read back: its config, library, runs and each run's
+/// training returns (what the comparison is computed from).
+pub struct Results {
+    pub config: Config,
+    pub library: Option<Vec<results::LibraryEntry>>,
+    pub runs: Vec<RunSummary>,
+    pub rewards: BTreeMap<(MethodId, u32), Vec<f64>>,
+}
+
+/// Reads the results in `dir` from its summary and run records.
+pub fn read_results(dir: &Path) -> Result<Results> {
+    let header = replot::read_header(dir)?;
+    let folders = records::read(dir, &header.config)?;
+    let rewards = assemble::rewards(&folders)?;
+    Ok(Results {
+        config: header.config,
+        library: header.library,
+        runs: folders.into_iter().map(|f| f.summary).collect(),
+        rewards,
+    })
 }
 
 /// The protocol into `out`. `resumed` is `None` for a new protocol, else the library the
@@ -227,7 +254,9 @@ fn protocol(
         .as_ref()
         .map(|s| s.iter().map(|p| p.name.clone()).collect())
         .unwrap_or_default();
-    let copies = LibraryCopies::new(config, out, &options.library.path);
+    let copies = options
+        .copy_chosen
+        .then(|| LibraryCopies::new(config, out, &options.library.path));
     let planned = plan.specs.iter().map(|s| u64::from(s.episodes)).sum();
     let mut files = ResultFiles {
         out: out.to_path_buf(),
@@ -277,8 +306,8 @@ struct ResultFiles {
     writers: BTreeMap<(MethodId, u32), RunWriter>,
     /// Runs finished so far, rewritten to `summary.json` as each ends.
     summary: Summary,
-    /// Where the chosen policies join the library.
-    copies: LibraryCopies,
+    /// Where the chosen policies join the library, if they do.
+    copies: Option<LibraryCopies>,
 }
 
 impl ResultFiles {
@@ -332,15 +361,16 @@ impl Observer for ResultFiles {
                 .with_context(|| format!("saving the trained {}", record.method))?;
             // Only a finished reuse's choice, tested, is worth reusing. The results hold
             // it already, so a library that cannot take it costs a warning, not the run.
-            if record.chosen.is_some() && !record.stopped {
-                match self.copies.add(&name, &outcome.net, &info) {
+            if let (Some(copies), true) = (&self.copies, record.chosen.is_some() && !record.stopped)
+            {
+                match copies.add(&name, &outcome.net, &info) {
                     Ok(path) => library_copy = Some(path),
                     Err(err) => self.progress.warn(&format!(
                         "the chosen policy of {} run {} could not be added to the library in \
                          {}: {err:#}; it is in {}",
                         record.method,
                         record.run + 1,
-                        self.copies.dir.display(),
+                        copies.dir.display(),
                         self.out.join("policies").display()
                     )),
                 }

@@ -1,0 +1,132 @@
+//! `sapnet sweep plan`: a grid expanded into `SWEEP/cells/NNNN.ron`, the manifest, and the
+//! command lines that fan the cells out (a Slurm array job, GNU parallel).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+
+use super::grid::{describe, Grid};
+use super::{cell_config, CellEntry, Manifest};
+use crate::config::ron_options;
+use crate::policy_store::{sha256_hex, write_atomically};
+
+/// What to plan.
+pub struct PlanOptions {
+    pub grid: PathBuf,
+    /// `--config`: the base, instead of the grid's `base`.
+    pub config: Option<PathBuf>,
+    pub out: PathBuf,
+    /// The library root the cells reuse.
+    pub library: PathBuf,
+}
+
+/// Writes the sweep and returns its manifest. Planning the same grid again into the same
+/// folder changes nothing; a folder that holds another sweep is refused.
+pub fn plan(options: &PlanOptions) -> Result<Manifest> {
+    let grid = Grid::read(&options.grid)?;
+    let origin = options.grid.display().to_string();
+    let base = grid.base_config(&options.grid, options.config.as_deref())?;
+    let cells = grid.cells(&base, &origin)?;
+    let sweep = absolute(&options.out)?;
+    let library = absolute(&options.library)?;
+
+    let texts: Vec<String> = cells
+        .iter()
+        .enumerate()
+        .map(|(id, cell)| {
+            let pretty = ron::ser::PrettyConfig::default().compact_arrays(true);
+            let config = ron_options()
+                .to_string_pretty(&cell.config, pretty)
+                .context("a cell's config")?;
+            Ok(format!(
+                "// Cell {id} of the sweep planned from {origin}: {}\n{config}\n",
+                describe(&cell.axes)
+            ))
+        })
+        .collect::<Result<_>>()?;
+    let manifest = Manifest {
+        grid: absolute(&options.grid)?,
+        library,
+        cells: cells
+            .iter()
+            .zip(&texts)
+            .enumerate()
+            .map(|(id, (cell, text))| CellEntry {
+                id,
+                axes: cell.axes.clone(),
+                config_sha256: sha256_hex(text.as_bytes()),
+            })
+            .collect(),
+    };
+    if sweep.join("sweep.ron").exists() {
+        let found = Manifest::read(&sweep)?;
+        if found.cells != manifest.cells || found.library != manifest.library {
+            bail!(
+                "{} holds another sweep (its cells or library differ); plan into another --out",
+                sweep.display()
+            );
+        }
+        return Ok(found);
+    }
+    for dir in ["cells", "results", "failed", "logs"] {
+        std::fs::create_dir_all(sweep.join(dir))
+            .with_context(|| format!("creating {}", sweep.join(dir).display()))?;
+    }
+    for (id, text) in texts.iter().enumerate() {
+        write_atomically(&cell_config(&sweep, id), text.as_bytes())?;
+    }
+    let exe = std::env::current_exe().context("finding the sapnet binary")?;
+    let n = manifest.cells.len();
+    write_atomically(
+        &sweep.join("slurm.sbatch"),
+        slurm_script(&exe, &sweep, n).as_bytes(),
+    )?;
+    write_atomically(
+        &sweep.join("parallel.txt"),
+        parallel_lines(&exe, &sweep, n).as_bytes(),
+    )?;
+    // The manifest last: a folder with one is a whole plan.
+    manifest.write(&sweep)?;
+    Ok(manifest)
+}
+
+/// An array job with one task per cell, one CPU each, a log pair per cell.
+pub fn slurm_script(exe: &Path, sweep: &Path, cells: usize) -> String {
+    let (exe, sweep) = (exe.display(), sweep.display());
+    format!(
+        "#!/bin/bash\n\
+         # The {cells} cells of {sweep} as a Slurm array job: `sbatch {sweep}/slurm.sbatch`.\n\
+         # Throttle with `sbatch --array=0-{last}%8 …`; rerun cells 3 and 7 only with\n\
+         # `sbatch --array=3,7 …` (`sapnet sweep status {sweep}` lists what failed).\n\
+         #SBATCH --job-name=sapnet-sweep\n\
+         #SBATCH --array=0-{last}\n\
+         #SBATCH --cpus-per-task=1\n\
+         #SBATCH --output={sweep}/logs/%a.out\n\
+         #SBATCH --error={sweep}/logs/%a.err\n\
+         exec {exe} sweep run {sweep} --jobs 1\n",
+        last = cells.saturating_sub(1)
+    )
+}
+
+/// GNU parallel command lines: here, over machines, and rerunning what failed.
+pub fn parallel_lines(exe: &Path, sweep: &Path, cells: usize) -> String {
+    let (exe, sweep) = (exe.display(), sweep.display());
+    let last = cells.saturating_sub(1);
+    format!(
+        "# The {cells} cells of {sweep} with GNU parallel, one core each, on this machine:\n\
+         parallel --joblog {sweep}/parallel.log -j 2 {exe} sweep run {sweep} --cell {{}} --jobs 1 ::: $(seq 0 {last})\n\
+         # Over machines that share the sweep folder (and have sapnet at the same path):\n\
+         parallel --joblog {sweep}/parallel.log --sshloginfile HOSTS {exe} sweep run {sweep} --cell {{}} --jobs 1 ::: $(seq 0 {last})\n\
+         # Rerun only the cells that failed (a finished cell is skipped anyway):\n\
+         parallel --retry-failed --joblog {sweep}/parallel.log\n"
+    )
+}
+
+fn absolute(path: &Path) -> Result<PathBuf> {
+    if path.is_absolute() {
+        return Ok(path.to_path_buf());
+    }
+    Ok(std::env::current_dir()
+        .context("the working directory")?
+        .join(path))
+}

@@ -1,0 +1,245 @@
+//! `sapnet sweep run`: one cell (as a Slurm array task, a GNU parallel job or by hand), or
+//! every missing cell on this machine; `sapnet sweep prepare`: the libraries the cells
+//! reuse, trained once before the array starts.
+
+use std::io::IsTerminal;
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc::Receiver;
+use std::time::Duration;
+
+use anyhow::{bail, Context, Result};
+
+use super::status::{state, CellState};
+use super::{cell_config, cell_failure, cell_name, cell_partial, cell_results, Manifest};
+use crate::config::Config;
+use crate::headless::{self, OutputOptions, RunOptions};
+use crate::policy_store::sha256_hex;
+use crate::sources::{self, LibraryRoot};
+use crate::trainer::Command as TrainerCommand;
+
+/// How a `sweep run` of one cell ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CellRun {
+    /// Its results were there already.
+    AlreadyDone,
+    Finished,
+    /// Stopped by a signal; its partial results are run again next time.
+    Stopped,
+}
+
+/// The cell a scheduler asks for: `SLURM_ARRAY_TASK_ID`, else `JOB_COMPLETION_INDEX` (a
+/// Kubernetes indexed Job).
+pub fn cell_from_environment() -> Result<Option<usize>> {
+    for name in ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX"] {
+        if let Ok(value) = std::env::var(name) {
+            let id = value
+                .trim()
+                .parse()
+                .with_context(|| format!("{name}={value:?} is not a cell number"))?;
+            return Ok(Some(id));
+        }
+    }
+    Ok(None)
+}
+
+/// Runs cell `id` headless into a partial folder, renamed to `results/NNNN` once whole. A
+/// cell done already is skipped; a partial one a killed process left is run again. The
+/// library must be there (`sweep prepare`): cells never train it, as many run at once.
+pub fn run_cell(
+    sweep: &Path,
+    id: usize,
+    jobs: usize,
+    stop: &Receiver<TrainerCommand>,
+) -> Result<CellRun> {
+    let manifest = Manifest::read(sweep)?;
+    let Some(entry) = manifest.cells.iter().find(|c| c.id == id) else {
+        bail!(
+            "cell {id}: the sweep {} has cells 0 to {}",
+            sweep.display(),
+            manifest.cells.len().saturating_sub(1)
+        );
+    };
+    if state(sweep, id) == CellState::Done {
+        return Ok(CellRun::AlreadyDone);
+    }
+    let outcome = attempt(sweep, &manifest, entry, jobs, stop);
+    let failure = cell_failure(sweep, id);
+    match &outcome {
+        Err(err) => {
+            // A failed attempt leaves its error, not a partial result that would read as
+            // running.
+            let _ = std::fs::remove_dir_all(cell_partial(sweep, id));
+            let _ = std::fs::create_dir_all(failure.parent().unwrap_or(sweep));
+            let _ = std::fs::write(&failure, format!("{err:#}\n"));
+        }
+        Ok(CellRun::Finished) => {
+            let _ = std::fs::remove_file(&failure);
+        }
+        Ok(_) => {}
+    }
+    outcome
+}
+
+fn attempt(
+    sweep: &Path,
+    manifest: &Manifest,
+    entry: &super::CellEntry,
+    jobs: usize,
+    stop: &Receiver<TrainerCommand>,
+) -> Result<CellRun> {
+    let id = entry.id;
+    let path = cell_config(sweep, id);
+    let text = crate::config::read_text(&path)?;
+    if sha256_hex(text.as_bytes()) != entry.config_sha256 {
+        bail!(
+            "{} changed after the sweep was planned (its SHA-256 differs from sweep.ron): plan \
+             the sweep again",
+            path.display()
+        );
+    }
+    let config = Config::from_ron(&text, &path.display().to_string())?;
+    let partial = cell_partial(sweep, id);
+    if partial.exists() {
+        std::fs::remove_dir_all(&partial)
+            .with_context(|| format!("removing the partial cell {}", partial.display()))?;
+    }
+    let output = OutputOptions {
+        dir: partial.clone(),
+        force: false,
+    };
+    let options = RunOptions {
+        jobs,
+        library: LibraryRoot {
+            path: manifest.library.clone(),
+            train_if_missing: false,
+        },
+        trace: false,
+        copy_chosen: false,
+    };
+    let summary = headless::run(&config, &output, &options, stop).map_err(|err| {
+        if err.to_string().contains("source library") {
+            err.context(format!(
+                "cell {}: `sapnet sweep prepare {}` trains the library once, before the cells",
+                cell_name(id),
+                sweep.display()
+            ))
+        } else {
+            err.context(format!("cell {}", cell_name(id)))
+        }
+    })?;
+    if summary.stopped() {
+        return Ok(CellRun::Stopped);
+    }
+    let results = cell_results(sweep, id);
+    std::fs::rename(&partial, &results)
+        .with_context(|| format!("renaming {} into place", partial.display()))?;
+    Ok(CellRun::Finished)
+}
+
+/// Trains every library the cells reuse that is missing or unfinished, one after the other.
+pub fn prepare(sweep: &Path, stop: &Receiver<TrainerCommand>) -> Result<()> {
+    let manifest = Manifest::read(sweep)?;
+    let mut seen = Vec::new();
+    for entry in &manifest.cells {
+        let config = Config::from_file(&cell_config(sweep, entry.id))?;
+        if !config.protocol.methods.iter().any(|m| m.kind().reuses()) {
+            continue;
+        }
+        let training = sources::LibraryTraining::of(&config);
+        let dir = sources::library_dir(&manifest.library, &config);
+        if seen.contains(&(dir.clone(), training.clone())) {
+            continue;
+        }
+        seen.push((dir.clone(), training));
+        let root = LibraryRoot {
+            path: manifest.library.clone(),
+            train_if_missing: true,
+        };
+        sources::ensure_library(&config, &root, stop)
+            .with_context(|| format!("the library {} of cell {}", dir.display(), entry.id))?;
+        eprintln!("library {} ready", dir.display());
+    }
+    Ok(())
+}
+
+/// Runs every cell not done yet on this machine, `jobs` cells at a time, each a `sapnet
+/// sweep run --cell K` process of its own (as under Slurm or parallel) logging to
+/// `logs/NNNN.{out,err}`; a line of progress over cells on stderr. Returns how many failed.
+pub fn run_all(sweep: &Path, jobs: usize) -> Result<usize> {
+    let manifest = Manifest::read(sweep)?;
+    let exe = std::env::current_exe().context("finding the sapnet binary")?;
+    let todo: Vec<usize> = manifest
+        .cells
+        .iter()
+        .map(|c| c.id)
+        .filter(|&id| state(sweep, id) != CellState::Done)
+        .collect();
+    let total = manifest.cells.len();
+    let mut done = total - todo.len();
+    let mut failed = 0;
+    let mut queue = todo.into_iter();
+    let mut running: Vec<(usize, Child)> = Vec::new();
+    let mut said = String::new();
+    let logs = sweep.join("logs");
+    std::fs::create_dir_all(&logs).with_context(|| format!("creating {}", logs.display()))?;
+    loop {
+        while running.len() < jobs.max(1) {
+            let Some(id) = queue.next() else { break };
+            let log =
+                |ext: &str| std::fs::File::create(logs.join(format!("{}.{ext}", cell_name(id))));
+            let child = Command::new(&exe)
+                .args(["sweep", "run"])
+                .arg(sweep)
+                .args(["--cell", &id.to_string(), "--jobs", "1"])
+                .stdout(Stdio::from(log("out")?))
+                .stderr(Stdio::from(log("err")?))
+                .spawn()
+                .with_context(|| format!("starting cell {id}"))?;
+            running.push((id, child));
+        }
+        if running.is_empty() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+        let mut still = Vec::new();
+        for (id, mut child) in running {
+            match child.try_wait()? {
+                Some(status) if status.success() => done += 1,
+                Some(_) => {
+                    failed += 1;
+                    eprintln!(
+                        "cell {}: failed, see {}",
+                        cell_name(id),
+                        logs.join(format!("{}.err", cell_name(id))).display()
+                    );
+                }
+                None => still.push((id, child)),
+            }
+        }
+        running = still;
+        let line = format!(
+            "cells: {done}/{total} done, {} running, {failed} failed",
+            running.len()
+        );
+        if line != said {
+            // One line redrawn on a terminal; a line per change in a log.
+            if std::io::stderr().is_terminal() {
+                eprint!("\r{line}   ");
+            } else {
+                eprintln!("{line}");
+            }
+            said = line;
+        }
+        if crate::signals::received().is_some() {
+            // The children got the signal too (one process group): wait for them to stop.
+            for (_, child) in &mut running {
+                let _ = child.wait();
+            }
+            eprintln!();
+            bail!("stopped by the user: finished cells are kept; run again to finish the rest");
+        }
+    }
+    eprintln!();
+    Ok(failed)
+}

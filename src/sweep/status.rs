@@ -1,0 +1,68 @@
+//! `sapnet sweep status`: which cells are done, running, failed or missing.
+
+use std::path::Path;
+
+use anyhow::Result;
+
+use super::{cell_failure, cell_partial, cell_results, Manifest};
+
+/// Where one cell stands.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CellState {
+    Done,
+    /// A partial result is there: running now, or killed (then `sweep run` reruns it).
+    Running,
+    /// Its last attempt failed, with the error's last line.
+    Failed(String),
+    Missing,
+}
+
+/// The state of every cell, in order.
+pub fn states(sweep: &Path) -> Result<Vec<(usize, CellState)>> {
+    let manifest = Manifest::read(sweep)?;
+    Ok(manifest
+        .cells
+        .iter()
+        .map(|cell| (cell.id, state(sweep, cell.id)))
+        .collect())
+}
+
+pub fn state(sweep: &Path, id: usize) -> CellState {
+    if cell_results(sweep, id).is_dir() {
+        return CellState::Done;
+    }
+    if cell_partial(sweep, id).is_dir() {
+        return CellState::Running;
+    }
+    match std::fs::read_to_string(cell_failure(sweep, id)) {
+        Ok(text) => CellState::Failed(
+            text.lines()
+                .rev()
+                .find(|l| !l.trim().is_empty())
+                .unwrap_or("")
+                .to_string(),
+        ),
+        Err(_) => CellState::Missing,
+    }
+}
+
+/// The counts, then one line per cell that is not done.
+pub fn report(states: &[(usize, CellState)]) -> String {
+    let count = |f: fn(&CellState) -> bool| states.iter().filter(|(_, s)| f(s)).count();
+    let mut out = format!(
+        "{} cells: {} done, {} running, {} failed, {} missing\n",
+        states.len(),
+        count(|s| *s == CellState::Done),
+        count(|s| *s == CellState::Running),
+        count(|s| matches!(s, CellState::Failed(_))),
+        count(|s| *s == CellState::Missing),
+    );
+    for (id, state) in states {
+        match state {
+            CellState::Failed(line) => out.push_str(&format!("{id:04} failed: {line}\n")),
+            CellState::Running => out.push_str(&format!("{id:04} running (or killed)\n")),
+            CellState::Missing | CellState::Done => {}
+        }
+    }
+    out
+}

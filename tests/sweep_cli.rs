@@ -1,0 +1,213 @@
+//! Sweeps as a cluster runs them: planned once, each cell an ordinary process fanned out by
+//! GNU parallel, one cell killed with SIGKILL and run again, merged to what a sweep that
+//! never failed merges to.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn sapnet() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_sapnet"))
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+fn ok(output: Output) -> Output {
+    assert!(output.status.success(), "{}", stderr(&output));
+    output
+}
+
+/// A grid over tiny_transfer.ron (SAP-Net and a DQN on a library of three tiny sources):
+/// two values of τ × three seeds, six cells of a second or so.
+fn grid(tmp: &Path) -> PathBuf {
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/configs/tiny_transfer.ron");
+    let text = std::fs::read_to_string(base)
+        .unwrap()
+        .replace("episodes: 12,", "episodes: 60,");
+    std::fs::write(tmp.join("base.ron"), text).unwrap();
+    let grid = tmp.join("grid.ron");
+    std::fs::write(
+        &grid,
+        "(base: \"base.ron\", seeds: Some(3), \
+         axes: [(path: \"sapnet.temperature\", values: [1.0, 4.0])])",
+    )
+    .unwrap();
+    grid
+}
+
+fn plan(grid: &Path, sweep: &Path, library: &Path) -> Output {
+    sapnet()
+        .args(["sweep", "plan", "--grid"])
+        .arg(grid)
+        .arg("--out")
+        .arg(sweep)
+        .arg("--library")
+        .arg(library)
+        .output()
+        .unwrap()
+}
+
+fn sweep(args: &[&str], sweep: &Path) -> Output {
+    sapnet()
+        .args(["sweep", args[0]])
+        .arg(sweep)
+        .args(&args[1..])
+        .output()
+        .unwrap()
+}
+
+/// The merged files, `wall_s` (the last column of the episodes) left out.
+fn merged(sweep: &Path) -> (String, String) {
+    let comparison = std::fs::read_to_string(sweep.join("merged/comparison.csv")).unwrap();
+    let episodes = std::fs::read_to_string(sweep.join("merged/episodes.csv"))
+        .unwrap()
+        .lines()
+        .map(|l| l.rsplit_once(',').unwrap().0.to_string())
+        .collect::<Vec<_>>()
+        .join("\n");
+    (comparison, episodes)
+}
+
+#[test]
+fn a_sweep_through_gnu_parallel_survives_a_killed_cell() {
+    let tmp = tempfile::tempdir().unwrap();
+    let grid = grid(tmp.path());
+    let library = tmp.path().join("lib");
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    ok(plan(&grid, &a, &library));
+    // Planning again gives the same cells, and changes nothing.
+    let cells = std::fs::read(a.join("cells/0004.ron")).unwrap();
+    ok(plan(&grid, &a, &library));
+    assert_eq!(std::fs::read(a.join("cells/0004.ron")).unwrap(), cells);
+    let text = String::from_utf8(cells).unwrap();
+    assert!(text.contains("sapnet.temperature=4.0, seed=6"), "{text}");
+    ok(plan(&grid, &b, &library));
+
+    // The cells never train the library: they ask for `sweep prepare`.
+    let refused = sweep(&["run", "--cell", "0"], &a);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(
+        stderr(&refused).contains("sapnet sweep prepare"),
+        "{}",
+        stderr(&refused)
+    );
+    let status = String::from_utf8(sweep(&["status"], &a).stdout).unwrap();
+    assert!(status.contains("1 failed"), "{status}");
+    assert!(status.contains("0000 failed:"), "{status}");
+    ok(sapnet()
+        .args(["sources", "--config"])
+        .arg(tmp.path().join("base.ron"))
+        .arg("--library")
+        .arg(&library)
+        .output()
+        .unwrap());
+
+    // The reference: every cell on this machine, nothing failing.
+    ok(sweep(&["run", "--all", "--jobs", "2"], &b));
+    ok(sweep(&["merge"], &b));
+
+    // Cell 2 killed half-way: a partial result, no result.
+    let mut child = sapnet()
+        .args(["sweep", "run"])
+        .arg(&a)
+        .args(["--cell", "2", "--jobs", "1"])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let partial = a.join("results/.0002.partial/runs");
+    let started = Instant::now();
+    while std::fs::read_dir(&partial).map_or(true, |d| d.count() == 0) {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "cell 2 never started"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let status = String::from_utf8(sweep(&["status"], &a).stdout).unwrap();
+    assert!(status.contains("0002 running"), "{status}");
+
+    // Merging what there is names what is missing.
+    let partly = ok(sweep(&["merge"], &a));
+    assert!(
+        stderr(&partly).contains("6 cells are not done"),
+        "{}",
+        stderr(&partly)
+    );
+
+    if Command::new("parallel").arg("--version").output().is_err() {
+        eprintln!("GNU parallel is not installed: the cells run one by one instead");
+        for cell in 0..6 {
+            ok(sweep(
+                &["run", "--cell", &cell.to_string(), "--jobs", "1"],
+                &a,
+            ));
+        }
+    } else {
+        // The sweep's own command line, as a user copies it from parallel.txt.
+        let lines = std::fs::read_to_string(a.join("parallel.txt")).unwrap();
+        let line = lines.lines().find(|l| l.starts_with("parallel ")).unwrap();
+        ok(Command::new("bash").args(["-c", line]).output().unwrap());
+    }
+    let status = String::from_utf8(sweep(&["status"], &a).stdout).unwrap();
+    assert!(status.starts_with("6 cells: 6 done"), "{status}");
+    ok(sweep(&["merge"], &a));
+    assert_eq!(merged(&a), merged(&b));
+    let (comparison, episodes) = merged(&a);
+    assert!(
+        comparison.starts_with("axis,value,cells,method,runs,"),
+        "{comparison}"
+    );
+    assert!(
+        comparison.contains("\nsapnet.temperature,4.0,3,sapnet,6,"),
+        "{comparison}"
+    );
+    assert!(comparison.contains("\nseed,7,2,dqn[8],4,"), "{comparison}");
+    assert!(
+        episodes.starts_with("cell,sapnet.temperature,seed,run,method,episode,reward"),
+        "{episodes}"
+    );
+    // 6 cells × 2 methods × 2 runs × 60 episodes, and the header.
+    assert_eq!(episodes.lines().count(), 1 + 6 * 2 * 2 * 60);
+    assert!(a
+        .join("merged/sapnet.temperature=4.0/learning_curve.png")
+        .exists());
+}
+
+#[test]
+fn a_grid_key_that_names_no_field_is_a_located_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("base.ron"), "()").unwrap();
+    let grid = tmp.path().join("grid.ron");
+    std::fs::write(
+        &grid,
+        "(base: \"base.ron\", axes: [(path: \"dqn.gama\", values: [0.9])])",
+    )
+    .unwrap();
+    let output = plan(&grid, &tmp.path().join("s"), &tmp.path().join("lib"));
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(message.contains("axis `dqn.gama`"), "{message}");
+    assert!(message.contains("gama"), "{message}");
+    assert!(!tmp.path().join("s/sweep.ron").exists());
+}
+
+#[test]
+fn a_scheduler_names_the_cell_through_its_environment() {
+    let tmp = tempfile::tempdir().unwrap();
+    let output = sapnet()
+        .args(["sweep", "run"])
+        .arg(tmp.path())
+        .env("SLURM_ARRAY_TASK_ID", "x1")
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output).contains("SLURM_ARRAY_TASK_ID=\"x1\" is not a cell number"),
+        "{}",
+        stderr(&output)
+    );
+}
