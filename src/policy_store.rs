@@ -326,54 +326,36 @@ pub fn load_for_task(
 /// Names of the policies in `dir` (those with a metadata file), sorted; none if `dir` does
 /// not exist.
 pub fn list(dir: &Path) -> Result<Vec<String>, StoreError> {
-    let entries = match fs::read_dir(dir) {
-        Ok(entries) => entries,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(source) => {
-            return Err(StoreError::Read {
-                path: dir.to_path_buf(),
-                cause: source,
-            })
-        }
-    };
-    let mut names = Vec::new();
-    for entry in entries {
-        let entry = entry.map_err(|source| StoreError::Read {
-            path: dir.to_path_buf(),
-            cause: source,
-        })?;
-        let path = entry.path();
-        if path.extension().is_some_and(|e| e == "ron") {
-            if let Some(stem) = path.file_stem().and_then(|s| s.to_str()) {
-                if check_name(stem).is_ok() {
-                    names.push(stem.to_string());
-                }
-            }
-        }
-    }
-    names.sort();
-    Ok(names)
+    names_of(dir, "ron", |_| true)
 }
 
 /// Names of the weights files in `dir` that have no metadata beside them (a policy whose
 /// `.ron` was lost), sorted.
 pub fn orphan_weights(dir: &Path) -> Result<Vec<String>, StoreError> {
+    names_of(dir, "safetensors", |path| {
+        !path.with_extension("ron").exists()
+    })
+}
+
+/// The plain names of the files `*.<extension>` in `dir` that `keep` accepts, sorted.
+fn names_of(
+    dir: &Path,
+    extension: &str,
+    keep: impl Fn(&Path) -> bool,
+) -> Result<Vec<String>, StoreError> {
+    let read_error = |cause| StoreError::Read {
+        path: dir.to_path_buf(),
+        cause,
+    };
     let entries = match fs::read_dir(dir) {
         Ok(entries) => entries,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(source) => {
-            return Err(StoreError::Read {
-                path: dir.to_path_buf(),
-                cause: source,
-            })
-        }
+        Err(cause) => return Err(read_error(cause)),
     };
     let mut names = Vec::new();
-    for entry in entries.flatten() {
-        let path = entry.path();
-        if path.extension().is_some_and(|e| e == "safetensors")
-            && !path.with_extension("ron").exists()
-        {
+    for entry in entries {
+        let path = entry.map_err(read_error)?.path();
+        if path.extension().is_some_and(|e| e == extension) && keep(&path) {
             if let Some(stem) = path.file_stem().and_then(|s| s.to_str()) {
                 if check_name(stem).is_ok() {
                     names.push(stem.to_string());

@@ -3,9 +3,12 @@
 //! one; the same seed gives the same files whatever `--jobs`; `--force` deletes the old
 //! results only once the new ones are written.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
+
+use common::signal::signal_when;
 
 fn config(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -75,17 +78,7 @@ fn signal_after(mut command: Command, out: &Path, runs: usize, signal: &str) -> 
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    let started = Instant::now();
-    while finished_runs(out) < runs {
-        assert!(started.elapsed() < Duration::from_secs(120), "no run ended");
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    let status = Command::new("kill")
-        .arg(format!("-{signal}"))
-        .arg(child.id().to_string())
-        .status()
-        .unwrap();
-    assert!(status.success());
+    signal_when(&child, signal, || finished_runs(out) >= runs);
     child
 }
 

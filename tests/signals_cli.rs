@@ -2,9 +2,13 @@
 //! is written, and the exit code is 128 + the signal (130, 143, 129), in headless runs and
 //! library training alike.
 
+mod common;
+
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use common::signal::signal_when;
 
 /// A DQN that would train for hours: only a signal ends it.
 const ENDLESS: &str = "(protocol: (episodes: 1000000, runs: 1, methods: [Dqn(hidden: [8])]))";
@@ -20,21 +24,6 @@ fn start(args: &[&str], dir: &Path) -> Child {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap()
-}
-
-/// Waits until `ready` holds (at most 60 s), then sends `signal` with kill(1).
-fn signal_when(child: &Child, signal: &str, ready: impl Fn() -> bool) {
-    let started = Instant::now();
-    while !ready() {
-        assert!(started.elapsed() < Duration::from_secs(60), "never ready");
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    let status = Command::new("kill")
-        .arg(format!("-{signal}"))
-        .arg(child.id().to_string())
-        .status()
-        .unwrap();
-    assert!(status.success());
 }
 
 /// Episodes written so far by every run, finished or in progress (`runs/*/episodes.csv`,

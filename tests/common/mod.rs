@@ -1,3 +1,5 @@
 // Each test binary (and the render bench) uses a part of the script.
 #[allow(dead_code)]
+pub mod signal;
+#[allow(dead_code)]
 pub mod tui_script;
