@@ -262,6 +262,28 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
 
 fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
     let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
+    if args.evaluate {
+        let evaluations = crate::sources::evaluate(&config, &cli.run.library_path())?;
+        let target = env::make(&config.env).id().to_string();
+        let mut out = std::io::stdout().lock();
+        writeln!(
+            out,
+            "{:<10} {:<28} {:<16} {:>10} {:>12}",
+            "source", "task", "hidden", "own task", target
+        )?;
+        for e in &evaluations {
+            writeln!(
+                out,
+                "{:<10} {:<28} {:<16} {:>10} {:>12.1}",
+                e.name,
+                e.task,
+                format!("{:?}", e.hidden),
+                e.own_score.map_or("-".into(), |s| format!("{s:.1}")),
+                e.target_score
+            )?;
+        }
+        return Ok(());
+    }
     let dir = crate::sources::train_library(
         &config,
         &cli.run.library_path(),

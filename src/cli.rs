@@ -192,6 +192,11 @@ pub struct SourcesArgs {
     /// Replace a library already on disk.
     #[arg(long)]
     pub retrain: bool,
+
+    /// Train nothing: test each source of the library greedily on the config's target task
+    /// (`protocol.test_episodes` episodes) beside its score on its own task.
+    #[arg(long, conflicts_with = "retrain")]
+    pub evaluate: bool,
 }
 
 #[derive(Debug, Args)]

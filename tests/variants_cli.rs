@@ -52,6 +52,26 @@ fn a_library_over_two_tasks_records_each_policys_task_and_is_reused() {
     let manifest = sources::manifest::read(&dir).unwrap().unwrap();
     assert_eq!(manifest.training.tasks, tasks);
 
+    // Each source tested on the target, beside its score on its own task.
+    let evaluated = sapnet(
+        &["sources", "--config", file.to_str().unwrap(), "--evaluate"],
+        &library,
+    );
+    assert!(evaluated.status.success(), "{}", stderr(&evaluated));
+    let table = String::from_utf8(evaluated.stdout).unwrap();
+    let rows: Vec<&str> = table.lines().collect();
+    assert!(
+        rows[0].contains("own task") && rows[0].ends_with("CartPole-v1"),
+        "{table}"
+    );
+    assert_eq!(rows.len(), 4, "{table}");
+    assert!(
+        rows[3].starts_with("source-2") && rows[3].contains("mirrored"),
+        "{table}"
+    );
+    let evaluations = sources::evaluate(&parsed, &library).unwrap();
+    assert!(evaluations.iter().all(|e| e.target_score >= 1.0));
+
     let out = tmp.path().join("out");
     let output = sapnet(
         &[

@@ -384,6 +384,42 @@ impl Observer for SourceTraining<'_> {
     }
 }
 
+/// A source tested on the target task.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Evaluation {
+    pub name: String,
+    /// Its task's label.
+    pub task: String,
+    pub hidden: Vec<usize>,
+    /// Mean greedy return on its own task, as recorded when it was trained.
+    pub own_score: Option<f64>,
+    /// Mean greedy return on `config.env`.
+    pub target_score: f64,
+}
+
+/// Tests every source of the library of `config` greedily on the target task, for
+/// `protocol.test_episodes` episodes (at least one) from the config's seed: how useful each
+/// would be unchanged, which a library over other tasks does not say by its scores.
+pub fn evaluate(config: &Config, library: &Path) -> Result<Vec<Evaluation>> {
+    let sources = load_library(config, library)?;
+    let episodes = config.protocol.test_episodes.max(1);
+    let seed = seeds::derive(config.seed, &[SOURCES_STREAM, u64::MAX]);
+    sources
+        .iter()
+        .map(|source| {
+            let mut env = crate::env::make(&config.env);
+            let returns = crate::trainer::test_greedy(&source.net, env.as_mut(), episodes, seed)?;
+            Ok(Evaluation {
+                name: source.name.clone(),
+                task: source.description.source_task.clone(),
+                hidden: source.description.hidden.clone(),
+                own_score: source.final_score,
+                target_score: returns.iter().sum::<f64>() / returns.len() as f64,
+            })
+        })
+        .collect()
+}
+
 /// Where a run finds its library, and whether it may train one that is missing.
 #[derive(Debug, Clone)]
 pub struct LibraryRoot {
