@@ -149,9 +149,10 @@ pub fn train_library(
     };
     // Written before any policy: from here until `complete`, runs refuse the library.
     manifest::write(&dir, &manifest)?;
-    let todo: Vec<&SourcePlan> = plans
+    let todo: Vec<(&SourcePlan, &RunSpec)> = plans
         .iter()
-        .filter(|p| !manifest.policies.iter().any(|e| e.name == p.name))
+        .zip(&specs)
+        .filter(|(p, _)| !manifest.policies.iter().any(|e| e.name == p.name))
         .collect();
     if !manifest.policies.is_empty() {
         eprintln!(
@@ -166,22 +167,8 @@ pub fn train_library(
     let mut progress = crate::headless::Progress::new(
         u64::from(config.sources.training_episodes) * todo.len() as u64,
     );
-    for source in todo {
-        let i = plans
-            .iter()
-            .position(|p| p.name == source.name)
-            .unwrap_or(0);
-        let spec = specs[i].clone();
-        let mut training = SourceTraining {
-            progress: &mut progress,
-            outcome: None,
-        };
-        let stopped = schedule(vec![spec], 1, stop, &mut training)
-            .with_context(|| format!("training {}", source.name))?;
-        let outcome = training
-            .outcome
-            .expect("a run that neither failed nor was stopped has an outcome");
-        if stopped || outcome.record.stopped {
+    for (source, spec) in todo {
+        let Some(entry) = train_source(&dir, source, spec, &mut progress, stop)? else {
             progress.finish(false);
             bail!(
                 "stopped by the user: {} of {} policies are trained and kept in {}; the same \
@@ -190,22 +177,7 @@ pub fn train_library(
                 plans.len(),
                 dir.display()
             );
-        }
-        let returns = &outcome.record.test_returns;
-        let info = PolicyInfo {
-            source_task: manifest.training.tasks[source.task].env.clone(),
-            training: TrainingBudget {
-                episodes: u64::from(outcome.record.episodes),
-                steps: outcome.record.steps,
-            },
-            seed: source.seed,
-            final_score: (!returns.is_empty())
-                .then(|| returns.iter().sum::<f64>() / returns.len() as f64),
-            reused: None,
         };
-        policy_store::save(&dir, &source.name, &outcome.net, &info)
-            .with_context(|| format!("writing {} to {}", source.name, dir.display()))?;
-        let (entry, _) = ManifestEntry::of_policy(&dir, &source.name)?;
         manifest.policies.push(entry);
         manifest
             .policies
@@ -213,14 +185,59 @@ pub fn train_library(
         manifest::write(&dir, &manifest)?;
     }
     progress.finish(true);
+    // A smaller library replaces a larger one: its extra sources go before the library
+    // is declared whole.
+    remove_unplanned(&dir, &plans)?;
+    manifest.complete = true;
+    manifest::write(&dir, &manifest)?;
+    Ok(dir)
+}
 
-    // A smaller library replaces a larger one: its extra sources must go before the
-    // library is declared whole.
-    for stale in policy_files(&dir)?
+/// Trains one source with `spec` and saves it in `dir`; its manifest entry, or `None` when
+/// the user stopped it.
+fn train_source(
+    dir: &Path,
+    source: &SourcePlan,
+    spec: &RunSpec,
+    progress: &mut crate::headless::Progress,
+    stop: &Receiver<Command>,
+) -> Result<Option<ManifestEntry>> {
+    let mut training = SourceTraining {
+        progress,
+        outcome: None,
+    };
+    let stopped = schedule(vec![spec.clone()], 1, stop, &mut training)
+        .with_context(|| format!("training {}", source.name))?;
+    let outcome = training
+        .outcome
+        .expect("a run that neither failed nor was stopped has an outcome");
+    if stopped || outcome.record.stopped {
+        return Ok(None);
+    }
+    let returns = &outcome.record.test_returns;
+    let info = PolicyInfo {
+        source_task: spec.env.clone(),
+        training: TrainingBudget {
+            episodes: u64::from(outcome.record.episodes),
+            steps: outcome.record.steps,
+        },
+        seed: source.seed,
+        final_score: (!returns.is_empty())
+            .then(|| returns.iter().sum::<f64>() / returns.len() as f64),
+        reused: None,
+    };
+    policy_store::save(dir, &source.name, &outcome.net, &info)
+        .with_context(|| format!("writing {} to {}", source.name, dir.display()))?;
+    Ok(Some(ManifestEntry::of_policy(dir, &source.name)?.0))
+}
+
+/// Removes the policies in `dir` that `plans` does not name.
+fn remove_unplanned(dir: &Path, plans: &[SourcePlan]) -> Result<()> {
+    for stale in policy_files(dir)?
         .iter()
         .filter(|name| !plans.iter().any(|p| &p.name == *name))
     {
-        let (weights, metadata) = policy_store::paths(&dir, stale);
+        let (weights, metadata) = policy_store::paths(dir, stale);
         for path in [metadata, weights] {
             match std::fs::remove_file(&path) {
                 Err(err) if err.kind() != std::io::ErrorKind::NotFound => {
@@ -231,9 +248,7 @@ pub fn train_library(
             }
         }
     }
-    manifest.complete = true;
-    manifest::write(&dir, &manifest)?;
-    Ok(dir)
+    Ok(())
 }
 
 /// The run that trains `source`, the `i`-th of the plan: DQN from scratch on its source
