@@ -240,3 +240,21 @@ fn a_library_over_several_tasks_is_grouped_and_labelled_by_task() {
     }
     insta::assert_snapshot!("dashboard_tasks_140x40", terminal.backend());
 }
+
+#[test]
+fn v_shows_each_score_less_the_highest() {
+    let mut d = dashboard();
+    d.on_key(key('v'));
+    let terminal = draw_dashboard(&d, (120, 40));
+    let text = format!("{}", terminal.backend());
+    assert!(text.contains("A−max"), "{text}");
+    // The locked-in source reads 0, every other one below it.
+    let row = text
+        .lines()
+        .find(|l| l.contains("source-6  "))
+        .expect("source-6's row");
+    assert!(row.contains(" 0.000 "), "{row}");
+    insta::assert_snapshot!("dashboard_relative_120x40", terminal.backend());
+    d.on_key(key('v'));
+    assert!(!format!("{}", draw_dashboard(&d, (120, 40)).backend()).contains("A−max"));
+}

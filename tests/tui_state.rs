@@ -200,3 +200,38 @@ fn a_step_count_that_goes_back_restarts_the_speedometer() {
     d.tick(t0 + Duration::from_millis(1500));
     assert_eq!(d.steps_per_second, None);
 }
+
+/// The collapsed-softmax notice: the policy above P = 0.99 and the step since which it has
+/// been there, forgotten when it drops below or another takes its place.
+#[test]
+fn lock_in_is_dated_from_the_first_snapshot_above_the_threshold() {
+    let mut d = Dashboard::new("CartPole-v1");
+    d.on_event(tui_script::sapnet_start());
+    let snapshot = |step: u64, top: usize, p: f64| {
+        let n = tui_script::HIDDEN.len();
+        let mut probabilities = vec![(1.0 - p) / (n - 1) as f64; n];
+        probabilities[top] = p;
+        sapnet::trainer::Event::Activations(sapnet::trainer::ActivationSnapshot {
+            run: 0,
+            method: tui_script::method("sapnet"),
+            step,
+            episode: 1,
+            score_name: "A",
+            activations: vec![0.0; n],
+            probabilities,
+            selections: vec![0; n],
+            positive: vec![0; n],
+            negative: vec![0; n],
+        })
+    };
+    let locked = |d: &Dashboard| d.sapnet.as_ref().unwrap().locked;
+    d.on_event(snapshot(5, 6, 0.9));
+    assert_eq!(locked(&d), None);
+    d.on_event(snapshot(10, 6, 0.995));
+    d.on_event(snapshot(20, 6, 0.999));
+    assert_eq!(locked(&d), Some((6, 10)));
+    d.on_event(snapshot(30, 6, 0.5));
+    assert_eq!(locked(&d), None);
+    d.on_event(snapshot(40, 2, 0.9999));
+    assert_eq!(locked(&d), Some((2, 40)));
+}

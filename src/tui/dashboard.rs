@@ -13,7 +13,7 @@ use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
 use crate::config::MethodKind;
 use crate::sapnet::{PolicyDescription, Prototype, SapNet};
-use crate::trainer::{ActivationSnapshot, Command, Event, MethodId, RunRecord};
+use crate::trainer::{ActivationSnapshot, Command, Event, MethodId, RunRecord, LOCK_IN};
 
 use super::teach::Teach;
 
@@ -142,6 +142,9 @@ pub struct SapNetView {
     pub acting: Option<usize>,
     /// The last policy that activated and spread, and the step it did.
     pub spread: Option<(usize, u64)>,
+    /// The policy that has held P > [`LOCK_IN`] since the step given, while it does: the
+    /// softmax has collapsed onto it.
+    pub locked: Option<(usize, u64)>,
 }
 
 impl SapNetView {
@@ -232,6 +235,8 @@ pub struct Dashboard {
     pub mode: Mode,
     pub focus: Focus,
     pub help: bool,
+    /// The table shows A − max(A) instead of A (`v`): readable once A saturates.
+    pub relative: bool,
     /// The policy the arrows point at.
     pub cursor: usize,
     pub speed: usize,
@@ -256,6 +261,7 @@ impl Dashboard {
             mode: Mode::Running,
             focus: Focus::Table,
             help: false,
+            relative: false,
             cursor: 0,
             speed: 0,
             runs: Vec::new(),
@@ -335,6 +341,7 @@ impl Dashboard {
                         negative: vec![0; n],
                         acting: None,
                         spread: None,
+                        locked: None,
                     });
                     self.runs.insert(0, run);
                 } else {
@@ -405,6 +412,12 @@ impl Dashboard {
             view.selections = snapshot.selections;
             view.positive = snapshot.positive;
             view.negative = snapshot.negative;
+            let top = view.probabilities.iter().position(|&p| p > LOCK_IN);
+            view.locked = match (top, view.locked) {
+                (Some(i), Some((held, since))) if i == held => Some((held, since)),
+                (Some(i), _) => Some((i, snapshot.step)),
+                (None, _) => None,
+            };
         }
         self.step = self.step.max(snapshot.step);
     }
@@ -497,6 +510,10 @@ impl Dashboard {
                 Action::None
             }
             KeyCode::Char('t') => self.enter_teach(),
+            KeyCode::Char('v') => {
+                self.relative = !self.relative;
+                Action::None
+            }
             _ => Action::None,
         }
     }

@@ -142,6 +142,7 @@ fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Th
                 ),
                 view,
                 dashboard.cursor,
+                dashboard.relative,
                 theme,
             );
         }
@@ -188,8 +189,37 @@ fn policies_title(dashboard: &Dashboard, width: u16) -> String {
             let mean = record.test_returns.iter().sum::<f64>() / record.test_returns.len() as f64;
             format!("policies · chosen {} · test mean {mean:.1}", chosen.name)
         }
-        None => "policies".to_string(),
+        None => match dashboard.sapnet.as_ref().and_then(|v| Some((v, v.locked?))) {
+            // The softmax has collapsed: say so, and since when if it fits.
+            Some((view, (i, since))) => {
+                let name = &view.policies[i].name;
+                let full = format!(
+                    "policies · P({name}) > {} since step {}",
+                    crate::trainer::LOCK_IN,
+                    thousands(since)
+                );
+                if full.chars().count() + 4 <= usize::from(width) {
+                    full
+                } else {
+                    format!("policies · P({name}) > {}", crate::trainer::LOCK_IN)
+                }
+            }
+            None => "policies".to_string(),
+        },
     }
+}
+
+/// `1234567` → `1,234,567`.
+fn thousands(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
 }
 
 fn draw_policy_table(
@@ -198,8 +228,22 @@ fn draw_policy_table(
     block: Block,
     view: &SapNetView,
     cursor: usize,
+    relative: bool,
     theme: Theme,
 ) {
+    // `v`: each score less the highest, so that saturated activations (2.360e5 beside
+    // 2.359e5) still read apart.
+    let highest = view
+        .net
+        .activations()
+        .iter()
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
+    let score_header = if relative {
+        format!("{}−max", view.score_name)
+    } else {
+        view.score_name.to_string()
+    };
     let top = view
         .net
         .activations()
@@ -232,7 +276,11 @@ fn draw_policy_table(
                 p.description.hidden.len().to_string()
             }));
         }
-        cells.push(Cell::from(format_activation(a)));
+        cells.push(Cell::from(format_activation(if relative {
+            a - highest
+        } else {
+            a
+        })));
         cells.push(Cell::from(probability_bar(probability, bar_width)));
         cells.push(Cell::from(count(view.selections[i])));
         if full {
@@ -255,7 +303,7 @@ fn draw_policy_table(
                 "policy",
                 "hidden",
                 if tasks { "task" } else { "cat" },
-                view.score_name,
+                &score_header,
                 "P(π)",
                 "acted",
                 "+/−",
@@ -272,7 +320,7 @@ fn draw_policy_table(
         )
     } else {
         (
-            vec!["policy", view.score_name, "P(π)", "acted"],
+            vec!["policy", &score_header, "P(π)", "acted"],
             vec![
                 Constraint::Length(9),
                 Constraint::Length(9),
@@ -511,6 +559,7 @@ const HELP: &[(&str, &str)] = &[
     ("tab", "move focus between the graph and the table"),
     ("↑↓←→ hjkl", "pick a policy"),
     ("m", "follow the next reusing method's run"),
+    ("v", "scores as A − max(A), readable when A saturates"),
     ("t", "teach mode on the live graph (pauses training)"),
     ("t / Esc", "teach: back to the paused dashboard"),
     ("a", "teach: activate the picked policy (A += 𝒜, eq. 8)"),
