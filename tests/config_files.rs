@@ -102,11 +102,23 @@ fn every_shipped_config_loads() {
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();
             let name = path.file_name().unwrap().to_string_lossy().into_owned();
-            // Teaching graphs have their own schema (tests/teach_cli.rs loads them).
-            if path.extension().is_some_and(|e| e == "ron") && !name.starts_with("teach_") {
-                Config::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
-                loaded += 1;
+            if path.extension().is_none_or(|e| e != "ron") || name.starts_with("teach_") {
+                // Teaching graphs have their own schema (tests/teach_cli.rs loads them).
+                continue;
             }
+            if name.starts_with("sweep_") {
+                // A sweep's grid: it loads, names a base that loads, and expands.
+                let grid =
+                    sapnet::sweep::grid::Grid::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
+                let base = grid
+                    .base_config(&path, None)
+                    .unwrap_or_else(|e| panic!("{e:#}"));
+                let cells = grid.cells(&base, &name).unwrap_or_else(|e| panic!("{e:#}"));
+                assert!(cells.len() >= 4, "{name}: {} cells", cells.len());
+            } else {
+                Config::from_file(&path).unwrap_or_else(|e| panic!("{e}"));
+            }
+            loaded += 1;
         }
     }
     assert!(loaded >= 10, "only {loaded} configs found");
