@@ -53,7 +53,7 @@ use crate::trainer::{Command, Divergence, Event, MethodId, RunOutcome, RunSpec, 
 
 use assemble::{assemble, Ending};
 pub use plots::{write_all as write_plots, Curve, PlotData};
-pub(crate) use progress::Progress;
+pub(crate) use progress::{Progress, Unit};
 pub use records::run_name;
 use records::RunWriter;
 pub use replot::replot;
@@ -257,12 +257,19 @@ fn protocol(
     let copies = options
         .copy_chosen
         .then(|| LibraryCopies::new(config, out, &options.library.path));
-    let planned = plan.specs.iter().map(|s| u64::from(s.episodes)).sum();
+    // A step budget bounds runs in steps, else their episodes do.
+    let (unit, planned) = match config.protocol.max_steps {
+        Some(steps) => (Unit::Steps, steps * plan.specs.len() as u64),
+        None => (
+            Unit::Episodes,
+            plan.specs.iter().map(|s| u64::from(s.episodes)).sum(),
+        ),
+    };
     let mut files = ResultFiles {
         out: out.to_path_buf(),
         config: config.clone(),
         names,
-        progress: Progress::new(planned),
+        progress: Progress::new(planned, unit),
         writers: BTreeMap::new(),
         summary,
         copies,
@@ -324,8 +331,18 @@ impl ResultFiles {
 impl Observer for ResultFiles {
     fn on_event(&mut self, event: Event) -> Result<()> {
         match event {
-            Event::RunStarted { run, method, .. } => {
-                self.progress.run_started(method.label(), run);
+            Event::RunStarted {
+                run,
+                method,
+                planned_episodes,
+                ..
+            } => {
+                let planned = self
+                    .config
+                    .protocol
+                    .max_steps
+                    .unwrap_or(u64::from(planned_episodes));
+                self.progress.run_started(method.label(), run, planned);
                 self.writer(&method, run)?;
             }
             Event::Activations(snapshot) => {
@@ -352,6 +369,8 @@ impl Observer for ResultFiles {
 
     fn on_finished(&mut self, _order: usize, _spec: &RunSpec, outcome: RunOutcome) -> Result<()> {
         let record = outcome.record;
+        self.progress
+            .run_finished(record.method.label(), record.run);
         let mut library_copy = None;
         // A run stopped before its first step trained nothing worth keeping.
         if record.steps > 0 {

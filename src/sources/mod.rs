@@ -166,6 +166,7 @@ pub fn train_library(
 
     let mut progress = crate::headless::Progress::new(
         u64::from(config.sources.training_episodes) * todo.len() as u64,
+        crate::headless::Unit::Episodes,
     );
     for (source, spec) in todo {
         let Some(entry) = train_source(&dir, source, spec, &mut progress, stop)? else {
@@ -382,7 +383,13 @@ struct SourceTraining<'a> {
 impl Observer for SourceTraining<'_> {
     fn on_event(&mut self, event: Event) -> Result<()> {
         match event {
-            Event::RunStarted { method, .. } => self.progress.run_started(method.label(), 0),
+            Event::RunStarted {
+                method,
+                planned_episodes,
+                ..
+            } => self
+                .progress
+                .run_started(method.label(), 0, u64::from(planned_episodes)),
             Event::EpisodeEnded(record) => self.progress.episode(&record),
             _ => {}
         }
@@ -390,6 +397,7 @@ impl Observer for SourceTraining<'_> {
     }
 
     fn on_finished(&mut self, _order: usize, _spec: &RunSpec, outcome: RunOutcome) -> Result<()> {
+        self.progress.run_finished(outcome.record.method.label(), 0);
         self.outcome = Some(outcome);
         Ok(())
     }
