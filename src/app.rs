@@ -76,9 +76,13 @@ fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
         // SIGTERM or SIGHUP end teach mode as `q` does, the terminal restored.
         let _stop = crate::signals::stop_on_signals()?;
         let mut teach = Teach::new(lesson.names, lesson.net);
+        // Each activation finishes the walk before it; the last is left to step, unless
+        // --run.
         for &i in &args.activate {
             teach.move_cursor(i as isize - teach.cursor() as isize);
             teach.activate();
+        }
+        if args.run {
             teach.run_to_end();
         }
         return tui::run_teach(teach);

@@ -22,7 +22,9 @@ pub struct Cli {
 /// Options of a training run.
 #[derive(Debug, Args)]
 pub struct RunArgs {
-    /// RON config file (see assets/). Without it, the embedded CartPole config (paper values).
+    /// RON config file (see assets/). Without it, the embedded CartPole config (paper
+    /// values). For `teach`: a lesson file (assets/teach_*.ron), by default the paper's
+    /// Fig. 2.
     #[arg(long, short, value_name = "FILE", global = true)]
     pub config: Option<PathBuf>,
 
@@ -212,9 +214,14 @@ pub struct TeachArgs {
     #[arg(long)]
     pub headless: bool,
 
-    /// Activate this policy (0-based index); repeat to activate several in order.
+    /// Activate this policy (0-based index); repeat to activate several in order. The
+    /// interactive view opens at the start of the last one's walk, to step it.
     #[arg(long = "activate", value_name = "I")]
     pub activate: Vec<usize>,
+
+    /// With --activate: open with the last walk already run to its end.
+    #[arg(long)]
+    pub run: bool,
 
     /// With --headless: print one JSON object {activations, probabilities, trace}.
     #[arg(long)]

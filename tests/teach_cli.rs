@@ -167,3 +167,14 @@ fn a_coefficient_that_would_overflow_is_refused_at_its_field() {
     assert!(stderr.contains("1e308"), "{stderr}");
     assert!(output.stdout.is_empty());
 }
+
+/// Issue 15: a training config given to teach was refused as "Unexpected field `env` in
+/// TeachConfig"; it is now told what teach reads.
+#[test]
+fn a_training_config_is_told_teach_reads_a_lesson() {
+    let output = sapnet(&["teach", "--headless", "--config", "assets/cartpole.ron"]);
+    assert_eq!(output.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("this is a training config"), "{stderr}");
+    assert!(stderr.contains("assets/teach_fig2.ron"), "{stderr}");
+}

@@ -91,7 +91,21 @@ impl TeachConfig {
 
     /// Reads and builds a teach file from RON text; `origin` names it in errors.
     pub fn lesson_from_ron(text: &str, origin: &str) -> Result<Lesson, ConfigError> {
-        let config: TeachConfig = parse_ron(text, origin)?;
+        let config: TeachConfig = parse_ron(text, origin).map_err(|e| {
+            // A training config given where a lesson is expected: say what teach reads.
+            if crate::config::Config::from_ron(text, origin).is_ok() {
+                ConfigError::Invalid {
+                    origin: origin.to_string(),
+                    message: "this is a training config; `sapnet teach --config` reads a \
+                              lesson (a graph and SAP-Net's parameters, e.g. \
+                              assets/teach_fig2.ron, assets/teach_table2.ron); `t` on the \
+                              dashboard teaches on a training config's live graph"
+                        .to_string(),
+                }
+            } else {
+                e
+            }
+        })?;
         config.lesson().map_err(|message| ConfigError::Invalid {
             origin: origin.to_string(),
             message,
