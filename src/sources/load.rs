@@ -1,0 +1,236 @@
+//! Reading a library for reuse: whole, of the config's tasks, fitting the target; or
+//! trained first where that is allowed; and each source tested on the target.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::Receiver;
+
+use anyhow::{bail, Context, Result};
+
+use super::manifest::{self, LibraryTraining};
+use super::{library_dir, plan, policy_files, train_library, SourceTask, SOURCES_STREAM};
+use crate::config::Config;
+use crate::policy_store;
+use crate::sapnet::PolicyDescription;
+use crate::seeds;
+use crate::trainer::{Command, SourcePolicy};
+
+/// A source tested on the target task.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Evaluation {
+    pub name: String,
+    /// Its task's label.
+    pub task: String,
+    pub hidden: Vec<usize>,
+    /// Mean greedy return on its own task, as recorded when it was trained.
+    pub own_score: Option<f64>,
+    /// Mean greedy return on `config.env`.
+    pub target_score: f64,
+}
+
+/// Tests every source of the library of `config` greedily on the target task, for
+/// `protocol.test_episodes` episodes (at least one) from the config's seed: how useful each
+/// would be unchanged, which a library over other tasks does not say by its scores.
+pub fn evaluate(config: &Config, library: &Path) -> Result<Vec<Evaluation>> {
+    let sources = load_library(config, library)?;
+    let episodes = config.protocol.test_episodes.max(1);
+    let seed = seeds::derive(config.seed, &[SOURCES_STREAM, u64::MAX]);
+    sources
+        .iter()
+        .map(|source| {
+            let mut env = crate::env::make(&config.env);
+            let returns = crate::trainer::test_greedy(&source.net, env.as_mut(), episodes, seed)?;
+            Ok(Evaluation {
+                name: source.name.clone(),
+                task: source.description.source_task.clone(),
+                hidden: source.description.hidden.clone(),
+                own_score: source.final_score,
+                target_score: returns.iter().sum::<f64>() / returns.len() as f64,
+            })
+        })
+        .collect()
+}
+
+/// Where a run finds its library, and whether it may train one that is missing.
+#[derive(Debug, Clone)]
+pub struct LibraryRoot {
+    /// `<library>`: the task's library is `<library>/<source task>/`.
+    pub path: PathBuf,
+    /// Train a missing or unfinished library before the run (the default library, or
+    /// `--train-library`). Otherwise a typo in `--library` is an error, not hours of
+    /// training.
+    pub train_if_missing: bool,
+}
+
+/// Reads the source library of `config` from `<library>/<source task>/` for reuse on the
+/// target task. The library must be whole: its manifest complete, of the config's source
+/// task and `sources.count`, every policy on disk with the hashes the manifest records and
+/// no policy beside them; every policy must fit the target task's sizes.
+pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>> {
+    let dir = library_dir(library, config);
+    let Some(found) = manifest::read(&dir)? else {
+        let on_disk = policy_files(&dir)?;
+        if on_disk.is_empty() {
+            bail!(
+                "the source library {} holds no policies; train it with `sapnet sources \
+                 --config <FILE>`",
+                dir.display()
+            );
+        }
+        bail!(
+            "{} holds {} policies but no manifest ({}): an older sapnet wrote them, or their \
+             training was interrupted; `sapnet sources --config <FILE> --library {}` checks \
+             them against the config, trains what is missing and writes the manifest",
+            dir.display(),
+            on_disk.len(),
+            manifest::FILE,
+            library.display()
+        );
+    };
+    let manifest_path = manifest::path(&dir);
+    let wanted = LibraryTraining::of(config);
+    if found.training.tasks != wanted.tasks {
+        let tasks = |t: &[SourceTask]| -> String {
+            t.iter()
+                .map(|t| format!("{} ×{}", t.label, t.count))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        bail!(
+            "the library {} was trained on {}, but the config's source tasks are {}; retrain \
+             the library with `sapnet sources --retrain` or use another --library",
+            dir.display(),
+            tasks(&found.training.tasks),
+            tasks(&wanted.tasks)
+        );
+    }
+    if !found.complete {
+        let missing: Vec<String> = plan(config)
+            .into_iter()
+            .filter(|p| !found.policies.iter().any(|e| e.name == p.name))
+            .map(|p| p.name)
+            .collect();
+        bail!(
+            "the source library {} is unfinished: {} of {} policies trained (missing: {}); \
+             `sapnet sources --config <FILE>` trains the rest",
+            dir.display(),
+            found.policies.len(),
+            found.training.count(),
+            missing.join(", ")
+        );
+    }
+    if found.policies.len() != wanted.count() {
+        bail!(
+            "the library {} holds {} policies, the config's sources.count is {}; train one of \
+             {} with `sapnet sources --retrain` or set sources.count",
+            dir.display(),
+            found.policies.len(),
+            wanted.count(),
+            wanted.count()
+        );
+    }
+    for difference in wanted.differences(&found.training) {
+        eprintln!(
+            "warning: the library {} was trained with other settings than the config's \
+             ({difference}): it is reused as it is",
+            dir.display()
+        );
+    }
+    if let Some(stray) = policy_files(&dir)?
+        .into_iter()
+        .find(|name| !found.policies.iter().any(|e| &e.name == name))
+    {
+        bail!(
+            "{} holds policy {stray}, which its manifest {} does not list: remove it, or \
+             retrain the library with `sapnet sources --retrain`",
+            dir.display(),
+            manifest_path.display()
+        );
+    }
+
+    let env = crate::env::make(&config.env);
+    let plans = plan(config);
+    let mut sources = Vec::with_capacity(found.policies.len());
+    for (entry, planned) in found.policies.iter().zip(&plans) {
+        let task = &wanted.tasks[planned.task];
+        let stored = policy_store::load_for_task(
+            &dir,
+            &entry.name,
+            env.observation_size(),
+            env.action_count(),
+        )?;
+        let metadata_path = policy_store::paths(&dir, &entry.name).1;
+        let metadata_sha256 = policy_store::sha256_hex(
+            &std::fs::read(&metadata_path)
+                .with_context(|| format!("reading {}", metadata_path.display()))?,
+        );
+        if stored.metadata.weights_sha256 != entry.weights_sha256
+            || metadata_sha256 != entry.metadata_sha256
+        {
+            bail!(
+                "policy {} is not the one {} records (its files changed after the library was \
+                 written); retrain the library with `sapnet sources --retrain`",
+                metadata_path.display(),
+                manifest_path.display()
+            );
+        }
+        if entry.name != planned.name || stored.metadata.source_task != task.env {
+            bail!(
+                "policy {} was trained on {}, but the config puts {} on {}; retrain the library \
+                 with `sapnet sources --retrain` or use another --library",
+                metadata_path.display(),
+                stored.metadata.source_task.label(),
+                planned.name,
+                task.label
+            );
+        }
+        sources.push(SourcePolicy {
+            description: PolicyDescription {
+                hidden: stored.metadata.architecture.hidden.clone(),
+                activation: stored.metadata.activation.clone(),
+                source_task: task.label.clone(),
+            },
+            final_score: stored.metadata.final_score,
+            net: stored.net,
+            name: entry.name.clone(),
+        });
+    }
+    Ok(sources)
+}
+
+/// The library of `config`, trained first (or its training finished) if `root` allows it
+/// and `<library>/<task>/` holds none or an unfinished one, with progress on stderr
+/// (`stop` ends it), then loaded.
+pub fn ensure_library(
+    config: &Config,
+    root: &LibraryRoot,
+    stop: &Receiver<Command>,
+) -> Result<Vec<SourcePolicy>> {
+    let dir = library_dir(&root.path, config);
+    let unfinished = match manifest::read(&dir)? {
+        Some(found) => !found.complete,
+        None => policy_files(&dir)?.is_empty(),
+    };
+    if unfinished {
+        let state = if dir.exists() {
+            "an unfinished source library"
+        } else {
+            "no source library"
+        };
+        if !root.train_if_missing {
+            bail!(
+                "{state} in {}: train it with `sapnet sources --config <FILE> --library {}`, \
+                 or pass --train-library to train it before this run",
+                dir.display(),
+                root.path.display()
+            );
+        }
+        eprintln!(
+            "{state} in {}: training {} source policies first ({} episodes each)",
+            dir.display(),
+            config.sources.count,
+            config.sources.training_episodes
+        );
+        train_library(config, &root.path, false, stop)?;
+    }
+    load_library(config, &root.path)
+}

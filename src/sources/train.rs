@@ -1,0 +1,293 @@
+//! Training a library: one source at a time, each on disk and in the manifest as soon as
+//! it is trained, resumed after a kill.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::Receiver;
+
+use anyhow::{bail, Context, Result};
+
+use super::manifest::{self, LibraryTraining, Manifest, ManifestEntry};
+use super::{library_dir, plan, policy_files, tasks, SourcePlan};
+use crate::config::Config;
+use crate::experiment::{schedule, Observer};
+use crate::policy_store::{self, PolicyInfo, TrainingBudget};
+use crate::trainer::{Command, Event, RunOutcome, RunSpec, TrainerError};
+
+/// Trains the library `config` describes into `<library>/<source task>/`, one policy at a
+/// time, each on disk (and in the manifest) as soon as it is trained: a stop or a kill
+/// costs at most the policy in training, and the same command resumes. A finished library
+/// is replaced only when `retrain` is set; policies on disk that the config does not
+/// describe are never silently mixed in.
+pub fn train_library(
+    config: &Config,
+    library: &Path,
+    retrain: bool,
+    stop: &Receiver<Command>,
+) -> Result<PathBuf> {
+    let dir = library_dir(library, config);
+    let training = LibraryTraining::of(config);
+    let plans = plan(config);
+    let specs: Vec<RunSpec> = plans
+        .iter()
+        .enumerate()
+        .map(|(i, source)| source_spec(config, i, source))
+        .collect();
+    crate::experiment::memory::check(&specs, 1)?;
+    let kept = resumable(&dir, &training, &plans, retrain)?;
+    std::fs::create_dir_all(&dir)
+        .with_context(|| format!("creating the library folder {}", dir.display()))?;
+    remove_temporaries(&dir)?;
+    let mut manifest = Manifest {
+        complete: false,
+        training,
+        policies: kept,
+        crate_version: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    // Written before any policy: from here until `complete`, runs refuse the library.
+    manifest::write(&dir, &manifest)?;
+    let todo: Vec<(&SourcePlan, &RunSpec)> = plans
+        .iter()
+        .zip(&specs)
+        .filter(|(p, _)| !manifest.policies.iter().any(|e| e.name == p.name))
+        .collect();
+    if !manifest.policies.is_empty() {
+        eprintln!(
+            "{}: {} of {} policies already trained and checked; training {}",
+            dir.display(),
+            manifest.policies.len(),
+            plans.len(),
+            todo.len()
+        );
+    }
+
+    let mut progress = crate::headless::Progress::new(
+        u64::from(config.sources.training_episodes) * todo.len() as u64,
+        crate::headless::Unit::Episodes,
+    );
+    for (source, spec) in todo {
+        let Some(entry) = train_source(&dir, source, spec, &mut progress, stop)? else {
+            progress.finish(false);
+            bail!(
+                "stopped by the user: {} of {} policies are trained and kept in {}; the same \
+                 command trains the rest",
+                manifest.policies.len(),
+                plans.len(),
+                dir.display()
+            );
+        };
+        manifest.policies.push(entry);
+        manifest
+            .policies
+            .sort_by_key(|e| plans.iter().position(|p| p.name == e.name));
+        manifest::write(&dir, &manifest)?;
+    }
+    progress.finish(true);
+    // A smaller library replaces a larger one: its extra sources go before the library
+    // is declared whole.
+    remove_unplanned(&dir, &plans)?;
+    manifest.complete = true;
+    manifest::write(&dir, &manifest)?;
+    Ok(dir)
+}
+
+/// Trains one source with `spec` and saves it in `dir`; its manifest entry, or `None` when
+/// the user stopped it.
+fn train_source(
+    dir: &Path,
+    source: &SourcePlan,
+    spec: &RunSpec,
+    progress: &mut crate::headless::Progress,
+    stop: &Receiver<Command>,
+) -> Result<Option<ManifestEntry>> {
+    let mut training = SourceTraining {
+        progress,
+        outcome: None,
+    };
+    let stopped = schedule(vec![spec.clone()], 1, stop, &mut training)
+        .with_context(|| format!("training {}", source.name))?;
+    let outcome = training
+        .outcome
+        .expect("a run that neither failed nor was stopped has an outcome");
+    if stopped || outcome.record.stopped {
+        return Ok(None);
+    }
+    let returns = &outcome.record.test_returns;
+    let info = PolicyInfo {
+        source_task: spec.env.clone(),
+        training: TrainingBudget {
+            episodes: u64::from(outcome.record.episodes),
+            steps: outcome.record.steps,
+        },
+        seed: source.seed,
+        final_score: (!returns.is_empty())
+            .then(|| returns.iter().sum::<f64>() / returns.len() as f64),
+        reused: None,
+    };
+    policy_store::save(dir, &source.name, &outcome.net, &info)
+        .with_context(|| format!("writing {} to {}", source.name, dir.display()))?;
+    Ok(Some(ManifestEntry::of_policy(dir, &source.name)?.0))
+}
+
+/// Removes the policies in `dir` that `plans` does not name.
+fn remove_unplanned(dir: &Path, plans: &[SourcePlan]) -> Result<()> {
+    for stale in policy_files(dir)?
+        .iter()
+        .filter(|name| !plans.iter().any(|p| &p.name == *name))
+    {
+        let (weights, metadata) = policy_store::paths(dir, stale);
+        for path in [metadata, weights] {
+            match std::fs::remove_file(&path) {
+                Err(err) if err.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(err)
+                        .with_context(|| format!("removing the old policy {}", path.display()));
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The run that trains `source`, the `i`-th of the plan: DQN from scratch on its source
+/// task, with the sources' DQN settings.
+fn source_spec(config: &Config, i: usize, source: &SourcePlan) -> RunSpec {
+    RunSpec::scratch(
+        i as u32,
+        &source.name,
+        tasks(config)[source.task].env.clone(),
+        config.sources.dqn.as_ref().unwrap_or(&config.dqn).clone(),
+        source.hidden.clone(),
+        config.sources.training_episodes,
+        config.protocol.test_episodes,
+        source.seed,
+    )
+}
+
+/// The policies already in `dir` that a (resumed) training of `training` keeps: those of
+/// an unfinished training of the same config that still match their hashes, or, in a
+/// folder without a manifest (an older sapnet, or a kill before the first policy), those
+/// whose own metadata match the plan. Refuses to mix anything else in unless `retrain`.
+fn resumable(
+    dir: &Path,
+    training: &LibraryTraining,
+    plans: &[SourcePlan],
+    retrain: bool,
+) -> Result<Vec<ManifestEntry>> {
+    match manifest::read(dir)? {
+        Some(found) if &found.training == training => {
+            if found.complete && !retrain {
+                bail!(
+                    "{} already holds the {} policies this config describes; pass --retrain to \
+                     train them again",
+                    dir.display(),
+                    found.policies.len()
+                );
+            }
+            if found.complete {
+                return Ok(Vec::new());
+            }
+            Ok(found
+                .policies
+                .into_iter()
+                .filter(|e| ManifestEntry::of_policy(dir, &e.name).is_ok_and(|(now, _)| &now == e))
+                .collect())
+        }
+        Some(found) => {
+            if !retrain {
+                bail!(
+                    "{} holds a {} library trained with other settings ({}); pass --retrain to \
+                     replace it",
+                    dir.display(),
+                    if found.complete {
+                        "finished"
+                    } else {
+                        "partly trained"
+                    },
+                    found.training.all_differences(training).join("; ")
+                );
+            }
+            Ok(Vec::new())
+        }
+        None => {
+            let on_disk = policy_files(dir)?;
+            if retrain || on_disk.is_empty() {
+                return Ok(Vec::new());
+            }
+            let adopted: Vec<ManifestEntry> = plans
+                .iter()
+                .filter(|p| on_disk.contains(&p.name))
+                .filter_map(|p| {
+                    let (entry, metadata) = ManifestEntry::of_policy(dir, &p.name).ok()?;
+                    let planned = entry.seed == p.seed
+                        && entry.hidden == p.hidden
+                        && metadata.source_task == training.tasks[p.task].env
+                        && metadata.training.episodes == u64::from(training.training_episodes);
+                    planned.then_some(entry)
+                })
+                .collect();
+            let foreign: Vec<&String> = on_disk
+                .iter()
+                .filter(|name| !adopted.iter().any(|e| &e.name == *name))
+                .collect();
+            if !foreign.is_empty() {
+                bail!(
+                    "{} holds policies without a manifest that this config does not describe \
+                     ({}); pass --retrain to replace them",
+                    dir.display(),
+                    foreign
+                        .iter()
+                        .map(|n| n.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+            }
+            Ok(adopted)
+        }
+    }
+}
+
+/// Removes the hidden `*.tmp` files an interrupted save leaves behind.
+fn remove_temporaries(dir: &Path) -> Result<()> {
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let path = entry?.path();
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name.starts_with('.') && name.ends_with(".tmp") && path.is_file() {
+            std::fs::remove_file(&path)
+                .with_context(|| format!("removing the leftover {}", path.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// Progress of one source's training, and its outcome.
+struct SourceTraining<'a> {
+    progress: &'a mut crate::headless::Progress,
+    outcome: Option<RunOutcome>,
+}
+
+impl Observer for SourceTraining<'_> {
+    fn on_event(&mut self, event: Event) -> Result<()> {
+        match event {
+            Event::RunStarted {
+                method,
+                planned_episodes,
+                ..
+            } => self
+                .progress
+                .run_started(method.label(), 0, u64::from(planned_episodes)),
+            Event::EpisodeEnded(record) => self.progress.episode(&record),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn on_finished(&mut self, _order: usize, _spec: &RunSpec, outcome: RunOutcome) -> Result<()> {
+        self.progress.run_finished(outcome.record.method.label(), 0);
+        self.outcome = Some(outcome);
+        Ok(())
+    }
+
+    fn on_failed(&mut self, _spec: &RunSpec, err: TrainerError) -> anyhow::Error {
+        anyhow::Error::new(err)
+    }
+}
