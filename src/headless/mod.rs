@@ -33,6 +33,8 @@
 
 mod assemble;
 pub mod comparison;
+mod observer;
+mod output;
 mod plots;
 mod progress;
 mod records;
@@ -47,41 +49,18 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 
 use crate::config::{Config, MethodKind};
-use crate::experiment::{self, policy_info, LibraryCopies, Observer};
-use crate::policy_store::{self, PolicyInfo, TrainingBudget};
-use crate::trainer::{Command, Divergence, Event, MethodId, RunOutcome, RunSpec, TrainerError};
+use crate::experiment::{self, LibraryCopies};
+use crate::trainer::{Command, MethodId};
 
 use assemble::{assemble, Ending};
+use observer::ResultFiles;
+use output::prepare_output;
 pub use plots::{write_all as write_plots, Curve, PlotData};
 pub(crate) use progress::{Progress, Unit};
 pub use records::run_name;
-use records::RunWriter;
 pub use replot::replot;
 pub use results::{LibraryEntry, RunSummary, Status, Summary};
 
-/// Entries that mark a directory as holding results already.
-const RESULT_FILES: [&str; 8] = [
-    "episodes.csv",
-    "tests.csv",
-    "activations.csv",
-    "trace.csv",
-    "comparison.csv",
-    "summary.json",
-    "policies",
-    records::RUNS,
-];
-
-/// Files a run draws, replaced with the results.
-const PLOT_FILES: [&str; 5] = [
-    "learning_curve.png",
-    "learning_curve.svg",
-    "tests.png",
-    "activations.png",
-    "selections.png",
-];
-
-/// Where `--force` moves the results it replaces until the new ones are written.
-const REPLACED: &str = ".replaced";
 /// Where results go and whether old ones may be replaced.
 #[derive(Debug, Clone)]
 pub struct OutputOptions {
@@ -265,18 +244,17 @@ fn protocol(
             plan.specs.iter().map(|s| u64::from(s.episodes)).sum(),
         ),
     };
-    let mut files = ResultFiles {
-        out: out.to_path_buf(),
-        config: config.clone(),
+    let mut files = ResultFiles::new(
+        out.to_path_buf(),
+        config.clone(),
         names,
-        progress: Progress::new(planned, unit),
-        writers: BTreeMap::new(),
+        Progress::new(planned, unit),
         summary,
         copies,
-    };
+    );
     let started = Instant::now();
     let outcome = experiment::schedule(plan.specs, options.jobs, commands, &mut files);
-    files.progress.finish(matches!(outcome, Ok(false)));
+    files.finish_progress(matches!(outcome, Ok(false)));
     let ending = match outcome {
         Ok(false) => Ending {
             status: Status::Complete,
@@ -299,248 +277,4 @@ fn protocol(
         bail!("{error}");
     }
     Ok(summary)
-}
-
-/// What the event stream writes: each run's record, progress, and `summary.json` after
-/// every run.
-struct ResultFiles {
-    out: PathBuf,
-    config: Config,
-    /// The sources' names (none without a library).
-    names: Vec<String>,
-    progress: Progress,
-    /// The record of every run in progress.
-    writers: BTreeMap<(MethodId, u32), RunWriter>,
-    /// Runs finished so far, rewritten to `summary.json` as each ends.
-    summary: Summary,
-    /// Where the chosen policies join the library, if they do.
-    copies: Option<LibraryCopies>,
-}
-
-impl ResultFiles {
-    fn writer(&mut self, method: &MethodId, run: u32) -> Result<&mut RunWriter> {
-        let key = (method.clone(), run);
-        if !self.writers.contains_key(&key) {
-            let writer = RunWriter::create(&self.out, method, run, &self.names)?;
-            self.writers.insert(key.clone(), writer);
-        }
-        Ok(self.writers.get_mut(&key).expect("inserted above"))
-    }
-}
-
-impl Observer for ResultFiles {
-    fn on_event(&mut self, event: Event) -> Result<()> {
-        match event {
-            Event::RunStarted {
-                run,
-                method,
-                planned_episodes,
-                ..
-            } => {
-                let planned = self
-                    .config
-                    .protocol
-                    .max_steps
-                    .unwrap_or(u64::from(planned_episodes));
-                self.progress.run_started(method.label(), run, planned);
-                self.writer(&method, run)?;
-            }
-            Event::Activations(snapshot) => {
-                let (method, run) = (snapshot.method.clone(), snapshot.run);
-                self.writer(&method, run)?.snapshot(snapshot);
-            }
-            Event::EpisodeEnded(record) => {
-                self.writer(&record.method, record.run)?.episode(&record)?;
-                self.progress.episode(&record);
-            }
-            Event::Trace(record) => {
-                let names = std::mem::take(&mut self.names);
-                let written = self
-                    .writer(&record.method, record.run)
-                    .and_then(|w| w.trace(&record, &names));
-                self.names = names;
-                written?;
-            }
-            // A failure is reported from the run's thread when it is joined.
-            Event::Step(_) | Event::RunEnded(_) | Event::RunFailed { .. } => {}
-        }
-        Ok(())
-    }
-
-    fn on_finished(&mut self, _order: usize, _spec: &RunSpec, outcome: RunOutcome) -> Result<()> {
-        let record = outcome.record;
-        self.progress
-            .run_finished(record.method.label(), record.run);
-        let mut library_copy = None;
-        // A run stopped before its first step trained nothing worth keeping.
-        if record.steps > 0 {
-            let name = run_name(record.method.label(), record.run);
-            let info = policy_info(&self.config, &record);
-            policy_store::save(&self.out.join("policies"), &name, &outcome.net, &info)
-                .with_context(|| format!("saving the trained {}", record.method))?;
-            // Only a finished reuse's choice, tested, is worth reusing. The results hold
-            // it already, so a library that cannot take it costs a warning, not the run.
-            if let (Some(copies), true) = (&self.copies, record.chosen.is_some() && !record.stopped)
-            {
-                match copies.add(&name, &outcome.net, &info) {
-                    Ok(path) => library_copy = Some(path),
-                    Err(err) => self.progress.warn(&format!(
-                        "the chosen policy of {} run {} could not be added to the library in \
-                         {}: {err:#}; it is in {}",
-                        record.method,
-                        record.run + 1,
-                        copies.dir.display(),
-                        self.out.join("policies").display()
-                    )),
-                }
-            }
-        }
-        let key = (record.method.clone(), record.run);
-        self.writer(&record.method, record.run)?;
-        let writer = self.writers.remove(&key).expect("created above");
-        let mut summary =
-            RunSummary::new(record, &writer.rewards, self.config.protocol.moving_average);
-        summary.library_copy = library_copy;
-        writer.finish(&self.out, &summary)?;
-
-        let runs = &mut self.summary.runs;
-        runs.push(summary);
-        runs.sort_by_key(|r| (r.record.method.index, r.record.run));
-        self.summary.unfinished.retain(|k| {
-            !runs.iter().any(|r| {
-                !r.record.stopped && r.record.run == k.run && r.record.method.label() == k.method
-            })
-        });
-        results::write_json(&self.out.join("summary.json"), &self.summary)
-    }
-
-    /// Keeps what a failed run left (its last good weights) and says what happened.
-    fn on_failed(&mut self, spec: &RunSpec, err: TrainerError) -> anyhow::Error {
-        let TrainerError::Diverged(divergence) = err else {
-            return anyhow::Error::new(err).context(format!(
-                "{} run {}",
-                spec.method,
-                spec.run + 1
-            ));
-        };
-        let Divergence {
-            method,
-            run,
-            source,
-            episodes,
-            steps,
-            last_good,
-        } = *divergence;
-        let info = PolicyInfo {
-            source_task: self.config.env.clone(),
-            training: TrainingBudget {
-                episodes: u64::from(episodes),
-                steps,
-            },
-            seed: spec.seed,
-            final_score: None,
-            reused: None,
-        };
-        let policies = self.out.join("policies");
-        let name = run_name(spec.method.label(), run);
-        let kept = match policy_store::save(&policies, &name, &last_good, &info) {
-            Ok(_) => format!(
-                "its last good weights are in {}",
-                policies.join(&name).display()
-            ),
-            Err(err) => format!("its last good weights could not be saved: {err}"),
-        };
-        anyhow::anyhow!("policy {method} (run {run}) diverged: {source}; {kept}")
-    }
-}
-
-/// Creates the output directory and refuses to mix new results with old ones. With
-/// `force`, the old results are moved into `<dir>/.replaced/` (returned), to be deleted
-/// once the new ones are written: a directory where nothing can be written loses nothing.
-fn prepare_output(output: &OutputOptions) -> Result<Option<PathBuf>> {
-    let dir = &output.dir;
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("creating the output directory {}", dir.display()))?;
-    let existing: Vec<&str> = RESULT_FILES
-        .into_iter()
-        .filter(|f| dir.join(f).exists())
-        .collect();
-    if existing.is_empty() {
-        return Ok(None);
-    }
-    if !output.force {
-        bail!(
-            "the output directory {} already holds results ({}); choose another --out, pass \
-             --force to replace them, or --resume to finish them",
-            dir.display(),
-            existing.join(", ")
-        );
-    }
-    let replaced = dir.join(REPLACED);
-    if replaced.exists() {
-        // A replacement that never finished: its results were replaced already.
-        std::fs::remove_dir_all(&replaced)
-            .with_context(|| format!("removing {}", replaced.display()))?;
-    }
-    std::fs::create_dir(&replaced).with_context(|| {
-        format!(
-            "cannot replace the results in {}: creating {}",
-            dir.display(),
-            replaced.display()
-        )
-    })?;
-    let mut moved = Vec::new();
-    for name in RESULT_FILES.iter().chain(PLOT_FILES.iter()) {
-        let (from, to) = (dir.join(name), replaced.join(name));
-        if !from.exists() {
-            continue;
-        }
-        if let Err(err) = std::fs::rename(&from, &to) {
-            // Put back what moved: the old results stay as they were.
-            for (from, to) in moved.iter().rev() {
-                let _ = std::fs::rename(to, from);
-            }
-            let _ = std::fs::remove_dir(&replaced);
-            return Err(err).with_context(|| {
-                format!(
-                    "cannot replace the results in {}: moving {} aside; nothing was changed",
-                    dir.display(),
-                    from.display()
-                )
-            });
-        }
-        moved.push((from, to));
-    }
-    Ok(Some(replaced))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn forced_results_move_aside_until_the_new_ones_are_written() {
-        let tmp = tempfile::tempdir().unwrap();
-        let dir = tmp.path().to_path_buf();
-        std::fs::write(dir.join("episodes.csv"), "old").unwrap();
-        std::fs::create_dir(dir.join("policies")).unwrap();
-        std::fs::write(dir.join("policies/p.ron"), "old").unwrap();
-        let refused = prepare_output(&OutputOptions {
-            dir: dir.clone(),
-            force: false,
-        });
-        assert!(format!("{:#}", refused.unwrap_err()).contains("--resume"));
-
-        let replaced = prepare_output(&OutputOptions {
-            dir: dir.clone(),
-            force: true,
-        })
-        .unwrap()
-        .unwrap();
-        assert!(!dir.join("episodes.csv").exists());
-        assert_eq!(
-            std::fs::read_to_string(replaced.join("policies/p.ron")).unwrap(),
-            "old"
-        );
-    }
 }

@@ -1,0 +1,193 @@
+//! What a protocol's event stream writes as it runs: each run's record, progress, and
+//! `summary.json` after every run; a reusing run's chosen policy added to the library.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+
+use super::records::{run_name, RunWriter};
+use super::results::{self, RunSummary, Summary};
+use super::Progress;
+use crate::config::Config;
+use crate::experiment::{policy_info, LibraryCopies, Observer};
+use crate::policy_store::{self, PolicyInfo, TrainingBudget};
+use crate::trainer::{Divergence, Event, MethodId, RunOutcome, RunSpec, TrainerError};
+
+/// What the event stream writes: each run's record, progress, and `summary.json` after
+/// every run.
+pub(super) struct ResultFiles {
+    out: PathBuf,
+    config: Config,
+    /// The sources' names (none without a library).
+    names: Vec<String>,
+    progress: Progress,
+    /// The record of every run in progress.
+    writers: BTreeMap<(MethodId, u32), RunWriter>,
+    /// Runs finished so far, rewritten to `summary.json` as each ends.
+    summary: Summary,
+    /// Where the chosen policies join the library, if they do.
+    copies: Option<LibraryCopies>,
+}
+
+impl ResultFiles {
+    /// Records into `out`; `summary` holds the runs finished before (a resumed protocol's).
+    pub(super) fn new(
+        out: PathBuf,
+        config: Config,
+        names: Vec<String>,
+        progress: Progress,
+        summary: Summary,
+        copies: Option<LibraryCopies>,
+    ) -> Self {
+        Self {
+            out,
+            config,
+            names,
+            progress,
+            writers: BTreeMap::new(),
+            summary,
+            copies,
+        }
+    }
+
+    /// Ends the progress display; `complete` false leaves it where it stopped.
+    pub(super) fn finish_progress(&mut self, complete: bool) {
+        self.progress.finish(complete);
+    }
+
+    fn writer(&mut self, method: &MethodId, run: u32) -> Result<&mut RunWriter> {
+        let key = (method.clone(), run);
+        if !self.writers.contains_key(&key) {
+            let writer = RunWriter::create(&self.out, method, run, &self.names)?;
+            self.writers.insert(key.clone(), writer);
+        }
+        Ok(self.writers.get_mut(&key).expect("inserted above"))
+    }
+}
+
+impl Observer for ResultFiles {
+    fn on_event(&mut self, event: Event) -> Result<()> {
+        match event {
+            Event::RunStarted {
+                run,
+                method,
+                planned_episodes,
+                ..
+            } => {
+                let planned = self
+                    .config
+                    .protocol
+                    .max_steps
+                    .unwrap_or(u64::from(planned_episodes));
+                self.progress.run_started(method.label(), run, planned);
+                self.writer(&method, run)?;
+            }
+            Event::Activations(snapshot) => {
+                let (method, run) = (snapshot.method.clone(), snapshot.run);
+                self.writer(&method, run)?.snapshot(snapshot);
+            }
+            Event::EpisodeEnded(record) => {
+                self.writer(&record.method, record.run)?.episode(&record)?;
+                self.progress.episode(&record);
+            }
+            Event::Trace(record) => {
+                let names = std::mem::take(&mut self.names);
+                let written = self
+                    .writer(&record.method, record.run)
+                    .and_then(|w| w.trace(&record, &names));
+                self.names = names;
+                written?;
+            }
+            // A failure is reported from the run's thread when it is joined.
+            Event::Step(_) | Event::RunEnded(_) | Event::RunFailed { .. } => {}
+        }
+        Ok(())
+    }
+
+    fn on_finished(&mut self, _order: usize, _spec: &RunSpec, outcome: RunOutcome) -> Result<()> {
+        let record = outcome.record;
+        self.progress
+            .run_finished(record.method.label(), record.run);
+        let mut library_copy = None;
+        // A run stopped before its first step trained nothing worth keeping.
+        if record.steps > 0 {
+            let name = run_name(record.method.label(), record.run);
+            let info = policy_info(&self.config, &record);
+            policy_store::save(&self.out.join("policies"), &name, &outcome.net, &info)
+                .with_context(|| format!("saving the trained {}", record.method))?;
+            // Only a finished reuse's choice, tested, is worth reusing. The results hold
+            // it already, so a library that cannot take it costs a warning, not the run.
+            if let (Some(copies), true) = (&self.copies, record.chosen.is_some() && !record.stopped)
+            {
+                match copies.add(&name, &outcome.net, &info) {
+                    Ok(path) => library_copy = Some(path),
+                    Err(err) => self.progress.warn(&format!(
+                        "the chosen policy of {} run {} could not be added to the library in \
+                         {}: {err:#}; it is in {}",
+                        record.method,
+                        record.run + 1,
+                        copies.dir.display(),
+                        self.out.join("policies").display()
+                    )),
+                }
+            }
+        }
+        let key = (record.method.clone(), record.run);
+        self.writer(&record.method, record.run)?;
+        let writer = self.writers.remove(&key).expect("created above");
+        let mut summary =
+            RunSummary::new(record, &writer.rewards, self.config.protocol.moving_average);
+        summary.library_copy = library_copy;
+        writer.finish(&self.out, &summary)?;
+
+        let runs = &mut self.summary.runs;
+        runs.push(summary);
+        runs.sort_by_key(|r| (r.record.method.index, r.record.run));
+        self.summary.unfinished.retain(|k| {
+            !runs.iter().any(|r| {
+                !r.record.stopped && r.record.run == k.run && r.record.method.label() == k.method
+            })
+        });
+        results::write_json(&self.out.join("summary.json"), &self.summary)
+    }
+
+    /// Keeps what a failed run left (its last good weights) and says what happened.
+    fn on_failed(&mut self, spec: &RunSpec, err: TrainerError) -> anyhow::Error {
+        let TrainerError::Diverged(divergence) = err else {
+            return anyhow::Error::new(err).context(format!(
+                "{} run {}",
+                spec.method,
+                spec.run + 1
+            ));
+        };
+        let Divergence {
+            method,
+            run,
+            source,
+            episodes,
+            steps,
+            last_good,
+        } = *divergence;
+        let info = PolicyInfo {
+            source_task: self.config.env.clone(),
+            training: TrainingBudget {
+                episodes: u64::from(episodes),
+                steps,
+            },
+            seed: spec.seed,
+            final_score: None,
+            reused: None,
+        };
+        let policies = self.out.join("policies");
+        let name = run_name(spec.method.label(), run);
+        let kept = match policy_store::save(&policies, &name, &last_good, &info) {
+            Ok(_) => format!(
+                "its last good weights are in {}",
+                policies.join(&name).display()
+            ),
+            Err(err) => format!("its last good weights could not be saved: {err}"),
+        };
+        anyhow::anyhow!("policy {method} (run {run}) diverged: {source}; {kept}")
+    }
+}
