@@ -25,6 +25,10 @@ pub struct PlanOptions {
 pub fn plan(options: &PlanOptions) -> Result<Manifest> {
     let grid = Grid::read(&options.grid)?;
     let origin = options.grid.display().to_string();
+    let grid_name = options
+        .grid
+        .file_name()
+        .map_or(origin.clone(), |n| n.to_string_lossy().into_owned());
     let base = grid.base_config(&options.grid, options.config.as_deref())?;
     let cells = grid.cells(&base, &origin)?;
     let sweep = absolute(&options.out)?;
@@ -38,8 +42,10 @@ pub fn plan(options: &PlanOptions) -> Result<Manifest> {
             let config = ron_options()
                 .to_string_pretty(&cell.config, pretty)
                 .context("a cell's config")?;
+            // The grid by its file name only: the same grid planned from another working
+            // directory gives the same cells, to the byte.
             Ok(format!(
-                "// Cell {id} of the sweep planned from {origin}: {}\n{config}\n",
+                "// Cell {id} of the sweep planned from {grid_name}: {}\n{config}\n",
                 describe(&cell.axes)
             ))
         })
