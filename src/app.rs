@@ -173,7 +173,7 @@ fn report(summary: &headless::Summary, dir: &Path) -> Result<()> {
         eprintln!(
             "{} run {}: {} episodes, best MA{} {}, greedy tests [{}]",
             run.record.method,
-            run.record.run + 1,
+            run.record.run,
             run.record.episodes,
             config.protocol.moving_average,
             run.best_moving_average

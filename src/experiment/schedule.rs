@@ -91,7 +91,7 @@ pub fn schedule(
                 anyhow::anyhow!(
                     "the trainer thread of {} run {} panicked",
                     run.spec.method,
-                    run.spec.run + 1
+                    run.spec.run
                 )
             })?;
             match outcome {

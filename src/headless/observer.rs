@@ -126,7 +126,7 @@ impl Observer for ResultFiles {
                         "the chosen policy of {} run {} could not be added to the library in \
                          {}: {err:#}; it is in {}",
                         record.method,
-                        record.run + 1,
+                        record.run,
                         copies.dir.display(),
                         self.out.join("policies").display()
                     )),
@@ -155,11 +155,7 @@ impl Observer for ResultFiles {
     /// Keeps what a failed run left (its last good weights) and says what happened.
     fn on_failed(&mut self, spec: &RunSpec, err: TrainerError) -> anyhow::Error {
         let TrainerError::Diverged(divergence) = err else {
-            return anyhow::Error::new(err).context(format!(
-                "{} run {}",
-                spec.method,
-                spec.run + 1
-            ));
+            return anyhow::Error::new(err).context(format!("{} run {}", spec.method, spec.run));
         };
         let Divergence {
             method,

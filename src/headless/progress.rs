@@ -92,7 +92,7 @@ impl Progress {
 
     /// A run of `method` started, planned to do `planned` units.
     pub fn run_started(&mut self, method: &str, run: u32, planned: u64) {
-        let label = format!("{method} run {}", run + 1);
+        let label = format!("{method} run {run}");
         let bar = match &self.multi {
             Some(multi) => {
                 let bar = multi.add(ProgressBar::new(planned));
@@ -158,7 +158,7 @@ impl Progress {
                     "{} run {}: {} {}/{}, return {:.0}, MA{WINDOW} {average:.1} · protocol \
                      {}/{} {} ({:.1}%){}",
                     record.method,
-                    record.run + 1,
+                    record.run,
                     singular(self.unit),
                     run.done,
                     run.planned,
