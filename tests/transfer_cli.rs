@@ -108,6 +108,17 @@ fn a_missing_library_is_trained_then_every_result_is_written() {
         .iter()
         .filter(|r| r.contains(",dqn[8],"))
         .all(|r| r.split(',').nth(8) == Some("")));
+    // SAP-Net's rows after the warm-up name the source that acted most, as tests.csv
+    // names the chosen one.
+    let policies: Vec<&str> = rows
+        .iter()
+        .filter(|r| r.contains(",sapnet,"))
+        .filter_map(|r| r.split(',').nth(8))
+        .collect();
+    assert!(policies
+        .iter()
+        .all(|p| p.is_empty() || p.starts_with("source-")));
+    assert!(policies.iter().any(|p| p.starts_with("source-")));
 
     let tests = std::fs::read_to_string(out.join("tests.csv")).unwrap();
     assert_eq!(tests.lines().next(), Some("run,method,test,return,policy"));

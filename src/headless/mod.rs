@@ -6,8 +6,8 @@
 //! ([`records`]); the files below are put together from those records in a fixed order
 //! when the protocol ends, is stopped, or is found killed ([`assemble`]):
 //! - `episodes.csv`: one row per training episode (`run, method, episode, reward, steps,
-//!   loss, statistic_loss, epsilon, policy, wall_s`; `policy` is the source that acted
-//!   most in the episode, for methods that reuse the library);
+//!   loss, statistic_loss, epsilon, policy, wall_s`; `policy` names the source that
+//!   acted most in the episode, for methods that reuse the library);
 //! - `tests.csv`: the greedy test returns of each run (`run, method, test, return, policy`);
 //! - `activations.csv`: per episode of every run that reuses the library, each source's
 //!   score (SAP-Net: its activation), probability of being picked and steps acted;

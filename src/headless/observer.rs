@@ -92,12 +92,7 @@ impl Observer for ResultFiles {
                 self.progress.episode(&record);
             }
             Event::Trace(record) => {
-                let names = std::mem::take(&mut self.names);
-                let written = self
-                    .writer(&record.method, record.run)
-                    .and_then(|w| w.trace(&record, &names));
-                self.names = names;
-                written?;
+                self.writer(&record.method, record.run)?.trace(&record)?;
             }
             // A failure is reported from the run's thread when it is joined.
             Event::Step(_) | Event::RunEnded(_) | Event::RunFailed { .. } => {}

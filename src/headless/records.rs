@@ -51,6 +51,8 @@ pub struct RunWriter {
     episodes: results::EpisodeWriter,
     activations: Option<results::ActivationsWriter>,
     trace: Option<results::TraceWriter>,
+    /// The library's sources, by which episodes and traces name policies.
+    names: Vec<String>,
     /// Training returns so far, for the run's moving averages.
     pub rewards: Vec<f64>,
     /// The latest selector snapshot, and the selections counted before this episode.
@@ -82,6 +84,7 @@ impl RunWriter {
             episodes: results::EpisodeWriter::create(&partial.join("episodes.csv"))?,
             activations,
             trace: None,
+            names: names.to_vec(),
             rewards: Vec::new(),
             snapshot: None,
             partial,
@@ -100,7 +103,7 @@ impl RunWriter {
     /// An episode's row, and for a reusing run its row of `activations.csv` from the
     /// snapshot the trainer sends right before `EpisodeEnded`.
     pub fn episode(&mut self, record: &EpisodeRecord) -> Result<()> {
-        self.episodes.write(record)?;
+        self.episodes.write(record, &self.names)?;
         self.rewards.push(record.reward);
         if let (Some(writer), Some((snapshot, counted))) =
             (&mut self.activations, &mut self.snapshot)
@@ -128,11 +131,11 @@ impl RunWriter {
     }
 
     /// One positive activation's spread calls.
-    pub fn trace(&mut self, record: &TraceRecord, names: &[String]) -> Result<()> {
+    pub fn trace(&mut self, record: &TraceRecord) -> Result<()> {
         if self.trace.is_none() {
             self.trace = Some(results::TraceWriter::create(
                 &self.partial.join("trace.csv"),
-                names,
+                &self.names,
             )?);
         }
         match &mut self.trace {

@@ -39,12 +39,44 @@ impl EpisodeWriter {
         })
     }
 
-    pub fn write(&mut self, record: &EpisodeRecord) -> Result<()> {
+    /// Writes `record`, its `policy` by name among the sources `names` (as tests.csv
+    /// names the chosen one).
+    pub fn write(&mut self, record: &EpisodeRecord, names: &[String]) -> Result<()> {
+        let row = EpisodeRow {
+            run: record.run,
+            method: record.method.label(),
+            episode: record.episode,
+            reward: record.reward,
+            steps: record.steps,
+            loss: record.loss,
+            statistic_loss: record.statistic_loss,
+            epsilon: record.epsilon,
+            policy: record
+                .policy
+                .and_then(|i| names.get(i as usize))
+                .map(String::as_str),
+            wall_s: record.wall_s,
+        };
         self.csv
-            .serialize(record)
+            .serialize(row)
             .and_then(|()| Ok(self.csv.flush()?))
             .with_context(|| format!("writing {}", self.path))
     }
+}
+
+/// A row of `episodes.csv`, in [`EPISODES_HEADER`]'s order.
+#[derive(Serialize)]
+struct EpisodeRow<'a> {
+    run: u32,
+    method: &'a str,
+    episode: u32,
+    reward: f64,
+    steps: u32,
+    loss: Option<f64>,
+    statistic_loss: f64,
+    epsilon: f64,
+    policy: Option<&'a str>,
+    wall_s: f64,
 }
 
 /// `tests.csv`: the greedy test returns of every run, one row per test episode.
