@@ -258,3 +258,18 @@ fn v_shows_each_score_less_the_highest() {
     d.on_key(key('v'));
     assert!(!format!("{}", draw_dashboard(&d, (120, 40)).backend()).contains("A−max"));
 }
+
+#[test]
+fn teach_help_lists_the_teach_keys_only() {
+    let lesson = TeachConfig::load(None).unwrap();
+    let teach = Teach::new(lesson.names, lesson.net);
+    let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
+    terminal
+        .draw(|f| view::draw_teach(f, &teach, true, Theme::plain()))
+        .unwrap();
+    let text = format!("{}", terminal.backend());
+    assert!(text.contains("activate the picked policy"), "{text}");
+    assert!(text.contains("run the spreading to its end"), "{text}");
+    assert!(!text.contains("pause / resume training"), "{text}");
+    insta::assert_snapshot!("teach_help_120x40", terminal.backend());
+}

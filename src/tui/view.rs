@@ -33,7 +33,7 @@ pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
     }
     draw_status(frame, status, dashboard, theme);
     if dashboard.help {
-        draw_help(frame, area, theme);
+        draw_help(frame, area, HELP, theme);
     }
 }
 
@@ -52,9 +52,21 @@ pub fn draw_teach(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {
     ]);
     frame.render_widget(Paragraph::new(line), status);
     if help {
-        draw_help(frame, area, theme);
+        draw_help(frame, area, TEACH_HELP, theme);
     }
 }
+
+/// Teach mode's own keys, for its `?`.
+const TEACH_HELP: &[(&str, &str)] = &[
+    ("↑↓←→ hjkl", "pick a policy"),
+    ("a", "activate the picked policy (A += 𝒜, eq. 8)"),
+    ("s", "make the next spread call (eq. 9–11)"),
+    ("r", "run the spreading to its end (s, u, c stop it)"),
+    ("u", "undo the last call, then the activation"),
+    ("c", "back to the starting activations"),
+    ("?", "this help (any key closes it)"),
+    ("q / Esc / Ctrl-C", "quit"),
+];
 
 const TEACH_HINTS: &str =
     "↑↓ pick · a activate · s step · r run · u undo · c reset · ? help · q quit";
@@ -571,16 +583,16 @@ const HELP: &[(&str, &str)] = &[
     ("q / Esc / Ctrl-C", "quit"),
 ];
 
-fn draw_help(frame: &mut Frame, area: Rect, theme: Theme) {
+fn draw_help(frame: &mut Frame, area: Rect, keys: &[(&str, &str)], theme: Theme) {
     let width = 76.min(area.width);
-    let height = (HELP.len() as u16 + 4).min(area.height);
+    let height = (keys.len() as u16 + 4).min(area.height);
     let [row] = Layout::vertical([Constraint::Length(height)])
         .flex(ratatui::layout::Flex::Center)
         .areas(area);
     let [popup] = Layout::horizontal([Constraint::Length(width)])
         .flex(ratatui::layout::Flex::Center)
         .areas(row);
-    let lines: Vec<Line> = HELP
+    let lines: Vec<Line> = keys
         .iter()
         .map(|(key, what)| {
             Line::from(vec![
