@@ -273,3 +273,25 @@ fn teach_help_lists_the_teach_keys_only() {
     assert!(!text.contains("pause / resume training"), "{text}");
     insta::assert_snapshot!("teach_help_120x40", terminal.backend());
 }
+
+#[test]
+fn p_numbers_the_policies_as_the_paper_does_and_says_so() {
+    let lesson = TeachConfig::load(None).unwrap();
+    let mut teach = Teach::new(lesson.names, lesson.net);
+    let draw = |teach: &Teach| {
+        let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
+        terminal
+            .draw(|f| view::draw_teach(f, teach, false, Theme::plain()))
+            .unwrap();
+        format!("{}", terminal.backend())
+    };
+    let zero = draw(&teach);
+    assert!(zero.contains("π0… (p)") && zero.contains("π0 ") && !zero.contains("π4"));
+    assert!(sapnet::tui::dashboard::apply_teach_key(
+        &mut teach,
+        key('p')
+    ));
+    let paper = draw(&teach);
+    assert!(paper.contains("π1… (p)"), "{paper}");
+    assert!(paper.contains("π4") && !paper.contains("π0 "), "{paper}");
+}

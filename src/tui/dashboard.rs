@@ -585,6 +585,9 @@ pub fn apply_teach_key(teach: &mut Teach, key: KeyEvent) -> bool {
         KeyCode::Char('r') => teach.run(),
         KeyCode::Char('u') => teach.undo(),
         KeyCode::Char('c') => teach.reset(),
+        KeyCode::Char('p') => {
+            teach.toggle_numbering();
+        }
         _ => return false,
     }
     true

@@ -16,6 +16,10 @@ pub const CALLS_PER_FRAME: usize = 50_000;
 #[derive(Debug, Clone)]
 pub struct Teach {
     names: Vec<String>,
+    /// The names as the paper numbers policies, π1…πN, where the given ones are π0…πN−1.
+    paper_names: Option<Vec<String>>,
+    /// Show `paper_names` (`p`).
+    paper_numbering: bool,
     net: SapNet,
     /// The activations before the first activation of this lesson (`c` goes back to them).
     initial: Vec<f64>,
@@ -58,7 +62,14 @@ pub struct WalkView<'a> {
 impl Teach {
     pub fn new(names: Vec<String>, net: SapNet) -> Self {
         let initial = net.activations().to_vec();
+        let zero_based = names
+            .iter()
+            .enumerate()
+            .all(|(i, name)| *name == format!("π{i}"));
+        let paper_names = zero_based.then(|| (1..=names.len()).map(|i| format!("π{i}")).collect());
         Self {
+            paper_names,
+            paper_numbering: false,
             names,
             net,
             initial,
@@ -79,8 +90,33 @@ impl Teach {
         self.groups.as_deref()
     }
 
+    /// The policies' names as shown: π0… as the lesson gives them, or π1… (`p`).
     pub fn names(&self) -> &[String] {
-        &self.names
+        match (&self.paper_names, self.paper_numbering) {
+            (Some(paper), true) => paper,
+            _ => &self.names,
+        }
+    }
+
+    /// `p`: the paper's numbering π1…πN, or back to π0…; `false` when the lesson names
+    /// its policies itself.
+    pub fn toggle_numbering(&mut self) -> bool {
+        if self.paper_names.is_some() {
+            self.paper_numbering = !self.paper_numbering;
+        }
+        self.paper_names.is_some()
+    }
+
+    /// Which numbering is on screen, for the status bar: `π0…` or `π1…` (none for names
+    /// the lesson gives).
+    pub fn numbering(&self) -> Option<&'static str> {
+        self.paper_names.as_ref().map(|_| {
+            if self.paper_numbering {
+                "π1…"
+            } else {
+                "π0…"
+            }
+        })
     }
 
     /// The net with the activations as they stand after the calls made so far.

@@ -45,11 +45,21 @@ pub fn draw_teach(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {
     }
     let [main, status] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
     draw_teach_body(frame, main, teach, theme);
-    let line = Line::from(vec![
+    let mut spans = vec![
         Span::styled(" teach ", theme.title().add_modifier(Modifier::REVERSED)),
         Span::raw(" "),
-        Span::styled(TEACH_HINTS, theme.dim()),
-    ]);
+    ];
+    if let Some(numbering) = teach.numbering() {
+        spans.push(Span::raw(format!("{numbering} (p) · ")));
+    }
+    // Narrow terminals drop the keys' words, not the keys.
+    let hints = if area.width >= 100 {
+        TEACH_HINTS
+    } else {
+        TEACH_HINTS_SHORT
+    };
+    spans.push(Span::styled(hints, theme.dim()));
+    let line = Line::from(spans);
     frame.render_widget(Paragraph::new(line), status);
     if help {
         draw_help(frame, area, TEACH_HELP, theme);
@@ -64,12 +74,14 @@ const TEACH_HELP: &[(&str, &str)] = &[
     ("r", "run the spreading to its end (s, u, c stop it)"),
     ("u", "undo the last call, then the activation"),
     ("c", "back to the starting activations"),
+    ("p", "number the policies π1…πN as the paper does, or π0…"),
     ("?", "this help (any key closes it)"),
     ("q / Esc / Ctrl-C", "quit"),
 ];
 
 const TEACH_HINTS: &str =
     "↑↓ pick · a activate · s step · r run · u undo · c reset · ? help · q quit";
+const TEACH_HINTS_SHORT: &str = "↑↓ a s r u c · ? help · q quit";
 
 fn too_small(frame: &mut Frame, area: Rect) -> bool {
     if area.width >= MIN_WIDTH && area.height >= MIN_HEIGHT {
