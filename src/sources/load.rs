@@ -197,6 +197,16 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
     Ok(sources)
 }
 
+/// Whether the library of `config` under `library` is missing or its training unfinished
+/// (a library without a manifest but with policies is not: loading it says what to do).
+pub fn needs_training(config: &Config, library: &Path) -> Result<bool> {
+    let dir = library_dir(library, config);
+    Ok(match manifest::read(&dir)? {
+        Some(found) => !found.complete,
+        None => policy_files(&dir)?.is_empty(),
+    })
+}
+
 /// The library of `config`, trained first (or its training finished) if `root` allows it
 /// and `<library>/<task>/` holds none or an unfinished one, with progress on stderr
 /// (`stop` ends it), then loaded.
@@ -206,11 +216,7 @@ pub fn ensure_library(
     stop: &Receiver<Command>,
 ) -> Result<Vec<SourcePolicy>> {
     let dir = library_dir(&root.path, config);
-    let unfinished = match manifest::read(&dir)? {
-        Some(found) => !found.complete,
-        None => policy_files(&dir)?.is_empty(),
-    };
-    if unfinished {
+    if needs_training(config, &root.path)? {
         let state = if dir.exists() {
             "an unfinished source library"
         } else {

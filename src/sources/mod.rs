@@ -23,7 +23,7 @@ mod load;
 pub mod manifest;
 mod train;
 
-pub use load::{ensure_library, evaluate, load_library, Evaluation, LibraryRoot};
+pub use load::{ensure_library, evaluate, load_library, needs_training, Evaluation, LibraryRoot};
 pub use manifest::{LibraryTraining, Manifest, ManifestEntry};
 pub use train::train_library;
 

@@ -117,17 +117,18 @@ fn attempt(
         trace: false,
         copy_chosen: false,
     };
-    let summary = headless::run(&config, &output, &options, stop).map_err(|err| {
-        if err.to_string().contains("source library") {
-            err.context(format!(
-                "cell {}: `sapnet sweep prepare {}` trains the library once, before the cells",
-                cell_name(id),
-                sweep.display()
-            ))
-        } else {
-            err.context(format!("cell {}", cell_name(id)))
-        }
-    })?;
+    let reuses = config.protocol.methods.iter().any(|m| m.kind().reuses());
+    if reuses && sources::needs_training(&config, &manifest.library)? {
+        bail!(
+            "cell {}: the source library {} is missing or unfinished; `sapnet sweep prepare \
+             {}` trains it once, before the cells",
+            cell_name(id),
+            sources::library_dir(&manifest.library, &config).display(),
+            sweep.display()
+        );
+    }
+    let summary = headless::run(&config, &output, &options, stop)
+        .with_context(|| format!("cell {}", cell_name(id)))?;
     if summary.stopped() {
         return Ok(CellRun::Stopped);
     }
