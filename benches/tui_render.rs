@@ -14,7 +14,7 @@ use sapnet::teach::config::TeachConfig;
 use sapnet::tui::dashboard::Dashboard;
 use sapnet::tui::teach::Teach;
 use sapnet::tui::theme::Theme;
-use sapnet::tui::view;
+use sapnet::tui::{teach_view, view};
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
@@ -47,7 +47,7 @@ fn render(c: &mut Criterion) {
     group.bench_function("teach 200x60, Fig. 2 after 10 calls", |b| {
         b.iter(|| {
             terminal
-                .draw(|f| view::draw_teach(f, &teach, false, theme))
+                .draw(|f| teach_view::draw(f, &teach, false, theme))
                 .expect("draw");
         })
     });

@@ -12,7 +12,7 @@ use sapnet::teach::config::TeachConfig;
 use sapnet::tui::dashboard::Dashboard;
 use sapnet::tui::teach::Teach;
 use sapnet::tui::theme::Theme;
-use sapnet::tui::view;
+use sapnet::tui::{teach_view, view};
 
 const SIZES: [(u16, u16); 2] = [(120, 40), (80, 24)];
 
@@ -149,7 +149,7 @@ fn teach_fig2_mid_walk() {
     for (w, h) in SIZES {
         let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
         terminal
-            .draw(|f| view::draw_teach(f, &teach, false, Theme::plain()))
+            .draw(|f| teach_view::draw(f, &teach, false, Theme::plain()))
             .unwrap();
         insta::assert_snapshot!(format!("teach_fig2_{w}x{h}"), terminal.backend());
     }
@@ -265,7 +265,7 @@ fn teach_help_lists_the_teach_keys_only() {
     let teach = Teach::new(lesson.names, lesson.net);
     let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
     terminal
-        .draw(|f| view::draw_teach(f, &teach, true, Theme::plain()))
+        .draw(|f| teach_view::draw(f, &teach, true, Theme::plain()))
         .unwrap();
     let text = format!("{}", terminal.backend());
     assert!(text.contains("activate the picked policy"), "{text}");
@@ -281,7 +281,7 @@ fn p_numbers_the_policies_as_the_paper_does_and_says_so() {
     let draw = |teach: &Teach| {
         let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
         terminal
-            .draw(|f| view::draw_teach(f, teach, false, Theme::plain()))
+            .draw(|f| teach_view::draw(f, teach, false, Theme::plain()))
             .unwrap();
         format!("{}", terminal.backend())
     };
@@ -294,4 +294,38 @@ fn p_numbers_the_policies_as_the_paper_does_and_says_so() {
     let paper = draw(&teach);
     assert!(paper.contains("π1… (p)"), "{paper}");
     assert!(paper.contains("π4") && !paper.contains("π0 "), "{paper}");
+}
+
+/// A teacher lowers T_ω in the middle of π1's walk: the walk restarts from the same
+/// activations, fewer calls reach as far, and the screen says by how much.
+#[test]
+fn teach_edits_restart_the_walk_and_show_the_difference() {
+    let lesson = TeachConfig::load(None).unwrap();
+    let mut teach = Teach::new(lesson.names, lesson.net);
+    let press = |teach: &mut Teach, c: char| {
+        assert!(
+            sapnet::tui::dashboard::apply_teach_key(teach, key(c)),
+            "{c}"
+        );
+    };
+    press(&mut teach, 'j');
+    press(&mut teach, 'a');
+    for _ in 0..4 {
+        press(&mut teach, 's');
+    }
+    press(&mut teach, '1');
+    press(&mut teach, '-');
+    press(&mut teach, '-');
+    let report = teach.last_edit().expect("an edit");
+    assert_eq!((report.from.as_str(), report.to.as_str()), ("0.9", "0.8"));
+    assert_eq!(teach.net().params().threshold, 0.8);
+    assert!(report.calls.1 < report.calls.0, "{:?}", report.calls);
+    assert_eq!(teach.walk().unwrap().trace.len(), 0, "restarted");
+    for (w, h) in SIZES {
+        let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
+        terminal
+            .draw(|f| teach_view::draw(f, &teach, false, Theme::plain()))
+            .unwrap();
+        insta::assert_snapshot!(format!("teach_edit_{w}x{h}"), terminal.backend());
+    }
 }

@@ -95,10 +95,16 @@ fn a_user_pauses_steps_teaches_and_quits() {
     session.keys("t");
     session.wait_for(&["TEACH", "pending spread calls", "the call"]);
     session.keys("a");
-    session.wait_for(&["next: spread("]);
+    session.wait_for(&["next (Alg. 2): spread("]);
     session.keys("s");
-    let screen = session.wait_for(&["calls: 1 made"]);
+    let screen = session.wait_for(&["calls 1 made"]);
     assert!(screen.contains("Ω < T_ω"), "{screen}");
+    // A teacher lowers T_ω below the library's same-category weight (0.95): the walk
+    // restarts and no longer reaches any neighbour.
+    session.keys("1");
+    session.keys("-");
+    let screen = session.wait_for(&["T_ω 1 → 0.9", "restarted", "calls 0 made"]);
+    assert!(screen.contains("SAP-Net · T_ω 0.9"), "{screen}");
     session.keys("q");
     let screen = session.wait_for(&["SAPNET-EXITED 0"]);
     assert!(

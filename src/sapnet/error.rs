@@ -23,6 +23,8 @@ pub enum SapNetError {
     },
     #[error("edge ({i}, {j}) names a policy that does not exist: there are {n} policies, numbered from 0")]
     EdgeOutOfRange { i: usize, j: usize, n: usize },
+    #[error("policies {i} and {j} are not joined: there is no edge to change")]
+    NoEdge { i: usize, j: usize },
     #[error("edge ({i}, {i}) joins a policy to itself")]
     SelfLoop { i: usize },
     #[error("edge ({i}, {j}) is listed twice")]

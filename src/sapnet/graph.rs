@@ -149,6 +149,28 @@ impl Graph {
         })
     }
 
+    /// The same graph with the edge (i, j) at `weight`, for a front end that edits M live.
+    ///
+    /// # Errors
+    /// If i and j are not joined, or `weight` is not a finite number > 0.
+    pub fn with_weight(&self, i: usize, j: usize, weight: f64) -> Result<Self, SapNetError> {
+        let n = self.len();
+        if i >= n || j >= n {
+            return Err(SapNetError::EdgeOutOfRange { i, j, n });
+        }
+        if self.weight(i, j).is_none() {
+            return Err(SapNetError::NoEdge { i, j });
+        }
+        let edges = self.edges().map(|(a, b, w)| {
+            if (a, b) == (i.min(j), i.max(j)) {
+                (a, b, weight)
+            } else {
+                (a, b, w)
+            }
+        });
+        Self::from_edges(self.len(), edges)
+    }
+
     /// The dense N×N matrix M of eq. 4, row-major, 0 where there is no edge.
     pub fn matrix(&self) -> Vec<f64> {
         let n = self.len();

@@ -27,7 +27,9 @@ pub use error::SapNetError;
 pub use graph::Graph;
 pub use judgment::judge;
 pub use policy::PolicyDescription;
-pub use spreading::{Call, NoTrace, SpreadState, Spreader, Spreading, TraceSink, TraceStep};
+pub use spreading::{
+    Call, CallCount, NoTrace, SpreadState, Spreader, Spreading, TraceSink, TraceStep,
+};
 
 /// Most depositing `spread` calls one activation may make. Positive weights make every
 /// walk end (eq. 10), but a light graph under a high threshold can still take longer than

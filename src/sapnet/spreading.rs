@@ -73,6 +73,17 @@ impl TraceSink for NoTrace {
     fn record(&mut self, _: TraceStep) {}
 }
 
+/// Counts the calls, stopped ones too (as a teach-mode trace lists them).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct CallCount(pub usize);
+
+impl TraceSink for CallCount {
+    #[inline(always)]
+    fn record(&mut self, _: TraceStep) {
+        self.0 += 1;
+    }
+}
+
 impl TraceSink for Vec<TraceStep> {
     fn record(&mut self, step: TraceStep) {
         self.push(step);

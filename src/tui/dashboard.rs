@@ -15,6 +15,7 @@ use crate::config::MethodKind;
 use crate::sapnet::{PolicyDescription, Prototype, SapNet};
 use crate::trainer::{ActivationSnapshot, Command, Event, MethodId, RunRecord, LOCK_IN};
 
+use super::knobs::Knob;
 use super::teach::Teach;
 
 /// Points kept per curve; beyond it every other point is dropped and the stride doubles.
@@ -569,9 +570,16 @@ impl Dashboard {
     }
 }
 
-/// Applies a teach-mode key (arrows, `a`, `s`, `r`, `u`, `c`); `false` if it is not one.
+/// Applies a teach-mode key (arrows, `a`, `s`, `r`, `u`, `c`, `p`, and the edits `1`…`5`,
+/// `+`, `−`, `e`); `false` if it is not one.
 pub fn apply_teach_key(teach: &mut Teach, key: KeyEvent) -> bool {
     match key.code {
+        KeyCode::Char(c) if Knob::from_key(c).is_some() => {
+            teach.choose_knob(Knob::from_key(c).expect("checked"));
+        }
+        KeyCode::Char('+') | KeyCode::Char('=') => teach.edit(true),
+        KeyCode::Char('-') => teach.edit(false),
+        KeyCode::Char('e') => teach.next_edge(),
         KeyCode::Up | KeyCode::Char('k') | KeyCode::Left | KeyCode::Char('h') => {
             teach.move_cursor(-1)
         }

@@ -7,11 +7,14 @@
 //!
 //! - [`dashboard`]: what the UI keeps of the stream, and what keys do.
 //! - [`teach`]: one activation's spreading, a call at a time, with undo.
-//! - [`view`], [`graph_view`]: drawing, as pure functions of that state.
+//! - [`knobs`]: teach mode's live edits (T_ω, 𝒜, τ, paths, an edge's weight).
+//! - [`view`], [`teach_view`], [`graph_view`]: drawing, as pure functions of that state.
 
 pub mod dashboard;
 pub mod graph_view;
+pub mod knobs;
 pub mod teach;
+pub mod teach_view;
 pub mod theme;
 pub mod view;
 
@@ -183,7 +186,7 @@ pub fn run_teach(mut teach: Teach) -> Result<()> {
         // A long `r` runs in slices between frames: keys are read between them.
         teach.advance(teach::CALLS_PER_FRAME);
         terminal
-            .draw(|frame| view::draw_teach(frame, &teach, help, theme))
+            .draw(|frame| teach_view::draw(frame, &teach, help, theme))
             .context("drawing teach mode")?;
         let wait = if teach.is_running() {
             Duration::ZERO

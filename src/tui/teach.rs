@@ -7,6 +7,7 @@
 //! [`Teach::advance`], so a walk of millions of calls leaves the screen and the keys
 //! responsive.
 
+use super::knobs::{walk_end, EditReport, Knob};
 use crate::sapnet::{Call, SapNet, SpreadState, Spreader, TraceStep};
 
 /// Calls `r` makes between two frames: a few milliseconds' worth.
@@ -30,6 +31,15 @@ pub struct Teach {
     running: bool,
     /// Category of each policy, to draw related policies together.
     groups: Option<Vec<usize>>,
+    /// What `+` and `−` change (`1`…`5`).
+    knob: Knob,
+    /// Which of the picked policy's edges a weight edit changes (`e` moves it).
+    edge: usize,
+    /// The last edit and what it changed.
+    last_edit: Option<EditReport>,
+    /// Something the last key did that the screen must say: an edit refused, pending
+    /// calls made before a new activation.
+    notice: Option<String>,
 }
 
 /// One activation being stepped.
@@ -44,6 +54,8 @@ struct Walk {
     state: SpreadState,
     /// The activations after those calls (the net's, once synced).
     activations: Vec<f64>,
+    /// `activations − before`, kept with them.
+    deposited: Vec<f64>,
 }
 
 /// What a front end draws of the walk in progress.
@@ -57,6 +69,9 @@ pub struct WalkView<'a> {
     /// The walk from the activated policy to the last call's target.
     pub path: &'a [usize],
     pub done: bool,
+    /// What the walk has added to each activation so far, eq. 8's 𝒜 included: eq. 11's
+    /// sum of ΔA.
+    pub deposited: &'a [f64],
 }
 
 impl Teach {
@@ -77,6 +92,10 @@ impl Teach {
             walk: None,
             running: false,
             groups: None,
+            knob: Knob::default(),
+            edge: 0,
+            last_edit: None,
+            notice: None,
         }
     }
 
@@ -133,14 +152,112 @@ impl Teach {
         let n = self.net.len() as isize;
         if n > 0 {
             self.cursor = (self.cursor as isize + delta).rem_euclid(n) as usize;
+            self.edge = 0;
+        }
+    }
+
+    /// What `+` and `−` change.
+    pub fn knob(&self) -> Knob {
+        self.knob
+    }
+
+    /// `1`…`5`: chooses what `+` and `−` change.
+    pub fn choose_knob(&mut self, knob: Knob) {
+        self.knob = knob;
+    }
+
+    /// The edge a weight edit changes: the picked policy's `e`-th, as `(picked, other)`.
+    pub fn selected_edge(&self) -> Option<(usize, usize)> {
+        let degree = self.net.graph().degree(self.cursor);
+        (degree > 0).then(|| {
+            let (j, _) = self
+                .net
+                .graph()
+                .neighbours(self.cursor)
+                .nth(self.edge % degree)
+                .expect("within the degree");
+            (self.cursor, j)
+        })
+    }
+
+    /// `e`: selects the picked policy's next edge (and chooses the weight knob).
+    pub fn next_edge(&mut self) {
+        let degree = self.net.graph().degree(self.cursor);
+        if degree > 0 {
+            self.edge = (self.edge + 1) % degree;
+        }
+        self.knob = Knob::EdgeWeight;
+    }
+
+    /// The last edit and what it changed, until the next one.
+    pub fn last_edit(&self) -> Option<&EditReport> {
+        self.last_edit.as_ref()
+    }
+
+    /// What the last key did that needs saying, if anything.
+    pub fn notice(&self) -> Option<&str> {
+        self.notice.as_deref()
+    }
+
+    /// `+` / `−`: turns the chosen knob one step. The walk on screen restarts from the
+    /// activations it started from, and [`last_edit`](Self::last_edit) compares its end
+    /// before and after. A value the net refuses changes nothing and is said.
+    pub fn edit(&mut self, up: bool) {
+        self.running = false;
+        self.notice = None;
+        let (policy, before) = match &self.walk {
+            Some(w) => (Some(w.policy), w.before.clone()),
+            None => (None, self.net.activations().to_vec()),
+        };
+        let mut start = self.net.clone();
+        start
+            .set_activations(before.clone())
+            .expect("activations of the same graph");
+        let from = self.knob.value(&start, self.selected_edge());
+        let turned = match self.knob.turn(&start, self.selected_edge(), up) {
+            Ok(net) => net,
+            Err(refused) => {
+                self.notice = Some(format!("{} stays {from}: {refused}", self.knob.symbol()));
+                return;
+            }
+        };
+        let (old_a, old_p, old_calls) = walk_end(&start, policy, &before);
+        let (new_a, new_p, new_calls) = walk_end(&turned, policy, &before);
+        self.last_edit = Some(EditReport {
+            knob: self.knob,
+            to: self.knob.value(&turned, self.selected_edge()),
+            from,
+            policy,
+            calls: (old_calls, new_calls),
+            activations: (old_a, new_a),
+            probabilities: (old_p, new_p),
+        });
+        self.net = turned;
+        if let Some(policy) = policy {
+            self.walk = Some(self.start(policy, before));
+            self.sync();
         }
     }
 
     /// `a`: activates the policy under the cursor as after a positive transition (eq. 8),
     /// queueing the first `spread` calls. A walk still in progress is finished first, so
-    /// its deposits are not lost.
+    /// its deposits are not lost, and the screen says so.
     pub fn activate(&mut self) {
+        self.notice = None;
+        let pending = self
+            .walk
+            .as_ref()
+            .filter(|w| !w.state.is_done())
+            .map(|w| w.policy);
+        let made_before = self.walk.as_ref().map_or(0, |w| w.trace.len());
         self.run_to_end();
+        if let Some(policy) = pending {
+            let made = self.walk.as_ref().map_or(0, |w| w.trace.len()) - made_before;
+            self.notice = Some(format!(
+                "{}'s walk was not done: its {made} remaining calls were made first",
+                self.names()[policy]
+            ));
+        }
         let before = self.net.activations().to_vec();
         let walk = self.start(self.cursor, before);
         self.walk = Some(walk);
@@ -151,6 +268,7 @@ impl Teach {
     /// step.
     pub fn step(&mut self) -> Option<TraceStep> {
         self.running = false;
+        self.notice = None;
         let call = self.call();
         self.sync();
         call
@@ -192,6 +310,7 @@ impl Teach {
     /// `u`: takes back the last call (or, before any, the activation itself).
     pub fn undo(&mut self) {
         self.running = false;
+        self.notice = None;
         let Some(walk) = self.walk.take() else {
             return;
         };
@@ -214,6 +333,7 @@ impl Teach {
     /// `c`: back to the activations the lesson started with.
     pub fn reset(&mut self) {
         self.running = false;
+        self.notice = None;
         self.walk = None;
         self.set_activations(self.initial.clone());
     }
@@ -227,6 +347,7 @@ impl Teach {
             pending: walk.state.pending(),
             path: walk.state.path(),
             done: walk.state.is_done(),
+            deposited: &walk.deposited,
         })
     }
 
@@ -248,6 +369,7 @@ impl Teach {
             trace: Vec::new(),
             state,
             activations,
+            deposited: Vec::new(),
         }
     }
 
@@ -264,7 +386,13 @@ impl Teach {
 
     /// Shows the walk's activations on the net.
     fn sync(&mut self) {
-        if let Some(walk) = &self.walk {
+        if let Some(walk) = &mut self.walk {
+            walk.deposited = walk
+                .activations
+                .iter()
+                .zip(&walk.before)
+                .map(|(a, b)| a - b)
+                .collect();
             let activations = walk.activations.clone();
             self.set_activations(activations);
         }

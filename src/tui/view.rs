@@ -2,7 +2,7 @@
 //! tests draw exactly what a user sees.
 
 use ratatui::layout::{Constraint, Layout, Rect};
-use ratatui::style::{Modifier, Style};
+use ratatui::style::Modifier;
 use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{
@@ -12,9 +12,7 @@ use ratatui::Frame;
 
 use super::dashboard::{Dashboard, Focus, Mode, RunView, SapNetView, SPEEDS};
 use super::graph_view::{self, node_style, Scene};
-use super::teach::Teach;
 use super::theme::Theme;
-use crate::sapnet::TraceStep;
 
 /// The smallest terminal the layouts fit.
 pub const MIN_WIDTH: u16 = 80;
@@ -28,7 +26,7 @@ pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
     }
     let [main, status] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
     match (&dashboard.teach, dashboard.mode) {
-        (Some(teach), Mode::Teach) => draw_teach_body(frame, main, teach, theme),
+        (Some(teach), Mode::Teach) => super::teach_view::draw_body(frame, main, teach, theme),
         _ => draw_training(frame, main, dashboard, theme),
     }
     draw_status(frame, status, dashboard, theme);
@@ -37,53 +35,7 @@ pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
     }
 }
 
-/// Draws stand-alone teach mode (`sapnet teach`).
-pub fn draw_teach(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {
-    let area = frame.area();
-    if too_small(frame, area) {
-        return;
-    }
-    let [main, status] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
-    draw_teach_body(frame, main, teach, theme);
-    let mut spans = vec![
-        Span::styled(" teach ", theme.title().add_modifier(Modifier::REVERSED)),
-        Span::raw(" "),
-    ];
-    if let Some(numbering) = teach.numbering() {
-        spans.push(Span::raw(format!("{numbering} (p) · ")));
-    }
-    // Narrow terminals drop the keys' words, not the keys.
-    let hints = if area.width >= 100 {
-        TEACH_HINTS
-    } else {
-        TEACH_HINTS_SHORT
-    };
-    spans.push(Span::styled(hints, theme.dim()));
-    let line = Line::from(spans);
-    frame.render_widget(Paragraph::new(line), status);
-    if help {
-        draw_help(frame, area, TEACH_HELP, theme);
-    }
-}
-
-/// Teach mode's own keys, for its `?`.
-const TEACH_HELP: &[(&str, &str)] = &[
-    ("↑↓←→ hjkl", "pick a policy"),
-    ("a", "activate the picked policy (A += 𝒜, eq. 8)"),
-    ("s", "make the next spread call (eq. 9–11)"),
-    ("r", "run the spreading to its end (s, u, c stop it)"),
-    ("u", "undo the last call, then the activation"),
-    ("c", "back to the starting activations"),
-    ("p", "number the policies π1…πN as the paper does, or π0…"),
-    ("?", "this help (any key closes it)"),
-    ("q / Esc / Ctrl-C", "quit"),
-];
-
-const TEACH_HINTS: &str =
-    "↑↓ pick · a activate · s step · r run · u undo · c reset · ? help · q quit";
-const TEACH_HINTS_SHORT: &str = "↑↓ a s r u c · ? help · q quit";
-
-fn too_small(frame: &mut Frame, area: Rect) -> bool {
+pub(super) fn too_small(frame: &mut Frame, area: Rect) -> bool {
     if area.width >= MIN_WIDTH && area.height >= MIN_HEIGHT {
         return false;
     }
@@ -379,7 +331,7 @@ fn format_activation(a: f64) -> String {
 }
 
 /// `P` as a bar of `width` cells and its value, e.g. `██████░░░░ 0.61`.
-fn probability_bar(p: f64, width: usize) -> String {
+pub(super) fn probability_bar(p: f64, width: usize) -> String {
     let filled = ((p.clamp(0.0, 1.0) * width as f64).round() as usize).min(width);
     format!(
         "{}{} {p:.2}",
@@ -499,7 +451,10 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
     let (mode, hints) = match dashboard.mode {
         Mode::Running => ("RUNNING", "space pause · t teach · ? keys · q quit"),
         Mode::Paused => ("PAUSED", "space resume · n step · t teach · ? keys"),
-        Mode::Teach => ("TEACH", "a · s · r · u · c · t back · ? keys"),
+        Mode::Teach => (
+            "TEACH",
+            "a · s · r · u · c · 1–5 +/− edit · t back · ? keys",
+        ),
     };
     let run = dashboard.main_run();
     let finished = run.is_some_and(|r| r.ended.is_some());
@@ -591,11 +546,16 @@ const HELP: &[(&str, &str)] = &[
     ("r", "teach: run the spreading to the end"),
     ("u", "teach: undo the last call"),
     ("c", "teach: back to the starting activations"),
+    (
+        "1 … 5, + / −",
+        "teach: edit T_ω, 𝒜, τ, paths or an edge's weight M",
+    ),
+    ("e", "teach: the picked policy's next edge (for 5)"),
     ("?", "this help (any key closes it)"),
     ("q / Esc / Ctrl-C", "quit"),
 ];
 
-fn draw_help(frame: &mut Frame, area: Rect, keys: &[(&str, &str)], theme: Theme) {
+pub(super) fn draw_help(frame: &mut Frame, area: Rect, keys: &[(&str, &str)], theme: Theme) {
     let width = 76.min(area.width);
     let height = (keys.len() as u16 + 4).min(area.height);
     let [row] = Layout::vertical([Constraint::Length(height)])
@@ -622,228 +582,6 @@ fn draw_help(frame: &mut Frame, area: Rect, keys: &[(&str, &str)], theme: Theme)
         ),
         popup,
     );
-}
-
-fn draw_teach_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
-    let [left, right] =
-        Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)]).areas(area);
-    let [graph, call] = Layout::vertical([Constraint::Min(8), Constraint::Length(8)]).areas(left);
-    let n = teach.net().len() as u16;
-    let [values, stack, trace] = Layout::vertical([
-        Constraint::Length((n + 3).min(right.height / 2)),
-        Constraint::Length(7),
-        Constraint::Min(3),
-    ])
-    .areas(right);
-
-    let walk = teach.walk();
-    let next = walk.as_ref().and_then(|w| w.pending.last().copied());
-    let lit: Vec<(usize, usize)> = walk
-        .as_ref()
-        .map(|w| w.path.windows(2).map(|e| (e[0], e[1])).collect())
-        .unwrap_or_default();
-    let scene = Scene {
-        net: teach.net(),
-        names: teach.names(),
-        groups: teach.groups(),
-        group_names: &[],
-        cursor: Some(teach.cursor()),
-        active: walk.as_ref().map(|w| w.policy),
-        lit: &lit,
-        walking: next.map(|c| (c.from, c.to)),
-    };
-    let params = teach.net().params();
-    let title = format!(
-        "SAP-Net · T_ω {} · 𝒜 {} · τ {}",
-        params.threshold, params.coefficient, params.temperature
-    );
-    graph_view::draw(
-        frame,
-        graph,
-        Block::bordered().title(Span::styled(format!(" {title} "), theme.title())),
-        scene,
-        theme,
-    );
-
-    // The call about to be made, with eq. 10's test, or the last one made.
-    let names = teach.names();
-    let threshold = params.threshold;
-    let mut lines = Vec::new();
-    match (&walk, next) {
-        (None, _) => lines.push(Line::from(
-            "Pick a policy with ↑↓ and press a to activate it: A[i] += 𝒜 (eq. 8).",
-        )),
-        (Some(w), Some(call)) => {
-            lines.push(Line::from(format!(
-                "next: spread({}, h = {}, Ω = {:.4}, η = {:.6}, from {})",
-                names[call.to], call.h, call.omega, call.eta, names[call.from]
-            )));
-            let passes = call.omega < threshold;
-            lines.push(Line::from(vec![
-                Span::raw(format!("Ω < T_ω: {:.4} < {threshold} is ", call.omega)),
-                if passes {
-                    Span::styled("true", theme.active())
-                } else {
-                    Span::styled("false: the call stops (eq. 10)", theme.stopped())
-                },
-            ]));
-            if passes {
-                lines.push(Line::from(format!(
-                    "ΔA[{}] = η/(h·Ω) = {:.6}/({}·{:.4}) = {:.6}",
-                    names[call.to],
-                    call.eta,
-                    call.h,
-                    call.omega,
-                    call.eta / (call.h as f64 * call.omega)
-                )));
-                lines.push(Line::from(format!(
-                    "then η/k = {:.6}/{} to each neighbour of {}",
-                    call.eta,
-                    teach.net().graph().degree(call.to),
-                    names[call.to]
-                )));
-            }
-            lines.push(Line::styled(
-                format!(
-                    "activated {}, k = {} · calls: {} made, {} pending",
-                    names[w.policy],
-                    teach.net().graph().degree(w.policy),
-                    w.trace.len(),
-                    w.pending.len()
-                ),
-                theme.dim(),
-            ));
-        }
-        (Some(w), None) => lines.push(Line::from(format!(
-            "spreading from {} is done: {} calls. a activates again, u undoes, c resets.",
-            names[w.policy],
-            w.trace.len()
-        ))),
-    }
-    frame.render_widget(
-        Paragraph::new(lines)
-            .wrap(Wrap { trim: false })
-            .block(Block::bordered().title(Span::styled(" the call ", theme.title()))),
-        call,
-    );
-
-    // A and P of every policy.
-    let probabilities = teach.net().probabilities();
-    let top = teach
-        .net()
-        .activations()
-        .iter()
-        .copied()
-        .fold(0.0_f64, f64::max);
-    let rows = names.iter().enumerate().map(|(i, name)| {
-        let a = teach.net().activations()[i];
-        let row = Row::new(vec![
-            Cell::from(Span::styled(name.clone(), node_style(theme, a, top))),
-            Cell::from(format!("{a:.6}")),
-            Cell::from(probability_bar(probabilities[i], 10)),
-        ]);
-        if i == teach.cursor() {
-            row.style(theme.cursor())
-        } else {
-            row
-        }
-    });
-    frame.render_widget(
-        Table::new(
-            rows,
-            [
-                Constraint::Length(10),
-                Constraint::Length(12),
-                Constraint::Min(16),
-            ],
-        )
-        .header(Row::new(["policy", "A", "P(π) (eq. 6)"]).style(theme.title()))
-        .block(Block::bordered().title(Span::styled(" activations ", theme.title()))),
-        values,
-    );
-
-    // The recursion's stack: pending calls, the next on top.
-    let stack_lines: Vec<Line> = walk
-        .as_ref()
-        .map(|w| {
-            w.pending
-                .iter()
-                .rev()
-                .enumerate()
-                .map(|(k, c)| {
-                    let text = format!(
-                        "{} → {}  h {}  Ω {:.2}  η {:.4}",
-                        names[c.from], names[c.to], c.h, c.omega, c.eta
-                    );
-                    if k == 0 {
-                        Line::styled(format!("▶ {text}"), theme.active())
-                    } else {
-                        Line::from(format!("  {text}"))
-                    }
-                })
-                .collect()
-        })
-        .unwrap_or_default();
-    frame.render_widget(
-        Paragraph::new(stack_lines).block(Block::bordered().title(Span::styled(
-            " pending spread calls (next on top) ",
-            theme.title(),
-        ))),
-        stack,
-    );
-
-    // The trace: the calls made so far, the latest last.
-    let trace_steps = walk.as_ref().map_or(&[][..], |w| w.trace);
-    let visible = trace.height.saturating_sub(3) as usize;
-    let skip = trace_steps.len().saturating_sub(visible);
-    let rows = trace_steps
-        .iter()
-        .enumerate()
-        .skip(skip)
-        .map(|(k, s)| trace_row(k + 1, s, names, theme));
-    let name_width = names
-        .iter()
-        .map(|n| n.chars().count())
-        .max()
-        .unwrap_or(2)
-        .clamp(4, 9) as u16;
-    // Wide enough for the last call's number: long walks make hundreds of thousands.
-    let number_width = trace_steps.len().max(1).to_string().len().max(4) as u16;
-    frame.render_widget(
-        Table::new(
-            rows,
-            [
-                Constraint::Length(number_width),
-                Constraint::Length(name_width),
-                Constraint::Length(name_width),
-                Constraint::Length(2),
-                Constraint::Length(5),
-                Constraint::Length(7),
-                Constraint::Min(10),
-            ],
-        )
-        .header(Row::new(["#", "from", "to", "h", "Ω", "η", "ΔA"]).style(theme.title()))
-        .block(Block::bordered().title(Span::styled(" trace ", theme.title()))),
-        trace,
-    );
-}
-
-fn trace_row(k: usize, s: &TraceStep, names: &[String], theme: Theme) -> Row<'static> {
-    let delta = if s.stopped {
-        Span::styled("stopped", theme.stopped())
-    } else {
-        Span::raw(format!("{:.6}", s.delta))
-    };
-    Row::new(vec![
-        Cell::from(k.to_string()),
-        Cell::from(names[s.from].clone()),
-        Cell::from(names[s.to].clone()),
-        Cell::from(s.h.to_string()),
-        Cell::from(format!("{:.2}", s.omega)),
-        Cell::from(format!("{:.4}", s.eta)),
-        Cell::from(delta),
-    ])
-    .style(Style::new())
 }
 
 #[cfg(test)]

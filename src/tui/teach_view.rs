@@ -1,0 +1,454 @@
+//! Drawing teach mode: one activation's spreading (Algorithms 1 and 2), every quantity
+//! beside its equation, and the live edits' effect on the walk.
+
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::style::{Modifier, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Cell, Paragraph, Row, Table, Wrap};
+use ratatui::Frame;
+
+use super::graph_view::{self, node_style, Scene};
+use super::knobs::{EditReport, Knob};
+use super::teach::Teach;
+use super::theme::Theme;
+use super::view::{draw_help, probability_bar, too_small};
+use crate::sapnet::TraceStep;
+
+/// Draws stand-alone teach mode (`sapnet teach`).
+pub fn draw(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {
+    let area = frame.area();
+    if too_small(frame, area) {
+        return;
+    }
+    let [main, status] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
+    draw_body(frame, main, teach, theme);
+    let mut spans = vec![
+        Span::styled(" teach ", theme.title().add_modifier(Modifier::REVERSED)),
+        Span::raw(" "),
+    ];
+    if let Some(numbering) = teach.numbering() {
+        spans.push(Span::raw(format!("{numbering} (p) · ")));
+    }
+    // Narrow terminals drop the keys' words, not the keys.
+    let hints = if area.width >= 100 {
+        TEACH_HINTS
+    } else {
+        TEACH_HINTS_SHORT
+    };
+    spans.push(Span::styled(hints, theme.dim()));
+    let line = Line::from(spans);
+    frame.render_widget(Paragraph::new(line), status);
+    if help {
+        draw_help(frame, area, TEACH_HELP, theme);
+    }
+}
+
+/// Teach mode's own keys, for its `?`.
+const TEACH_HELP: &[(&str, &str)] = &[
+    ("↑↓←→ hjkl", "pick a policy"),
+    ("a", "activate the picked policy (A += 𝒜, eq. 8)"),
+    ("s", "make the next spread call (eq. 9–11)"),
+    ("r", "run the spreading to its end (s, u, c stop it)"),
+    ("u", "undo the last call, then the activation"),
+    ("c", "back to the starting activations"),
+    ("p", "number the policies π1…πN as the paper does, or π0…"),
+    (
+        "1 … 5",
+        "edit T_ω, 𝒜, τ, the path mode or the weight M of an edge",
+    ),
+    (
+        "+ / −",
+        "turn it a step: the walk restarts, the change is shown",
+    ),
+    ("e", "the picked policy's next edge (for 5)"),
+    ("?", "this help (any key closes it)"),
+    ("q / Esc / Ctrl-C", "quit"),
+];
+
+const TEACH_HINTS: &str =
+    "↑↓ pick · a activate · s step · r run · u undo · c reset · 1–5 +/− edit · ? help · q quit";
+const TEACH_HINTS_SHORT: &str = "↑↓ a s r u c · 1–5 +/− e · ? help · q quit";
+
+/// Teach mode's panels, in the dashboard or on their own.
+pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+    let [left, right] =
+        Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)]).areas(area);
+    // Below 100 columns the call's lines wrap: give them the rows.
+    let call_rows = if area.width < 100 { 11 } else { 9 };
+    let [graph, call] =
+        Layout::vertical([Constraint::Min(8), Constraint::Length(call_rows)]).areas(left);
+    let n = teach.net().len() as u16;
+    let short = area.height < 30;
+    let [values, stack, edits, trace] = Layout::vertical([
+        Constraint::Length((n + 3).min(right.height / 3)),
+        Constraint::Length(if short { 5 } else { 7 }),
+        Constraint::Length(if short { 5 } else { 6 }),
+        Constraint::Min(3),
+    ])
+    .areas(right);
+
+    let walk = teach.walk();
+    let next = walk.as_ref().and_then(|w| w.pending.last().copied());
+    let lit: Vec<(usize, usize)> = walk
+        .as_ref()
+        .map(|w| w.path.windows(2).map(|e| (e[0], e[1])).collect())
+        .unwrap_or_default();
+    let scene = Scene {
+        net: teach.net(),
+        names: teach.names(),
+        groups: teach.groups(),
+        group_names: &[],
+        cursor: Some(teach.cursor()),
+        active: walk.as_ref().map(|w| w.policy),
+        lit: &lit,
+        walking: next.map(|c| (c.from, c.to)),
+    };
+    let params = teach.net().params();
+    let title = format!(
+        "SAP-Net · T_ω {} · 𝒜 {} · τ {}",
+        params.threshold, params.coefficient, params.temperature
+    );
+    graph_view::draw(
+        frame,
+        graph,
+        Block::bordered().title(Span::styled(format!(" {title} "), theme.title())),
+        scene,
+        theme,
+    );
+
+    // The call about to be made, with eq. 10's test, or the last one made.
+    let names = teach.names();
+    let threshold = params.threshold;
+    let mut lines = Vec::new();
+    if let Some(made) = walk.as_ref().and_then(|w| w.trace.last()) {
+        let outcome = if made.stopped {
+            "stopped (Ω ≥ T_ω)".to_string()
+        } else {
+            format!("ΔA {:.6}", made.delta)
+        };
+        lines.push(Line::styled(
+            format!(
+                "made: spread({}, h {}, Ω {:.4}) from {}: {outcome}",
+                names[made.to], made.h, made.omega, names[made.from]
+            ),
+            theme.dim(),
+        ));
+    }
+    match (&walk, next) {
+        (None, _) => lines.push(Line::from(
+            "Pick a policy with ↑↓ and press a to activate it: A[i] += 𝒜 (eq. 8).",
+        )),
+        (Some(w), Some(call)) => {
+            lines.push(Line::from(format!(
+                "next (Alg. 2): spread({}, h {}, Ω {:.4}, η {:.6}) from {}",
+                names[call.to], call.h, call.omega, call.eta, names[call.from]
+            )));
+            let passes = call.omega < threshold;
+            lines.push(Line::from(vec![
+                Span::raw(format!(
+                    "eq. 10: Ω < T_ω: {:.4} < {threshold} is ",
+                    call.omega
+                )),
+                if passes {
+                    Span::styled("true", theme.active())
+                } else {
+                    Span::styled("false: the call stops (eq. 10)", theme.stopped())
+                },
+            ]));
+            if passes {
+                lines.push(Line::from(format!(
+                    "eq. 10: ΔA[{}] = η/(h·Ω) = {:.6}/({}·{:.4}) = {:.6}",
+                    names[call.to],
+                    call.eta,
+                    call.h,
+                    call.omega,
+                    call.eta / (call.h as f64 * call.omega)
+                )));
+                lines.push(Line::from(format!(
+                    "eq. 9: then η/k = {:.6}/{} to each neighbour of {}",
+                    call.eta,
+                    teach.net().graph().degree(call.to),
+                    names[call.to]
+                )));
+            }
+            lines.push(Line::styled(
+                format!(
+                    "eq. 8: A[{}] += {} · k = {} · calls {} made, {} pending",
+                    names[w.policy],
+                    params.coefficient,
+                    teach.net().graph().degree(w.policy),
+                    w.trace.len(),
+                    w.pending.len()
+                ),
+                theme.dim(),
+            ));
+        }
+        (Some(w), None) => lines.push(Line::from(format!(
+            "spreading from {} is done: {} calls. a activates again, u undoes, c resets.",
+            names[w.policy],
+            w.trace.len()
+        ))),
+    }
+    frame.render_widget(
+        Paragraph::new(lines)
+            .wrap(Wrap { trim: false })
+            .block(Block::bordered().title(Span::styled(" the call ", theme.title()))),
+        call,
+    );
+
+    draw_edits(frame, edits, teach, theme);
+    draw_values(frame, values, teach, theme);
+
+    // The recursion's stack: pending calls, the next on top.
+    let stack_lines: Vec<Line> = walk
+        .as_ref()
+        .map(|w| {
+            w.pending
+                .iter()
+                .rev()
+                .enumerate()
+                .map(|(k, c)| {
+                    let text = format!(
+                        "{} → {}  h {}  Ω {:.2}  η {:.4}",
+                        names[c.from], names[c.to], c.h, c.omega, c.eta
+                    );
+                    if k == 0 {
+                        Line::styled(format!("▶ {text}"), theme.active())
+                    } else {
+                        Line::from(format!("  {text}"))
+                    }
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    frame.render_widget(
+        Paragraph::new(stack_lines).block(Block::bordered().title(Span::styled(
+            " pending spread calls (next on top) ",
+            theme.title(),
+        ))),
+        stack,
+    );
+
+    // The trace: the calls made so far, the latest last.
+    let trace_steps = walk.as_ref().map_or(&[][..], |w| w.trace);
+    let visible = trace.height.saturating_sub(3) as usize;
+    let skip = trace_steps.len().saturating_sub(visible);
+    let rows = trace_steps
+        .iter()
+        .enumerate()
+        .skip(skip)
+        .map(|(k, s)| trace_row(k + 1, s, names, theme));
+    let name_width = names
+        .iter()
+        .map(|n| n.chars().count())
+        .max()
+        .unwrap_or(2)
+        .clamp(4, 9) as u16;
+    // Wide enough for the last call's number: long walks make hundreds of thousands.
+    let number_width = trace_steps.len().max(1).to_string().len().max(4) as u16;
+    frame.render_widget(
+        Table::new(
+            rows,
+            [
+                Constraint::Length(number_width),
+                Constraint::Length(name_width),
+                Constraint::Length(name_width),
+                Constraint::Length(2),
+                Constraint::Length(5),
+                Constraint::Length(7),
+                Constraint::Min(10),
+            ],
+        )
+        .header(Row::new(["#", "from", "to", "h", "Ω", "η", "ΔA"]).style(theme.title()))
+        .block(Block::bordered().title(Span::styled(" trace ", theme.title()))),
+        trace,
+    );
+}
+
+fn trace_row(k: usize, s: &TraceStep, names: &[String], theme: Theme) -> Row<'static> {
+    let delta = if s.stopped {
+        Span::styled("stopped", theme.stopped())
+    } else {
+        Span::raw(format!("{:.6}", s.delta))
+    };
+    Row::new(vec![
+        Cell::from(k.to_string()),
+        Cell::from(names[s.from].clone()),
+        Cell::from(names[s.to].clone()),
+        Cell::from(s.h.to_string()),
+        Cell::from(format!("{:.2}", s.omega)),
+        Cell::from(format!("{:.4}", s.eta)),
+        Cell::from(delta),
+    ])
+    .style(Style::new())
+}
+
+/// A and P of every policy, with what the walk has deposited (eq. 11) and, after an edit,
+/// how the walk's end moved.
+fn draw_values(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+    let names = teach.names();
+    let net = teach.net();
+    let probabilities = net.probabilities();
+    let top = net.activations().iter().copied().fold(0.0_f64, f64::max);
+    let deposited = teach.walk().map(|w| w.deposited);
+    // The edit's columns where the panel has room; the edit panel sums them up anyway.
+    let edit = teach
+        .last_edit()
+        .filter(|_| area.width >= 60)
+        .map(|r| (r.activation_change(), r.probability_change()));
+    let rows = names.iter().enumerate().map(|(i, name)| {
+        let a = net.activations()[i];
+        let mut cells = vec![
+            Cell::from(Span::styled(name.clone(), node_style(theme, a, top))),
+            Cell::from(fit(a, VALUE_WIDTH)),
+            Cell::from(deposited.map_or(String::new(), |d| fit(d[i], VALUE_WIDTH))),
+            Cell::from(probability_bar(probabilities[i], 6)),
+        ];
+        if let Some((da, dp)) = &edit {
+            cells.push(Cell::from(signed(da[i], 4)));
+            cells.push(Cell::from(signed(dp[i], 3)));
+        }
+        let row = Row::new(cells);
+        if i == teach.cursor() {
+            row.style(theme.cursor())
+        } else {
+            row
+        }
+    });
+    let name_width = names
+        .iter()
+        .map(|n| n.chars().count())
+        .max()
+        .unwrap_or(2)
+        .clamp(6, 10) as u16;
+    let mut widths = vec![
+        Constraint::Length(name_width),
+        Constraint::Length(VALUE_WIDTH as u16),
+        Constraint::Length(VALUE_WIDTH as u16),
+        Constraint::Length(11),
+    ];
+    let mut header = vec!["policy", "A (eq. 8)", "ΣΔA eq.11", "P (eq. 6)"];
+    if edit.is_some() {
+        widths.extend([Constraint::Length(9), Constraint::Min(6)]);
+        header.extend(["edit: ΔA", "ΔP"]);
+    }
+    frame.render_widget(
+        Table::new(rows, widths)
+            .header(Row::new(header).style(theme.title()))
+            .block(Block::bordered().title(Span::styled(" activations ", theme.title()))),
+        area,
+    );
+}
+
+/// Characters of an activation in the table.
+const VALUE_WIDTH: usize = 10;
+
+/// `x` in at most `width` characters: six decimals as the hand computations have them
+/// (0.833333), fewer as the integer part grows (1639.5420), then an exponent (2.3600e5).
+fn fit(x: f64, width: usize) -> String {
+    for decimals in (1..=6).rev() {
+        let text = format!("{x:.decimals$}");
+        if text.chars().count() <= width {
+            return text;
+        }
+    }
+    format!("{x:.3e}")
+}
+
+/// `+0.8333`, `−0.0120`, ` 0` : a change, signed, 0 plain.
+fn signed(x: f64, decimals: usize) -> String {
+    if x == 0.0 {
+        "0".to_string()
+    } else {
+        format!("{x:+.decimals$}").replace('-', "−")
+    }
+}
+
+/// The knobs (`1`…`5`, the chosen one marked), and the last edit's effect or the notice.
+fn draw_edits(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+    let names = teach.names();
+    let edge = teach.selected_edge();
+    let mut knobs = Vec::new();
+    for knob in Knob::ALL {
+        let symbol = match (knob, edge) {
+            (Knob::EdgeWeight, Some((i, j))) => format!("M({},{})", names[i], names[j]),
+            _ => knob.symbol().to_string(),
+        };
+        let text = format!("{} {symbol} {}", knob.key(), knob.value(teach.net(), edge));
+        if !knobs.is_empty() {
+            knobs.push(Span::raw(" · "));
+        }
+        knobs.push(if knob == teach.knob() {
+            Span::styled(text, theme.title().add_modifier(Modifier::REVERSED))
+        } else {
+            Span::raw(text)
+        });
+    }
+    let mut lines = vec![Line::from(knobs)];
+    if let Some(notice) = teach.notice() {
+        lines.push(Line::styled(notice.to_string(), theme.stopped()));
+    } else if let Some(report) = teach.last_edit() {
+        lines.push(Line::from(edit_summary(report, names)));
+    }
+    frame.render_widget(
+        Paragraph::new(lines)
+            .wrap(Wrap { trim: false })
+            .block(Block::bordered().title(Span::styled(
+                " edit (1–5 choose, +/− turn, e edge) ",
+                theme.title(),
+            ))),
+        area,
+    );
+}
+
+/// `T_ω 1 → 0.9: π1's walk 21 → 9 calls, restarted · at its end A moved most at π0
+/// (−0.83), P(π1) 0.45 → 0.52`.
+fn edit_summary(report: &EditReport, names: &[String]) -> String {
+    let mut text = format!("{} {} → {}", report.knob.symbol(), report.from, report.to);
+    let Some(policy) = report.policy else {
+        let (i, dp) = largest(&report.probability_change());
+        if dp != 0.0 {
+            text.push_str(&format!(": P({}) moved {}", names[i], signed(dp, 3)));
+        }
+        return text;
+    };
+    text.push_str(&format!(
+        ": {}'s walk {} → {} calls, restarted",
+        names[policy], report.calls.0, report.calls.1
+    ));
+    let (i, da) = largest(&report.activation_change());
+    if da != 0.0 {
+        text.push_str(&format!(" · at its end A[{}] {}", names[i], signed(da, 4)));
+    }
+    let (j, dp) = largest(&report.probability_change());
+    if dp != 0.0 {
+        text.push_str(&format!(", P({}) {}", names[j], signed(dp, 3)));
+    }
+    text
+}
+
+/// The index and value of the change largest in size.
+fn largest(changes: &[f64]) -> (usize, f64) {
+    changes
+        .iter()
+        .copied()
+        .enumerate()
+        .fold(
+            (0, 0.0),
+            |best, (i, x)| if x.abs() > best.1.abs() { (i, x) } else { best },
+        )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fit;
+
+    #[test]
+    fn activations_fit_their_column() {
+        assert_eq!(fit(0.833_333_3, 10), "0.833333");
+        assert_eq!(fit(1639.542, 10), "1639.54200");
+        assert_eq!(fit(-1639.542, 10), "-1639.5420");
+        assert_eq!(fit(236_000.5, 10), "236000.500");
+        assert_eq!(fit(2.36e12, 10), "2.360e12");
+    }
+}
