@@ -469,6 +469,61 @@ mod tests {
         assert!(teach.walk().is_none());
     }
 
+    #[test]
+    fn activating_mid_walk_says_it_finished_the_walk_first() {
+        let mut teach = fig2();
+        teach.activate();
+        teach.step();
+        assert_eq!(teach.notice(), None);
+        teach.move_cursor(1);
+        teach.activate();
+        let notice = teach.notice().expect("a notice");
+        assert!(
+            notice.starts_with("π0's walk was not done: its "),
+            "{notice}"
+        );
+        teach.step();
+        assert_eq!(teach.notice(), None, "the next key clears it");
+    }
+
+    #[test]
+    fn an_edit_without_a_walk_compares_the_probabilities() {
+        let mut teach = fig2();
+        teach.activate();
+        teach.run_to_end();
+        teach.reset();
+        teach.move_cursor(1);
+        teach.activate();
+        teach.run_to_end();
+        let before = teach.net().activations().to_vec();
+        teach.walk = None;
+        teach.choose_knob(Knob::Temperature);
+        teach.edit(true);
+        let report = teach.last_edit().expect("a report");
+        assert_eq!((report.from.as_str(), report.to.as_str()), ("1", "2"));
+        assert_eq!(report.calls, (0, 0));
+        assert_eq!(report.activation_change(), vec![0.0; 4]);
+        // π1 holds the most activation: a hotter softmax gives it less of P.
+        assert!(report.probability_change()[1] < 0.0);
+        assert_eq!(teach.net().activations(), before.as_slice());
+    }
+
+    #[test]
+    fn a_refused_edit_changes_nothing_and_says_why() {
+        let mut teach = fig2();
+        teach.activate();
+        teach.choose_knob(Knob::Threshold);
+        for _ in 0..10 {
+            teach.edit(false);
+        }
+        assert_eq!(teach.net().params().threshold, 0.1);
+        let notice = teach.notice().expect("refused");
+        assert!(
+            notice.starts_with("T_ω stays 0.1: parameter `threshold`"),
+            "{notice}"
+        );
+    }
+
     /// The graph of issue 13: 300 policies, every pair joined with weight 0.6. One
     /// activation makes ~89,000 calls; replaying the walk at every step (as teach mode
     /// once did) froze the screen for seconds in a release build.
