@@ -98,14 +98,19 @@ fn the_warm_up_acts_in_turn_then_sap_net_selects_learns_and_activates() {
     for (t, step) in steps.iter().take(40).enumerate() {
         assert!(step.warm_up, "step {t}");
         assert_eq!(step.policy, Some(t / 10), "step {t}");
-        assert_eq!(step.loss, None);
+        assert_eq!(step.update, None);
     }
     assert!(steps.len() > 40, "20 CartPole episodes outlast the warm-up");
     for step in &steps[40..] {
         assert!(!step.warm_up);
         // One update per step (update_interval 1), judged by its T_a (eq. 7).
-        assert!(step.loss.is_some() && step.transition.is_some());
-        assert_eq!(step.judgment, Some(step.transition.unwrap() <= 0.0));
+        let update = step.update.expect("an update every step");
+        assert_eq!(step.judgment, Some(update.transition() <= 0.0));
+        // A positive judgment deposited 𝒜 = 1 on the acting policy, at least (eq. 8).
+        match step.deposit {
+            Some(deposit) => assert!(step.judgment == Some(true) && deposit.own >= 1.0),
+            None => assert_eq!(step.judgment, Some(false)),
+        }
     }
     assert_eq!(steps.last().unwrap().step, outcome.record.steps);
 

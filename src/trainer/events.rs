@@ -17,6 +17,7 @@ use std::borrow::Cow;
 use serde::{Deserialize, Serialize, Serializer};
 
 use crate::config::{Method, MethodKind};
+use crate::dqn::UpdateReport;
 use crate::sapnet::{PolicyDescription, SapNet, TraceStep};
 
 /// Which learner a run trains: its place in `protocol.methods`, its kind and its label in
@@ -178,15 +179,42 @@ pub struct StepRecord {
     pub policy: Option<usize>,
     pub action: usize,
     pub reward: f64,
-    /// The loss of the update this step made, if it made one.
-    pub loss: Option<f64>,
-    /// SAP-Net: `T_a = E_{t+1} − E_t` of that update (eq. 7).
-    pub transition: Option<f64>,
+    /// The update this step made, if it made one: its loss and the learner's statistic
+    /// loss before and after (`T_a = E_{t+1} − E_t`, eq. 7).
+    pub update: Option<UpdateReport>,
     /// The selector's judgment of the step, if it judged one (SAP-Net: positive activated
     /// the policy and spread).
     pub judgment: Option<bool>,
+    /// What a positive judgment deposited on the scores (SAP-Net: eq. 8–11).
+    pub deposit: Option<Deposit>,
     /// One of the first `N × replay_start_size` steps, acted in turn without learning.
     pub warm_up: bool,
+}
+
+/// The change of the selector's scores that a judgment made: on the judged source (eq. 8,
+/// plus whatever the walk brought back to it) and on all the others together (eq. 10–11).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Deposit {
+    pub own: f64,
+    pub others: f64,
+}
+
+impl Deposit {
+    /// The change from `before` to `after` with `source` the judged one.
+    pub fn between(before: &[f64], after: &[f64], source: usize) -> Self {
+        let mut deposit = Deposit {
+            own: 0.0,
+            others: 0.0,
+        };
+        for (i, (b, a)) in before.iter().zip(after).enumerate() {
+            if i == source {
+                deposit.own += a - b;
+            } else {
+                deposit.others += a - b;
+            }
+        }
+        deposit
+    }
 }
 
 /// The state of a run's selector at a step.

@@ -30,7 +30,7 @@ use rand::SeedableRng;
 
 use super::control::{Control, Next};
 use super::events::{
-    ActivationSnapshot, ChosenPolicy, Command, EpisodeRecord, Event, MethodId, RunRecord,
+    ActivationSnapshot, ChosenPolicy, Command, Deposit, EpisodeRecord, Event, MethodId, RunRecord,
     SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
 };
 use super::{Divergence, RunOutcome, TrainerError};
@@ -380,6 +380,7 @@ pub fn train(
 
             let mut report = None;
             let mut judgment = None;
+            let mut deposit = None;
             if !in_warm_up {
                 if let Some(i) = actor.source() {
                     tally.run[i] += 1;
@@ -419,7 +420,12 @@ pub fn train(
                 // A round without an update (update_interval > 1) has nothing to judge.
                 if let (Some(report), Some(i)) = (&report, name) {
                     selector.set_tracing(control.trace());
+                    // A live view shows what a judgment deposited: the scores around it.
+                    let before = spec.stream.steps.then(|| selector.view().scores);
                     judgment = selector.on_update(i, report);
+                    if let (Some(before), Some(true)) = (before, judgment) {
+                        deposit = Some(Deposit::between(&before, &selector.view().scores, i));
+                    }
                     send_traces(selector.as_mut(), steps);
                 }
                 selector.on_step();
@@ -437,12 +443,9 @@ pub fn train(
                     policy: actor.source(),
                     action,
                     reward: step.reward,
-                    loss: report.map(|r| r.loss),
-                    transition: match learning {
-                        Learning::ActingSource => report.map(|r| r.transition()),
-                        Learning::Learner => None,
-                    },
+                    update: report,
                     judgment,
+                    deposit,
                     warm_up: in_warm_up,
                 }));
             }

@@ -13,7 +13,9 @@ use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
 use crate::config::MethodKind;
 use crate::sapnet::{PolicyDescription, Prototype, SapNet};
-use crate::trainer::{ActivationSnapshot, Command, Event, MethodId, RunRecord, LOCK_IN};
+use crate::trainer::{
+    ActivationSnapshot, Command, Event, MethodId, RunRecord, StepRecord, LOCK_IN,
+};
 
 use super::knobs::Knob;
 use super::teach::Teach;
@@ -246,6 +248,11 @@ pub struct Dashboard {
     pub sapnet: Option<SapNetView>,
     /// Steps of the followed run (SAP-Net if any).
     pub step: u64,
+    /// The followed run's latest step, for the step line: who acted, the update, its
+    /// judgment (eq. 7) and what it deposited.
+    pub last_step: Option<StepRecord>,
+    /// The episode of the followed run in progress and its return so far.
+    pub episode_return: (u32, f64),
     /// Measured training speed, once there is enough to measure.
     pub steps_per_second: Option<f64>,
     speedometer: VecDeque<(Instant, u64)>,
@@ -268,6 +275,8 @@ impl Dashboard {
             runs: Vec::new(),
             sapnet: None,
             step: 0,
+            last_step: None,
+            episode_return: (0, 0.0),
             steps_per_second: None,
             speedometer: VecDeque::new(),
             teach: None,
@@ -283,6 +292,8 @@ impl Dashboard {
         }
         self.followed = Some(method.to_string());
         self.step = 0;
+        self.last_step = None;
+        self.episode_return = (0, 0.0);
         self.steps_per_second = None;
         self.speedometer.clear();
         self.cursor = 0;
@@ -357,6 +368,11 @@ impl Dashboard {
                     }
                 }
                 self.step = step.step;
+                if self.episode_return.0 != step.episode {
+                    self.episode_return = (step.episode, 0.0);
+                }
+                self.episode_return.1 += step.reward;
+                self.last_step = Some(step);
             }
             Event::Activations(snapshot) => self.on_snapshot(snapshot),
             Event::Trace(_) => {}

@@ -8,11 +8,13 @@
 //! - [`dashboard`]: what the UI keeps of the stream, and what keys do.
 //! - [`teach`]: one activation's spreading, a call at a time, with undo.
 //! - [`knobs`]: teach mode's live edits (T_ω, 𝒜, τ, paths, an edge's weight).
-//! - [`view`], [`teach_view`], [`graph_view`]: drawing, as pure functions of that state.
+//! - [`view`], [`step_line`], [`teach_view`], [`graph_view`]: drawing, as pure functions
+//!   of that state.
 
 pub mod dashboard;
 pub mod graph_view;
 pub mod knobs;
+pub mod step_line;
 pub mod teach;
 pub mod teach_view;
 pub mod theme;

@@ -12,6 +12,7 @@ use ratatui::Frame;
 
 use super::dashboard::{Dashboard, Focus, Mode, RunView, SapNetView, SPEEDS};
 use super::graph_view::{self, node_style, Scene};
+use super::step_line::step_line;
 use super::theme::Theme;
 
 /// The smallest terminal the layouts fit.
@@ -56,8 +57,13 @@ pub(super) fn too_small(frame: &mut Frame, area: Rect) -> bool {
 }
 
 fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Theme) {
+    let [panels, step] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
+    frame.render_widget(
+        Paragraph::new(step_line(dashboard, step.width, theme)),
+        step,
+    );
     let [top, bottom] =
-        Layout::vertical([Constraint::Percentage(55), Constraint::Percentage(45)]).areas(area);
+        Layout::vertical([Constraint::Percentage(55), Constraint::Percentage(45)]).areas(panels);
     let [graph, table] =
         Layout::horizontal([Constraint::Percentage(40), Constraint::Percentage(60)]).areas(top);
     let [rewards, loss] =
@@ -509,10 +515,32 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
             for method in other_failures {
                 spans.push(Span::styled(format!(" {method} FAILED ·"), theme.stopped()));
             }
-            spans.push(Span::raw(format!(
-                " {} · {episode} · step {} · {speed} · ε {epsilon:.2} · {throttle}",
-                dashboard.task, dashboard.step
-            )));
+            // The state first: how fast training is let run, where the run is. What does
+            // not fit before the keys is dropped from the end, never cut mid-word.
+            let room = usize::from(area.width)
+                .saturating_sub(hints.chars().count() + 1)
+                .saturating_sub(spans.iter().map(|s| s.content.chars().count()).sum());
+            let figures = [
+                throttle,
+                episode,
+                format!("step {}", thousands(dashboard.step)),
+                speed,
+                format!("ε {epsilon:.2}"),
+                dashboard.task.clone(),
+            ];
+            let mut text = String::new();
+            for figure in figures {
+                let next = if text.is_empty() {
+                    format!(" {figure}")
+                } else {
+                    format!(" · {figure}")
+                };
+                if text.chars().count() + next.chars().count() > room {
+                    break;
+                }
+                text.push_str(&next);
+            }
+            spans.push(Span::raw(text));
             Line::from(spans)
         }
     };

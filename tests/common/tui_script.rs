@@ -3,10 +3,11 @@
 //! does not depend on timing.
 
 use sapnet::config::{Config, Method};
+use sapnet::dqn::UpdateReport;
 use sapnet::sapnet::{PolicyDescription, SapNet};
 use sapnet::trainer::{
-    ActivationSnapshot, ChosenPolicy, EpisodeRecord, Event, MethodId, RunRecord, SapNetStart,
-    SourceSummary, StepRecord,
+    ActivationSnapshot, ChosenPolicy, Deposit, EpisodeRecord, Event, MethodId, RunRecord,
+    SapNetStart, SourceSummary, StepRecord,
 };
 
 /// The id of the scripted methods: `sapnet` first, then `dqn[100]`, as the embedded
@@ -104,9 +105,16 @@ pub fn episodes(episodes: u32) -> Vec<Event> {
             policy: Some(policy),
             action: 1,
             reward: 1.0,
-            loss: Some(0.05),
-            transition: Some(-0.001),
+            update: Some(UpdateReport {
+                loss: 0.05,
+                previous_statistic_loss: 0.0421,
+                statistic_loss: 0.0417,
+            }),
             judgment: Some(true),
+            deposit: Some(Deposit {
+                own: 1.0,
+                others: 0.526_315_789_473_684_2,
+            }),
             warm_up: false,
         }));
         events.push(Event::Activations(ActivationSnapshot {
