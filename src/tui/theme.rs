@@ -2,6 +2,7 @@
 //! back on symbols and bold/reverse, which read on any terminal.
 
 use ratatui::style::{Color, Modifier, Style};
+use ratatui::symbols::Marker;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Theme {
@@ -67,6 +68,21 @@ impl Theme {
             Color::Green,
         ];
         self.fg(COLORS[i % COLORS.len()])
+    }
+
+    /// How a curve is drawn, and the symbol its legend entry starts with: braille in
+    /// colour (the colours tell curves apart), else a marker of its own per curve.
+    pub fn series_marker(self, i: usize) -> (Marker, &'static str) {
+        const MARKERS: [(Marker, &str); 3] = [
+            (Marker::Dot, "• "),
+            (Marker::Block, "█ "),
+            (Marker::Bar, "▄ "),
+        ];
+        if self.color {
+            (Marker::Braille, "")
+        } else {
+            MARKERS[i % MARKERS.len()]
+        }
     }
 
     /// A node's colour by its share `level` (0 to 1) of the highest activation: cold blue

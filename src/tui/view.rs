@@ -364,8 +364,20 @@ fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], theme: Theme) {
     } else {
         (0.0, 1.0)
     };
+    // Without colour each curve has its own marker, shown before its legend name. The
+    // names are padded to one width: ratatui's legend does not clear its box, and a
+    // shorter name would leave the curves' dots showing through beside it.
+    let names: Vec<String> = runs
+        .iter()
+        .enumerate()
+        .map(|(i, run)| {
+            let (_, symbol) = theme.series_marker(i);
+            format!("{symbol}{} MA10", run.method)
+        })
+        .collect();
+    let width = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
     let mut datasets = Vec::new();
-    for (i, run) in runs.iter().enumerate() {
+    for (i, (run, name)) in runs.iter().zip(names).enumerate() {
         if i == 0 {
             datasets.push(
                 Dataset::default()
@@ -377,8 +389,8 @@ fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], theme: Theme) {
         }
         datasets.push(
             Dataset::default()
-                .name(format!("{} MA10", run.method))
-                .marker(Marker::Braille)
+                .name(format!("{name:width$}"))
+                .marker(theme.series_marker(i).0)
                 .graph_type(GraphType::Line)
                 .style(theme.series(i))
                 .data(&run.curve.average),
@@ -395,6 +407,7 @@ fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], theme: Theme) {
         title = title.replacen("episode reward", "reward", 1);
     }
     let chart = Chart::new(datasets)
+        .hidden_legend_constraints((Constraint::Ratio(1, 2), Constraint::Ratio(1, 2)))
         .block(Block::bordered().title(Span::styled(title, theme.title())))
         .x_axis(
             Axis::default()
