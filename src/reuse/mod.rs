@@ -26,6 +26,7 @@ pub mod schedule;
 pub mod scratch;
 pub mod ucb1;
 
+use std::borrow::Cow;
 use std::fmt;
 
 use rand::rngs::StdRng;
@@ -117,6 +118,12 @@ pub trait Selector: Send + fmt::Debug {
 
     /// Scores and probabilities for display.
     fn view(&self) -> SelectorView;
+
+    /// The scores of [`view`](Self::view) alone, borrowed where the selector keeps them:
+    /// what a live view compares around a judgment, every step.
+    fn scores(&self) -> Cow<'_, [f64]> {
+        Cow::Owned(self.view().scores)
+    }
 
     /// The largest probability of picking one source, where the method has probabilities:
     /// what lock-in (one source above 0.99) is measured on.

@@ -3,6 +3,8 @@
 //! paper; the knobs are variants beyond it: a temperature schedule, a judgment over
 //! episodes or over k updates, and activation decay.
 
+use std::borrow::Cow;
+
 use rand::rngs::StdRng;
 use serde::{Deserialize, Serialize};
 
@@ -231,6 +233,10 @@ impl Selector for SapNetSelector {
             positive: self.positive.clone(),
             negative: self.negative.clone(),
         }
+    }
+
+    fn scores(&self) -> Cow<'_, [f64]> {
+        Cow::Borrowed(self.net.activations())
     }
 
     fn top_probability(&self) -> Option<f64> {

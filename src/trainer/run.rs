@@ -338,6 +338,9 @@ pub fn train(
         }
     };
     let mut last_snapshot = Instant::now();
+    // The selector's scores before a judgment, kept between steps so a live run does not
+    // allocate for them.
+    let mut scores_before: Vec<f64> = Vec::new();
     // The learner whose loss an episode's record shows: the last source that acted, or the
     // method's own learner.
     let mut last_source = 0;
@@ -421,10 +424,13 @@ pub fn train(
                 if let (Some(report), Some(i)) = (&report, name) {
                     selector.set_tracing(control.trace());
                     // A live view shows what a judgment deposited: the scores around it.
-                    let before = spec.stream.steps.then(|| selector.view().scores);
+                    if spec.stream.steps {
+                        scores_before.clear();
+                        scores_before.extend_from_slice(&selector.scores());
+                    }
                     judgment = selector.on_update(i, report);
-                    if let (Some(before), Some(true)) = (before, judgment) {
-                        deposit = Some(Deposit::between(&before, &selector.view().scores, i));
+                    if spec.stream.steps && judgment == Some(true) {
+                        deposit = Some(Deposit::between(&scores_before, &selector.scores(), i));
                     }
                     send_traces(selector.as_mut(), steps);
                 }
