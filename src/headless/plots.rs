@@ -126,6 +126,39 @@ fn method_colour(curves: &[Curve], i: usize) -> RGBColor {
     }
 }
 
+/// Matplotlib's `tab10`: ten colours told apart at a glance (plotters' `Palette99` puts
+/// near-identical ones next to each other).
+const SOURCE_COLOURS: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+fn source_colour(p: usize) -> RGBColor {
+    SOURCE_COLOURS[p % SOURCE_COLOURS.len()]
+}
+
+/// Marker `shape` (any number: four shapes in turn) at `at` pixels from its anchor.
+fn marker<DB: DrawingBackend>(
+    shape: usize,
+    at: (i32, i32),
+    colour: RGBColor,
+) -> DynElement<'static, DB, (i32, i32)> {
+    match shape % 4 {
+        0 => Circle::new(at, 4, colour.filled()).into_dyn(),
+        1 => TriangleMarker::new(at, 6, colour.filled()).into_dyn(),
+        2 => Cross::new(at, 5, colour.stroke_width(2)).into_dyn(),
+        _ => Circle::new(at, 4, colour.stroke_width(2)).into_dyn(),
+    }
+}
+
 /// Element-wise mean of series of different lengths: index `i` averages the series that
 /// reach it (a stopped run is shorter).
 pub fn mean_over_runs(series: &[Vec<f64>]) -> Vec<f64> {
@@ -368,15 +401,38 @@ fn activation_lines<DB: DrawingBackend>(
         })
         .label_style((FAMILY, 15))
         .draw()?;
+    // Curves that coincide (two sources that never act keep the same activation) must
+    // still each be seen: ten colours far apart, and a marker shape of its own every tenth
+    // of the episodes, shifted per source so that the markers of equal curves sit side by
+    // side instead of on top of each other.
+    let every = (episodes / 10).max(1);
     for (p, line) in per_policy.iter().enumerate() {
-        let colour = Palette99::pick(p).to_rgba();
+        let colour = source_colour(p);
+        let shape = p / SOURCE_COLOURS.len() + p;
         chart
             .draw_series(LineSeries::new(
                 line.iter().enumerate().map(|(e, &a)| ((e + 1) as f64, a)),
                 colour.stroke_width(2),
             ))?
             .label(data.policy_names[p].clone())
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
+            .legend(move |(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new([(0, 0), (20, 0)], colour.stroke_width(2))
+                    + marker(shape, (10, 0), colour)
+            });
+        let offset = p * every / policies.max(1);
+        let points: Vec<(f64, f64)> = line
+            .iter()
+            .enumerate()
+            .skip(offset)
+            .step_by(every)
+            .map(|(e, &a)| ((e + 1) as f64, a))
+            .collect();
+        chart.draw_series(
+            points
+                .into_iter()
+                .map(|point| EmptyElement::at(point) + marker(shape, (0, 0), colour)),
+        )?;
     }
     chart
         .configure_series_labels()
@@ -445,7 +501,7 @@ fn selection_shares<DB: DrawingBackend>(
             .draw()?;
         // Stacked from the top: each area reaches the cumulative share up to its policy.
         for p in (0..policies).rev() {
-            let colour = Palette99::pick(p).to_rgba();
+            let colour = source_colour(p);
             let top: Vec<(f64, f64)> = (0..episodes)
                 .map(|e| {
                     let stacked: f64 = per_policy[..=p]
