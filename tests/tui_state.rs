@@ -6,8 +6,10 @@ use std::time::Duration;
 
 use common::tui_script;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use ratatui::layout::Rect;
 use sapnet::trainer::Command;
 use sapnet::tui::dashboard::{Action, Dashboard, Focus, Mode, CURVE_POINTS, SPEEDS};
+use sapnet::tui::{graph_view, view};
 
 fn key(c: char) -> KeyEvent {
     KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
@@ -107,6 +109,66 @@ fn arrows_and_hjkl_move_the_cursor_around_and_tab_the_focus() {
     assert_eq!(d.cursor, 1);
     d.on_key(KeyEvent::new(KeyCode::Tab, KeyModifiers::NONE));
     assert_eq!(d.focus, Focus::Graph);
+}
+
+/// In the graph an arrow goes where it points on screen: to the nearest node that way,
+/// not to the next index.
+#[test]
+fn in_the_graph_arrows_move_to_the_nearest_node_that_way() {
+    let mut d = scripted(1);
+    d.on_key(KeyEvent::new(KeyCode::Tab, KeyModifiers::NONE));
+    let view = d.sapnet.as_ref().unwrap();
+    let positions = graph_view::positions(view.policies.len(), Some(&view.categories()));
+    let start = d.cursor;
+    d.on_key(key('j'));
+    let below = d.cursor;
+    assert!(positions[below].1 < positions[start].1, "j went down");
+    d.on_key(key('k'));
+    assert!(
+        positions[d.cursor].1 > positions[below].1,
+        "k went up again"
+    );
+    // Far right, l has nowhere to go.
+    let rightmost = (0..positions.len())
+        .max_by(|&a, &b| positions[a].0.total_cmp(&positions[b].0))
+        .unwrap();
+    d.cursor = rightmost;
+    d.on_key(key('l'));
+    assert_eq!(d.cursor, rightmost);
+}
+
+#[test]
+fn z_enlarges_the_focused_panel_and_a_click_picks_a_row_or_a_node() {
+    let mut d = scripted(1);
+    let screen = Rect::new(0, 0, 120, 40);
+    let layout = view::training_layout(screen, d.zoomed());
+    // The third row of the table (below its border and header).
+    d.on_click(layout.table.x + 3, layout.table.y + 4, screen);
+    assert_eq!((d.cursor, d.focus), (2, Focus::Table));
+    // A click on a node of the graph picks it and focuses the graph.
+    let view_state = d.sapnet.as_ref().unwrap();
+    let positions =
+        graph_view::positions(view_state.policies.len(), Some(&view_state.categories()));
+    let target = 7;
+    let cell = (0..layout.graph.width)
+        .flat_map(|c| (0..layout.graph.height).map(move |r| (c, r)))
+        .map(|(c, r)| (layout.graph.x + c, layout.graph.y + r))
+        .find(|&(c, r)| {
+            graph_view::canvas_point(layout.graph, c, r)
+                .and_then(|p| graph_view::node_at(&positions, p, 0.25))
+                == Some(target)
+        })
+        .expect("a cell over the node");
+    d.on_click(cell.0, cell.1, screen);
+    assert_eq!((d.cursor, d.focus), (target, Focus::Graph));
+
+    d.on_key(key('z'));
+    assert_eq!(d.zoomed(), Some(Focus::Graph));
+    let zoomed = view::training_layout(screen, d.zoomed());
+    assert!(zoomed.table.is_empty() && zoomed.rewards.is_empty());
+    assert_eq!(zoomed.graph.width, 120, "the graph takes the screen");
+    d.on_key(key('z'));
+    assert_eq!(d.zoomed(), None);
 }
 
 #[test]

@@ -15,14 +15,22 @@ impl Session {
         static SESSIONS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
         let k = SESSIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let name = format!("sapnet-e2e-{}-{k}", std::process::id());
-        let status = Command::new("tmux")
-            .args(["new-session", "-d", "-s", &name])
-            .args(["-x", &width.to_string(), "-y", &height.to_string()])
-            .arg(command)
-            .status()
-            .expect("running tmux");
-        assert!(status.success(), "tmux new-session failed");
-        Session(name)
+        // Two tests starting the first sessions at once race to start the tmux server, and
+        // the loser's new-session fails: try again once the server is up.
+        for attempt in 1..=5 {
+            let status = Command::new("tmux")
+                .args(["new-session", "-d", "-s", &name])
+                .args(["-x", &width.to_string(), "-y", &height.to_string()])
+                .arg(command)
+                .status()
+                .expect("running tmux");
+            if status.success() {
+                return Session(name);
+            }
+            assert!(attempt < 5, "tmux new-session failed 5 times");
+            sleep(Duration::from_millis(200));
+        }
+        unreachable!("the loop returns or fails")
     }
 
     fn keys(&self, keys: &str) {

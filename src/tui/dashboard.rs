@@ -10,6 +10,7 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use ratatui::layout::{Position, Rect};
 
 use crate::config::MethodKind;
 use crate::sapnet::{PolicyDescription, Prototype, SapNet};
@@ -17,6 +18,7 @@ use crate::trainer::{
     ActivationSnapshot, Command, Event, MethodId, RunRecord, StepRecord, LOCK_IN,
 };
 
+use super::graph_view;
 use super::knobs::Knob;
 use super::teach::Teach;
 
@@ -33,6 +35,10 @@ pub const SPEEDS: [Duration; 6] = [
     Duration::from_millis(200),
     Duration::from_millis(1000),
 ];
+
+/// How far from a node (canvas units; the nodes sit on the unit circle) a click still
+/// picks it.
+const CLICK_REACH: f64 = 0.25;
 
 /// Steps a policy's edges stay highlighted after it spread activation.
 const SPREAD_GLOW_STEPS: u64 = 8;
@@ -240,6 +246,8 @@ pub struct Dashboard {
     pub help: bool,
     /// The table shows A − max(A) instead of A (`v`): readable once A saturates.
     pub relative: bool,
+    /// The focused panel fills the screen (`z`).
+    pub zoom: bool,
     /// The policy the arrows point at.
     pub cursor: usize,
     pub speed: usize,
@@ -270,6 +278,7 @@ impl Dashboard {
             focus: Focus::Table,
             help: false,
             relative: false,
+            zoom: false,
             cursor: 0,
             speed: 0,
             runs: Vec::new(),
@@ -312,6 +321,11 @@ impl Dashboard {
     /// A run of a method the dashboard no longer follows.
     fn is_stale(&self, method: &MethodId, reuses: bool) -> bool {
         reuses && self.followed.as_ref().is_some_and(|f| f != method.label())
+    }
+
+    /// The panel that fills the screen, if one is zoomed (`z`).
+    pub fn zoomed(&self) -> Option<Focus> {
+        self.zoom.then_some(self.focus)
     }
 
     /// The run the status bar follows: SAP-Net's if there is one, else the first.
@@ -518,17 +532,17 @@ impl Dashboard {
                 };
                 Action::None
             }
-            KeyCode::Up | KeyCode::Char('k') | KeyCode::Left | KeyCode::Char('h') => {
-                self.move_cursor(-1);
-                Action::None
-            }
-            KeyCode::Down | KeyCode::Char('j') | KeyCode::Right | KeyCode::Char('l') => {
-                self.move_cursor(1);
-                Action::None
-            }
+            KeyCode::Up | KeyCode::Char('k') => self.move_toward(-1, (0.0, 1.0)),
+            KeyCode::Down | KeyCode::Char('j') => self.move_toward(1, (0.0, -1.0)),
+            KeyCode::Left | KeyCode::Char('h') => self.move_toward(-1, (-1.0, 0.0)),
+            KeyCode::Right | KeyCode::Char('l') => self.move_toward(1, (1.0, 0.0)),
             KeyCode::Char('t') => self.enter_teach(),
             KeyCode::Char('v') => {
                 self.relative = !self.relative;
+                Action::None
+            }
+            KeyCode::Char('z') => {
+                self.zoom = !self.zoom;
                 Action::None
             }
             _ => Action::None,
@@ -538,6 +552,53 @@ impl Dashboard {
     fn set_speed(&mut self, speed: usize) -> Action {
         self.speed = speed;
         Action::Send(Command::Throttle(SPEEDS[speed]))
+    }
+
+    /// An arrow: in the table the previous or next row (`delta`), in the graph the
+    /// nearest node in `direction` on screen.
+    fn move_toward(&mut self, delta: isize, direction: (f64, f64)) -> Action {
+        match (&self.sapnet, self.focus) {
+            (Some(view), Focus::Graph) => {
+                let positions =
+                    graph_view::positions(view.policies.len(), Some(&view.categories()));
+                if let Some(next) = graph_view::nearest_ahead(&positions, self.cursor, direction) {
+                    self.cursor = next;
+                }
+            }
+            _ => self.move_cursor(delta),
+        }
+        Action::None
+    }
+
+    /// A left click at `(column, row)` of a screen of `area`: on a node or a table row it
+    /// picks that policy and focuses its panel.
+    pub fn on_click(&mut self, column: u16, row: u16, area: Rect) {
+        let Some(view) = &self.sapnet else {
+            return;
+        };
+        if self.mode == Mode::Teach || self.help {
+            return;
+        }
+        let layout = super::view::training_layout(area, self.zoomed());
+        let inside = |r: Rect| r.contains(Position::new(column, row));
+        if inside(layout.table) {
+            // Below the border and the header row.
+            let first = layout.table.y + 2;
+            if let Some(i) = row.checked_sub(first).map(usize::from) {
+                if i < view.policies.len() && row < layout.table.bottom() - 1 {
+                    self.cursor = i;
+                }
+            }
+            self.focus = Focus::Table;
+        } else if inside(layout.graph) {
+            let positions = graph_view::positions(view.policies.len(), Some(&view.categories()));
+            if let Some(i) = graph_view::canvas_point(layout.graph, column, row)
+                .and_then(|point| graph_view::node_at(&positions, point, CLICK_REACH))
+            {
+                self.cursor = i;
+            }
+            self.focus = Focus::Graph;
+        }
     }
 
     fn move_cursor(&mut self, delta: isize) {

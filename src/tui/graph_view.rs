@@ -15,6 +15,10 @@ use ratatui::Frame;
 use super::theme::{heat_symbol, Theme};
 use crate::sapnet::SapNet;
 
+/// The canvas's extent: the unit circle of nodes with room for their labels.
+const X_BOUNDS: [f64; 2] = [-1.35, 1.35];
+const Y_BOUNDS: [f64; 2] = [-1.3, 1.3];
+
 /// What to draw of a graph.
 #[derive(Debug, Clone, Copy)]
 pub struct Scene<'a> {
@@ -49,8 +53,8 @@ pub fn draw(frame: &mut Frame, area: Rect, block: Block, scene: Scene, theme: Th
     let cell = 2.7 / f64::from(area.width.saturating_sub(2).max(1));
     let canvas = Canvas::default()
         .block(block)
-        .x_bounds([-1.35, 1.35])
-        .y_bounds([-1.3, 1.3])
+        .x_bounds(X_BOUNDS)
+        .y_bounds(Y_BOUNDS)
         .paint(|ctx| {
             for (i, j, w) in scene.net.graph().edges() {
                 let (a, b) = (positions[i], positions[j]);
@@ -175,6 +179,56 @@ pub fn positions(n: usize, groups: Option<&[usize]>) -> Vec<(f64, f64)> {
     positions
 }
 
+/// The node a move from `from` in direction `(dx, dy)` (canvas axes, y up) lands on: of
+/// the nodes ahead, the one nearest along the direction, sideways distance counting
+/// double (as hjkl move in gitui's and k9s's panes). `None` when no node is ahead.
+pub fn nearest_ahead(positions: &[(f64, f64)], from: usize, (dx, dy): (f64, f64)) -> Option<usize> {
+    let (x0, y0) = *positions.get(from)?;
+    positions
+        .iter()
+        .enumerate()
+        .filter(|&(j, _)| j != from)
+        .filter_map(|(j, &(x, y))| {
+            let along = (x - x0) * dx + (y - y0) * dy;
+            let across = ((x - x0) * dy - (y - y0) * dx).abs();
+            (along > 1e-9).then_some((j, along + 2.0 * across))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(j, _)| j)
+}
+
+/// The node nearest to `point` (canvas units), if one lies within `reach`.
+pub fn node_at(positions: &[(f64, f64)], (x, y): (f64, f64), reach: f64) -> Option<usize> {
+    positions
+        .iter()
+        .enumerate()
+        .map(|(i, &(px, py))| (i, (px - x).hypot(py - y)))
+        .filter(|&(_, d)| d <= reach)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| i)
+}
+
+/// The canvas point under the terminal cell `(column, row)` of a graph panel drawn in
+/// `area` (its border included), as [`draw`] maps the canvas; `None` outside the canvas.
+pub fn canvas_point(area: Rect, column: u16, row: u16) -> Option<(f64, f64)> {
+    let inner = Rect::new(
+        area.x + 1,
+        area.y + 1,
+        area.width.saturating_sub(2),
+        area.height.saturating_sub(2),
+    );
+    let inside = (inner.x..inner.x + inner.width).contains(&column)
+        && (inner.y..inner.y + inner.height).contains(&row);
+    inside.then(|| {
+        let fx = (f64::from(column - inner.x) + 0.5) / f64::from(inner.width);
+        let fy = (f64::from(row - inner.y) + 0.5) / f64::from(inner.height);
+        (
+            X_BOUNDS[0] + fx * (X_BOUNDS[1] - X_BOUNDS[0]),
+            Y_BOUNDS[1] - fy * (Y_BOUNDS[1] - Y_BOUNDS[0]),
+        )
+    })
+}
+
 /// `cartpole(length=1.0)` → `length=1.0`: a source task's label without its family, for a
 /// library whose tasks are variants of one; other labels stay as they are.
 pub fn short_task(label: &str) -> &str {
@@ -212,6 +266,44 @@ mod tests {
         let step = TAU / 6.0;
         assert!((angle(p[3]) - (FRAC_PI_2 - step)).abs() < 1e-12);
         assert!((angle(p[0]) - (FRAC_PI_2 - 3.0 * step)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn moves_land_on_the_nearest_node_ahead() {
+        // Four nodes at 12, 3, 6 and 9 o'clock.
+        let p = positions(4, None);
+        assert_eq!(
+            nearest_ahead(&p, 0, (0.0, -1.0)),
+            Some(2),
+            "down from the top"
+        );
+        assert_eq!(
+            nearest_ahead(&p, 0, (1.0, 0.0)),
+            Some(1),
+            "right from the top"
+        );
+        assert_eq!(
+            nearest_ahead(&p, 1, (1.0, 0.0)),
+            None,
+            "nothing right of 3 o'clock"
+        );
+        assert_eq!(
+            nearest_ahead(&p, 3, (1.0, 0.0)),
+            Some(1),
+            "straight across, not aside"
+        );
+    }
+
+    #[test]
+    fn a_click_finds_the_node_under_it() {
+        let p = positions(4, None);
+        let area = Rect::new(0, 0, 29, 15);
+        // The top node (0, 1) sits in the middle column, a little below the top border.
+        let top = canvas_point(area, 14, 2).unwrap();
+        assert_eq!(node_at(&p, top, 0.3), Some(0));
+        assert_eq!(canvas_point(area, 0, 5), None, "the border");
+        let middle = canvas_point(area, 14, 7).unwrap();
+        assert_eq!(node_at(&p, middle, 0.3), None, "the empty middle");
     }
 
     #[test]

@@ -24,7 +24,7 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
-use crossterm::event::{self as term, KeyEventKind};
+use crossterm::event::{self as term, KeyEventKind, MouseButton, MouseEventKind};
 
 use crate::trainer::{self, Command, RunHandle, RunSpec};
 use dashboard::{apply_teach_key, Action, Dashboard};
@@ -34,24 +34,35 @@ use theme::Theme;
 /// The time between frames: about 30 per second.
 pub const FRAME: Duration = Duration::from_millis(33);
 
-/// Leaves the alternate screen and raw mode however the UI ends; ratatui's panic hook does
-/// the same for panics.
-struct TerminalGuard;
+/// Leaves the alternate screen and raw mode, and stops mouse reporting, however the UI
+/// ends; ratatui's panic hook restores the screen for panics, and the unwinding drops this.
+struct TerminalGuard {
+    mouse: bool,
+}
 
 impl Drop for TerminalGuard {
     fn drop(&mut self) {
         crate::signals::set_interactive(false);
+        if self.mouse {
+            let _ = crossterm::execute!(std::io::stdout(), crossterm::event::DisableMouseCapture);
+        }
         ratatui::restore();
     }
 }
 
-/// Raw mode and the alternate screen, with the guard that leaves them. If opening fails
-/// half-way, raw mode is undone here (nothing else was changed yet).
-fn open_terminal() -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
+/// Raw mode and the alternate screen (and mouse reporting, for the dashboard's clicks),
+/// with the guard that leaves them. If opening fails half-way, raw mode is undone here
+/// (nothing else was changed yet).
+fn open_terminal(mouse: bool) -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
     match ratatui::try_init() {
         Ok(terminal) => {
             crate::signals::set_interactive(true);
-            Ok((terminal, TerminalGuard))
+            let guard = TerminalGuard { mouse };
+            if mouse {
+                crossterm::execute!(std::io::stdout(), crossterm::event::EnableMouseCapture)
+                    .context("turning on mouse reporting")?;
+            }
+            Ok((terminal, guard))
         }
         Err(err) => {
             let _ = crossterm::terminal::disable_raw_mode();
@@ -103,7 +114,7 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
         let leads = runs.is_empty();
         runs.push(Driven { handle, leads });
     }
-    let (mut terminal, guard) = open_terminal()?;
+    let (mut terminal, guard) = open_terminal(true)?;
     let result = (|| -> Result<()> {
         loop {
             for event in events.try_iter() {
@@ -120,8 +131,16 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
             if !term::poll(FRAME).context("reading the keyboard")? {
                 continue;
             }
-            let term::Event::Key(key) = term::read().context("reading the keyboard")? else {
-                continue; // a resize redraws on the next frame
+            let key = match term::read().context("reading the keyboard")? {
+                term::Event::Key(key) => key,
+                term::Event::Mouse(mouse) => {
+                    if mouse.kind == MouseEventKind::Down(MouseButton::Left) {
+                        let size = terminal.size().context("reading the terminal's size")?;
+                        dashboard.on_click(mouse.column, mouse.row, size.into());
+                    }
+                    continue;
+                }
+                _ => continue, // a resize redraws on the next frame
             };
             if key.kind != KeyEventKind::Press {
                 continue;
@@ -179,7 +198,7 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
 /// Runs stand-alone teach mode until the user quits.
 pub fn run_teach(mut teach: Teach) -> Result<()> {
     let theme = Theme::from_env();
-    let (mut terminal, _guard) = open_terminal()?;
+    let (mut terminal, _guard) = open_terminal(false)?;
     let mut help = false;
     loop {
         if crate::signals::received().is_some() {

@@ -44,7 +44,7 @@ pub fn draw(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {
 }
 
 /// Teach mode's own keys, for its `?`.
-const TEACH_HELP: &[(&str, &str)] = &[
+pub(super) const TEACH_HELP: &[(&str, &str)] = &[
     ("↑↓←→ hjkl", "pick a policy"),
     ("a", "activate the picked policy (A += 𝒜, eq. 8)"),
     ("s", "make the next spread call (eq. 9–11)"),

@@ -28,11 +28,17 @@ pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
     let [main, status] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
     match (&dashboard.teach, dashboard.mode) {
         (Some(teach), Mode::Teach) => super::teach_view::draw_body(frame, main, teach, theme),
-        _ => draw_training(frame, main, dashboard, theme),
+        _ => draw_training(frame, dashboard, theme),
     }
     draw_status(frame, status, dashboard, theme);
     if dashboard.help {
-        draw_help(frame, area, HELP, theme);
+        if dashboard.mode == Mode::Teach {
+            let mut keys = super::teach_view::TEACH_HELP.to_vec();
+            keys.insert(keys.len() - 2, ("t / Esc", "back to the paused dashboard"));
+            draw_help(frame, area, &keys, theme);
+        } else {
+            draw_help(frame, area, HELP, theme);
+        }
     }
 }
 
@@ -56,19 +62,65 @@ pub(super) fn too_small(frame: &mut Frame, area: Rect) -> bool {
     true
 }
 
-fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Theme) {
-    let [panels, step] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
+/// Where the dashboard's panels are on a screen of `area`: drawing and mouse clicks use
+/// the same rectangles. A panel that is not shown (another is zoomed) has an empty one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct TrainingLayout {
+    pub graph: Rect,
+    pub table: Rect,
+    pub rewards: Rect,
+    pub loss: Rect,
+    pub step: Rect,
+}
+
+/// The panels of the training view on a terminal of `area` (the status bar included).
+pub fn training_layout(area: Rect, zoom: Option<Focus>) -> TrainingLayout {
+    let [main, _status] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(area);
+    let [panels, step] = Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(main);
+    match zoom {
+        Some(Focus::Graph) => TrainingLayout {
+            graph: panels,
+            step,
+            ..TrainingLayout::default()
+        },
+        Some(Focus::Table) => TrainingLayout {
+            table: panels,
+            step,
+            ..TrainingLayout::default()
+        },
+        None => {
+            let [top, bottom] =
+                Layout::vertical([Constraint::Percentage(55), Constraint::Percentage(45)])
+                    .areas(panels);
+            let [graph, table] =
+                Layout::horizontal([Constraint::Percentage(40), Constraint::Percentage(60)])
+                    .areas(top);
+            let [rewards, loss] =
+                Layout::horizontal([Constraint::Percentage(68), Constraint::Percentage(32)])
+                    .areas(bottom);
+            TrainingLayout {
+                graph,
+                table,
+                rewards,
+                loss,
+                step,
+            }
+        }
+    }
+}
+
+fn draw_training(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
+    let TrainingLayout {
+        graph,
+        table,
+        rewards,
+        loss,
+        step,
+    } = training_layout(frame.area(), dashboard.zoomed());
     frame.render_widget(
         Paragraph::new(step_line(dashboard, step.width, theme)),
         step,
     );
-    let [top, bottom] =
-        Layout::vertical([Constraint::Percentage(55), Constraint::Percentage(45)]).areas(panels);
-    let [graph, table] =
-        Layout::horizontal([Constraint::Percentage(40), Constraint::Percentage(60)]).areas(top);
-    let [rewards, loss] =
-        Layout::horizontal([Constraint::Percentage(68), Constraint::Percentage(32)]).areas(bottom);
-
     let focus_block = |title: &str, focused: bool| {
         let block = Block::bordered().title(Span::styled(format!(" {title} "), theme.title()));
         if focused {
@@ -108,35 +160,46 @@ fn draw_training(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Th
             } else {
                 format!("library graph · {} ({})", view.method, view.score_name)
             };
-            graph_view::draw(
-                frame,
-                graph,
-                focus_block(&graph_title, dashboard.focus == Focus::Graph),
-                scene,
-                theme,
-            );
-            draw_policy_table(
-                frame,
-                table,
-                focus_block(
-                    &policies_title(dashboard, table.width),
-                    dashboard.focus == Focus::Table,
-                ),
-                view,
-                dashboard.cursor,
-                dashboard.relative,
-                theme,
-            );
+            if !graph.is_empty() {
+                graph_view::draw(
+                    frame,
+                    graph,
+                    focus_block(&graph_title, dashboard.focus == Focus::Graph),
+                    scene,
+                    theme,
+                );
+            }
+            if !table.is_empty() {
+                draw_policy_table(
+                    frame,
+                    table,
+                    focus_block(
+                        &policies_title(dashboard, table.width),
+                        dashboard.focus == Focus::Table,
+                    ),
+                    view,
+                    dashboard.cursor,
+                    dashboard.relative,
+                    theme,
+                );
+            }
         }
         None => {
             let note = Paragraph::new("This config runs no SAP-Net: only its baselines train.")
                 .block(focus_block("SAP-Net graph", false))
                 .wrap(Wrap { trim: true });
+            let top = match (graph.is_empty(), table.is_empty()) {
+                (true, _) => table,
+                (_, true) => graph,
+                _ => graph.union(table),
+            };
             frame.render_widget(note, top);
         }
     }
-    draw_rewards(frame, rewards, &dashboard.runs, theme);
-    draw_loss(frame, loss, dashboard.main_run(), theme);
+    if !rewards.is_empty() {
+        draw_rewards(frame, rewards, &dashboard.runs, theme);
+        draw_loss(frame, loss, dashboard.main_run(), theme);
+    }
 }
 
 /// "policies", and once the followed run has ended, the source it chose (SAP-Net: the
@@ -576,24 +639,22 @@ const HELP: &[(&str, &str)] = &[
         "+ / -",
         "faster / slower (delays training, never the screen)",
     ),
-    ("tab", "move focus between the graph and the table"),
-    ("↑↓←→ hjkl", "pick a policy"),
+    ("tab / click", "focus the graph or the table"),
+    (
+        "↑↓←→ hjkl",
+        "pick a policy (graph: the nearest node that way)",
+    ),
+    ("click", "pick the policy of a node or a row"),
+    ("z", "enlarge the focused panel, or back"),
     ("m", "follow the next reusing method's run"),
     ("v", "scores as A − max(A), readable when A saturates"),
     ("t", "teach mode on the live graph (pauses training)"),
-    ("t / Esc", "teach: back to the paused dashboard"),
-    ("a", "teach: activate the picked policy (A += 𝒜, eq. 8)"),
-    ("s", "teach: make the next spread call (eq. 9–11)"),
-    ("r", "teach: run the spreading to the end"),
-    ("u", "teach: undo the last call"),
-    ("c", "teach: back to the starting activations"),
-    (
-        "1 … 5, + / −",
-        "teach: edit T_ω, 𝒜, τ, paths or an edge's weight M",
-    ),
-    ("e", "teach: the picked policy's next edge (for 5)"),
     ("?", "this help (any key closes it)"),
     ("q / Esc / Ctrl-C", "quit"),
+    ("", ""),
+    ("○ ◐ ●", "a node's A: < ¼, < ¾, ≥ ¾ of the highest A"),
+    ("cat", "category: number of hidden layers (the prototype)"),
+    ("+/−", "its positive / negative transitions so far (eq. 7)"),
 ];
 
 pub(super) fn draw_help(frame: &mut Frame, area: Rect, keys: &[(&str, &str)], theme: Theme) {
