@@ -329,3 +329,15 @@ fn teach_edits_restart_the_walk_and_show_the_difference() {
         insta::assert_snapshot!(format!("teach_edit_{w}x{h}"), terminal.backend());
     }
 }
+
+/// `z` gives the table the screen: wide enough for each policy's activation over the last
+/// episodes, beside the figures.
+#[test]
+fn the_zoomed_table_shows_each_policys_activation_over_time() {
+    let mut d = dashboard();
+    d.on_key(key('z'));
+    let terminal = draw_dashboard(&d, (120, 40));
+    let screen = format!("{}", terminal.backend());
+    assert!(screen.contains("A per episode"), "{screen}");
+    insta::assert_snapshot!("dashboard_zoomed_table_120x40", terminal.backend());
+}

@@ -40,6 +40,9 @@ pub const SPEEDS: [Duration; 6] = [
 /// picks it.
 const CLICK_REACH: f64 = 0.25;
 
+/// Episodes of scores kept for the table's sparklines.
+pub const HISTORY: usize = 40;
+
 /// Steps a policy's edges stay highlighted after it spread activation.
 const SPREAD_GLOW_STEPS: u64 = 8;
 
@@ -154,6 +157,9 @@ pub struct SapNetView {
     /// The policy that has held P > [`LOCK_IN`] since the step given, while it does: the
     /// softmax has collapsed onto it.
     pub locked: Option<(usize, u64)>,
+    /// The scores at the end of each of the last [`HISTORY`] episodes, oldest first: the
+    /// table's sparklines.
+    pub history: VecDeque<Vec<f64>>,
 }
 
 impl SapNetView {
@@ -368,6 +374,7 @@ impl Dashboard {
                         acting: None,
                         spread: None,
                         locked: None,
+                        history: VecDeque::new(),
                     });
                     self.runs.insert(0, run);
                 } else {
@@ -392,6 +399,16 @@ impl Dashboard {
             Event::Trace(_) => {}
             Event::EpisodeEnded(record) => {
                 let follows_steps = self.sapnet.is_some();
+                if let Some(view) = self
+                    .sapnet
+                    .as_mut()
+                    .filter(|v| v.method == record.method.label())
+                {
+                    if view.history.len() == HISTORY {
+                        view.history.pop_front();
+                    }
+                    view.history.push_back(view.net.activations().to_vec());
+                }
                 if let Some(run) = self.runs.iter_mut().find(|r| r.method == record.method) {
                     run.episode = record.episode;
                     run.epsilon = record.epsilon;

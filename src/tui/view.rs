@@ -10,7 +10,7 @@ use ratatui::widgets::{
 };
 use ratatui::Frame;
 
-use super::dashboard::{Dashboard, Focus, Mode, RunView, SapNetView, SPEEDS};
+use super::dashboard::{Dashboard, Focus, Mode, RunView, SapNetView, HISTORY, SPEEDS};
 use super::graph_view::{self, node_style, Scene};
 use super::step_line::step_line;
 use super::theme::Theme;
@@ -305,6 +305,15 @@ fn draw_policy_table(
         .iter()
         .any(|p| p.description.source_task != view.policies[0].description.source_task);
     let bar_width = 8;
+    // Each policy's score over the last episodes, on one scale for all (the highest in the
+    // window), where the panel is wide enough: zoomed (`z`) or on a wide terminal.
+    let history = area.width >= 90;
+    let history_top = view
+        .history
+        .iter()
+        .flatten()
+        .copied()
+        .fold(0.0_f64, f64::max);
     let rows = view.policies.iter().enumerate().map(|(i, p)| {
         let a = view.net.activations()[i];
         let probability = view.probabilities.get(i).copied().unwrap_or(0.0);
@@ -335,6 +344,12 @@ fn draw_policy_table(
                 count(view.negative[i])
             )));
         }
+        if history {
+            cells.push(Cell::from(sparkline(
+                view.history.iter().map(|scores| scores[i]),
+                history_top,
+            )));
+        }
         let row = Row::new(cells);
         if i == cursor {
             row.style(theme.cursor())
@@ -342,7 +357,7 @@ fn draw_policy_table(
             row
         }
     });
-    let (header, widths) = if full {
+    let (mut header, mut widths) = if full {
         (
             vec![
                 "policy",
@@ -374,10 +389,28 @@ fn draw_policy_table(
             ],
         )
     };
+    if history {
+        header.push("A per episode");
+        widths.push(Constraint::Length(HISTORY as u16));
+    }
     let table = Table::new(rows, widths)
         .header(Row::new(header).style(theme.title()))
         .block(block);
     frame.render_widget(table, area);
+}
+
+/// `values` as a sparkline of ▁…█ scaled to `top`; blank where a value is 0 or below.
+fn sparkline(values: impl Iterator<Item = f64>, top: f64) -> String {
+    const BARS: [char; 8] = ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'];
+    values
+        .map(|v| {
+            if v <= 0.0 || top <= 0.0 || !v.is_finite() {
+                ' '
+            } else {
+                BARS[((v / top * 7.0).round() as usize).min(7)]
+            }
+        })
+        .collect()
 }
 
 /// A count in at most five characters, so that a long run's tallies fit their column:
@@ -688,7 +721,13 @@ pub(super) fn draw_help(frame: &mut Frame, area: Rect, keys: &[(&str, &str)], th
 
 #[cfg(test)]
 mod tests {
-    use super::count;
+    use super::{count, sparkline};
+
+    #[test]
+    fn sparklines_share_one_scale() {
+        assert_eq!(sparkline([0.0, 1.0, 4.0, 8.0].into_iter(), 8.0), " ▂▄█");
+        assert_eq!(sparkline([3.0].into_iter(), 0.0), " ");
+    }
 
     #[test]
     fn counts_fit_five_characters() {
