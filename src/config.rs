@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::dqn::Init;
 use crate::env::{CartPoleParams, EnvConfig};
 use crate::reuse::prql::PrqlKnobs;
 use crate::reuse::sapnet::SapNetKnobs;
@@ -91,6 +92,9 @@ pub struct DqnConfig {
     /// Treat a time-limit truncation as terminal (old Gym and ChainerRL did); Gymnasium
     /// semantics (`false`) keep bootstrapping through it.
     pub truncation_as_terminal: bool,
+    /// How a new Q-network is drawn: `LecunNormal` (Chainer's, the paper's) or
+    /// `TorchDefault` (PyTorch's, Stable-Baselines3's).
+    pub init: Init,
 }
 
 impl Default for DqnConfig {
@@ -111,6 +115,7 @@ impl Default for DqnConfig {
             loss_decay: 0.99,
             exploration: Exploration::Constant { epsilon: 0.03 },
             truncation_as_terminal: false,
+            init: Init::LecunNormal,
         }
     }
 }

@@ -22,5 +22,5 @@ pub use error::DqnError;
 pub use exploration::EpsilonGreedy;
 pub use loss::{huber, td_huber_loss};
 pub use optim::Adam;
-pub use qnet::{Architecture, QNet};
+pub use qnet::{Architecture, Init, QNet};
 pub use replay::{Batch, ReplayBuffer, Transition};

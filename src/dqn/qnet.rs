@@ -75,6 +75,18 @@ impl std::fmt::Display for Architecture {
     }
 }
 
+/// How a new network's parameters are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Init {
+    /// Chainer's `L.Linear`, which ChainerRL's Q-functions (the paper's) use: weights
+    /// `N(0, 1/fan_in)`, biases 0.
+    #[default]
+    LecunNormal,
+    /// PyTorch's `nn.Linear`, which Stable-Baselines3 uses: weights and biases uniform in
+    /// `±1/√fan_in` (`kaiming_uniform_(a = √5)` for the weights).
+    TorchDefault,
+}
+
 /// An MLP Q-network on the CPU. Its parameters are candle [`Var`]s, so it can be trained
 /// and moved to another thread. Not `Clone`: a clone would share the parameters; see
 /// [`QNet::deep_copy`].
@@ -93,22 +105,39 @@ impl QNet {
     /// use) initialises one: weights `W ~ N(0, 1/fan_in)` (LeCun normal), biases 0. candle's
     /// own initialisers draw from an unseedable generator, so the draw is ours.
     pub fn new(architecture: Architecture, rng: &mut impl Rng) -> Result<Self, DqnError> {
+        Self::with_init(architecture, Init::LecunNormal, rng)
+    }
+
+    /// A freshly initialised network, drawn as `init` says, layer by layer (weight, then
+    /// bias) from `rng`.
+    pub fn with_init(
+        architecture: Architecture,
+        init: Init,
+        rng: &mut impl Rng,
+    ) -> Result<Self, DqnError> {
         architecture.validate()?;
+        let mut fan_in = 0;
         let values = architecture
             .parameter_shapes()
             .into_iter()
             .map(|(name, shape)| {
-                let values = if name.ends_with("weight") {
-                    let scale = (1.0 / shape[1] as f64).sqrt();
-                    let n = shape[0] * shape[1];
-                    (0..n)
+                let weight = name.ends_with("weight");
+                if weight {
+                    fan_in = shape[1];
+                }
+                let n: usize = shape.iter().product();
+                let scale = (1.0 / fan_in as f64).sqrt();
+                let values = match (init, weight) {
+                    (Init::LecunNormal, true) => (0..n)
                         .map(|_| {
                             let z: f64 = StandardNormal.sample(rng);
                             (scale * z) as f32
                         })
-                        .collect()
-                } else {
-                    vec![0.0; shape[0]]
+                        .collect(),
+                    (Init::LecunNormal, false) => vec![0.0; n],
+                    (Init::TorchDefault, _) => (0..n)
+                        .map(|_| (scale * rng.random_range(-1.0..1.0)) as f32)
+                        .collect(),
                 };
                 Tensor::from_vec(values, shape, &Device::Cpu)
             })
@@ -273,6 +302,29 @@ mod tests {
             assert_eq!(q.parameters().len(), 2 * (hidden.len() + 1));
         }
         assert_eq!(net(&[87, 113], 0).architecture().to_string(), "4-87-113-2");
+    }
+
+    /// PyTorch's `nn.Linear`: every weight and bias within ±1/√fan_in, spread over it
+    /// (a uniform draw has variance bound²/3).
+    #[test]
+    fn torch_default_initialisation_is_uniform_within_one_over_root_fan_in() {
+        let arch = Architecture::new(4, &[256, 256], 2);
+        let net = QNet::with_init(arch, Init::TorchDefault, &mut StdRng::seed_from_u64(3)).unwrap();
+        let fans = [4.0_f64, 4.0, 256.0, 256.0, 256.0, 256.0];
+        for (p, fan_in) in net.parameters().iter().zip(fans) {
+            let bound = 1.0 / fan_in.sqrt();
+            let values: Vec<f32> = p.as_tensor().flatten_all().unwrap().to_vec1().unwrap();
+            assert!(values.iter().all(|&v| f64::from(v).abs() <= bound));
+            if values.len() >= 256 {
+                let variance =
+                    values.iter().map(|&v| f64::from(v).powi(2)).sum::<f64>() / values.len() as f64;
+                let expected = bound * bound / 3.0;
+                assert!(
+                    (variance / expected - 1.0).abs() < 0.15,
+                    "{variance} vs {expected}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -268,7 +268,11 @@ pub fn train(
         Some(hidden) => {
             let architecture =
                 Architecture::new(env.observation_size(), hidden, env.action_count());
-            let net = QNet::new(architecture, &mut StdRng::seed_from_u64(streams.weights))?;
+            let net = QNet::with_init(
+                architecture,
+                spec.dqn.init,
+                &mut StdRng::seed_from_u64(streams.weights),
+            )?;
             Some(DqnAgent::new(net, &spec.dqn)?)
         }
         None => None,

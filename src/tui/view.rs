@@ -725,7 +725,7 @@ mod tests {
 
     #[test]
     fn sparklines_share_one_scale() {
-        assert_eq!(sparkline([0.0, 1.0, 4.0, 8.0].into_iter(), 8.0), " ▂▄█");
+        assert_eq!(sparkline([0.0, 1.0, 4.0, 8.0].into_iter(), 8.0), " ▂▅█");
         assert_eq!(sparkline([3.0].into_iter(), 0.0), " ");
     }
 
