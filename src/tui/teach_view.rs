@@ -238,12 +238,7 @@ pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         .enumerate()
         .skip(skip)
         .map(|(k, s)| trace_row(k + 1, s, names, theme));
-    let name_width = names
-        .iter()
-        .map(|n| n.chars().count())
-        .max()
-        .unwrap_or(2)
-        .clamp(4, 9) as u16;
+    let name_width = name_width(names, 4, 9);
     // Wide enough for the last call's number: long walks make hundreds of thousands.
     let number_width = trace_steps.len().max(1).to_string().len().max(4) as u16;
     frame.render_widget(
@@ -315,12 +310,7 @@ fn draw_values(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
             row
         }
     });
-    let name_width = names
-        .iter()
-        .map(|n| n.chars().count())
-        .max()
-        .unwrap_or(2)
-        .clamp(6, 10) as u16;
+    let name_width = name_width(names, 6, 10);
     let mut widths = vec![
         Constraint::Length(name_width),
         Constraint::Length(VALUE_WIDTH as u16),
@@ -338,6 +328,12 @@ fn draw_values(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
             .block(Block::bordered().title(Span::styled(" activations ", theme.title()))),
         area,
     );
+}
+
+/// A column for the longest of `names`, within `least..=most` characters.
+fn name_width(names: &[String], least: usize, most: usize) -> u16 {
+    let longest = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
+    longest.clamp(least, most) as u16
 }
 
 /// Characters of an activation in the table.
