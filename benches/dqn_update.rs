@@ -19,14 +19,13 @@ use sapnet::dqn::{Architecture, Batch, DqnAgent, QNet, Transition};
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-const BATCH: usize = 32;
 const POOL: usize = 64;
 
-fn random_batches(obs_size: usize, actions: usize, rng: &mut StdRng) -> Vec<Batch> {
+fn random_batches(obs_size: usize, actions: usize, size: usize, rng: &mut StdRng) -> Vec<Batch> {
     (0..POOL)
         .map(|_| {
             let mut batch = Batch::new();
-            for _ in 0..BATCH {
+            for _ in 0..size {
                 let obs: Vec<f32> = (0..obs_size).map(|_| rng.sample(StandardNormal)).collect();
                 let next_obs: Vec<f32> =
                     (0..obs_size).map(|_| rng.sample(StandardNormal)).collect();
@@ -52,15 +51,27 @@ fn update(c: &mut Criterion) {
     }
     let mut group = c.benchmark_group("dqn_update");
     group.measurement_time(Duration::from_secs(5));
-    for hidden in [&[100][..], &[100, 100], &[100, 100, 100]] {
+    // The paper's three shapes at ChainerRL's batch, and the zoo's CartPole network at
+    // its batch of 64 (about 34 MFLOP per update: the GFLOP/s figure of BENCHMARKS.md).
+    let cases: [(&[usize], usize); 4] = [
+        (&[100], 32),
+        (&[100, 100], 32),
+        (&[100, 100, 100], 32),
+        (&[256, 256], 64),
+    ];
+    for (hidden, size) in cases {
         let mut rng = StdRng::seed_from_u64(0);
         let architecture = Architecture::new(4, hidden, 2);
         let name = architecture.to_string();
         let net = QNet::new(architecture, &mut rng).expect("network");
-        let mut agent = DqnAgent::new(net, &DqnConfig::default()).expect("agent");
-        let batches = random_batches(4, 2, &mut rng);
+        let config = DqnConfig {
+            batch_size: size,
+            ..DqnConfig::default()
+        };
+        let mut agent = DqnAgent::new(net, &config).expect("agent");
+        let batches = random_batches(4, 2, size, &mut rng);
         let mut i = 0;
-        group.bench_function(BenchmarkId::new("batch32", name), |b| {
+        group.bench_function(BenchmarkId::new(format!("batch{size}"), name), |b| {
             b.iter(|| {
                 i = (i + 1) % POOL;
                 agent.update(&batches[i]).expect("finite loss")
