@@ -136,6 +136,8 @@ fn stepped(value: f64, step: f64) -> f64 {
 #[derive(Debug, Clone, PartialEq)]
 pub struct EditReport {
     pub knob: Knob,
+    /// The edge whose weight was edited (`EdgeWeight` only).
+    pub edge: Option<(usize, usize)>,
     pub from: String,
     pub to: String,
     /// The walk that was restarted, if one was on screen.

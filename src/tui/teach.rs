@@ -225,6 +225,9 @@ impl Teach {
         let (new_a, new_p, new_calls) = walk_end(&turned, policy, &before);
         self.last_edit = Some(EditReport {
             knob: self.knob,
+            edge: self
+                .selected_edge()
+                .filter(|_| self.knob == Knob::EdgeWeight),
             to: self.knob.value(&turned, self.selected_edge()),
             from,
             policy,
@@ -506,6 +509,20 @@ mod tests {
         // π1 holds the most activation: a hotter softmax gives it less of P.
         assert!(report.probability_change()[1] < 0.0);
         assert_eq!(teach.net().activations(), before.as_slice());
+    }
+
+    #[test]
+    fn an_edge_edit_names_its_edge_and_e_moves_to_the_next() {
+        let mut teach = fig2();
+        teach.move_cursor(1);
+        assert_eq!(teach.selected_edge(), Some((1, 0)));
+        teach.next_edge();
+        assert_eq!(teach.selected_edge(), Some((1, 2)));
+        assert_eq!(teach.knob(), Knob::EdgeWeight, "e chooses the weight");
+        teach.edit(true);
+        let report = teach.last_edit().expect("a report");
+        assert_eq!(report.edge, Some((1, 2)));
+        assert_eq!(teach.net().graph().weight(2, 1), Some(0.5));
     }
 
     #[test]

@@ -82,7 +82,7 @@ pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     let [values, stack, edits, trace] = Layout::vertical([
         Constraint::Length((n + 3).min(right.height / 3)),
         Constraint::Length(if short { 5 } else { 7 }),
-        Constraint::Length(if short { 5 } else { 6 }),
+        Constraint::Length(6),
         Constraint::Min(3),
     ])
     .areas(right);
@@ -400,7 +400,11 @@ fn draw_edits(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
 /// `T_ω 1 → 0.9: π1's walk 21 → 9 calls, restarted · at its end A moved most at π0
 /// (−0.83), P(π1) 0.45 → 0.52`.
 fn edit_summary(report: &EditReport, names: &[String]) -> String {
-    let mut text = format!("{} {} → {}", report.knob.symbol(), report.from, report.to);
+    let what = match report.edge {
+        Some((i, j)) => format!("M({},{})", names[i], names[j]),
+        None => report.knob.symbol().to_string(),
+    };
+    let mut text = format!("{what} {} → {}", report.from, report.to);
     let Some(policy) = report.policy else {
         let (i, dp) = largest(&report.probability_change());
         if dp != 0.0 {
