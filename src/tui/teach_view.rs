@@ -116,8 +116,19 @@ pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         theme,
     );
 
-    // The call about to be made, with eq. 10's test, or the last one made.
+    draw_call(frame, call, teach, theme);
+    draw_edits(frame, edits, teach, theme);
+    draw_values(frame, values, teach, theme);
+    draw_stack(frame, stack, teach, theme);
+    draw_trace(frame, trace, teach, theme);
+}
+
+/// The call about to be made, with eq. 10's test, beside the one just made.
+fn draw_call(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+    let walk = teach.walk();
     let names = teach.names();
+    let next = walk.as_ref().and_then(|w| w.pending.last().copied());
+    let params = teach.net().params();
     let threshold = params.threshold;
     let mut lines = Vec::new();
     if let Some(made) = walk.as_ref().and_then(|w| w.trace.last()) {
@@ -193,13 +204,14 @@ pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         Paragraph::new(lines)
             .wrap(Wrap { trim: false })
             .block(Block::bordered().title(Span::styled(" the call ", theme.title()))),
-        call,
+        area,
     );
+}
 
-    draw_edits(frame, edits, teach, theme);
-    draw_values(frame, values, teach, theme);
-
-    // The recursion's stack: pending calls, the next on top.
+/// The recursion's stack: pending calls, the next on top.
+fn draw_stack(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+    let walk = teach.walk();
+    let names = teach.names();
     let stack_lines: Vec<Line> = walk
         .as_ref()
         .map(|w| {
@@ -226,12 +238,16 @@ pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
             " pending spread calls (next on top) ",
             theme.title(),
         ))),
-        stack,
+        area,
     );
+}
 
-    // The trace: the calls made so far, the latest last.
+/// The trace: the calls made so far, the latest last.
+fn draw_trace(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+    let walk = teach.walk();
+    let names = teach.names();
     let trace_steps = walk.as_ref().map_or(&[][..], |w| w.trace);
-    let visible = trace.height.saturating_sub(3) as usize;
+    let visible = area.height.saturating_sub(3) as usize;
     let skip = trace_steps.len().saturating_sub(visible);
     let rows = trace_steps
         .iter()
@@ -256,7 +272,7 @@ pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         )
         .header(Row::new(["#", "from", "to", "h", "Ω", "η", "ΔA"]).style(theme.title()))
         .block(Block::bordered().title(Span::styled(" trace ", theme.title()))),
-        trace,
+        area,
     );
 }
 
