@@ -111,6 +111,12 @@ fn run_experiment(cli: &Cli) -> Result<()> {
         }
         return run_dashboard(cli, &config);
     }
+    if cli.run.compare.is_some() {
+        anyhow::bail!(
+            "--compare is for the dashboard: with --headless, `sapnet plot DIR` redraws a \
+             results folder's plots"
+        );
+    }
     if cli.run.follow.is_some() {
         anyhow::bail!("--follow is for the dashboard: --headless runs every method");
     }
@@ -199,6 +205,21 @@ fn report(summary: &headless::Summary, dir: &Path) -> Result<()> {
     Ok(())
 }
 
+/// The bands of a finished protocol's methods (`--compare DIR`), from its episodes.csv.
+fn reference_bands(dir: &Path) -> Result<Vec<tui::reference::Band>> {
+    let data = headless::read_plot_data(dir).with_context(|| {
+        format!(
+            "--compare {}: expected the output folder of a `sapnet --headless` run",
+            dir.display()
+        )
+    })?;
+    Ok(data
+        .curves
+        .iter()
+        .map(|c| tui::reference::Band::from_runs(&c.label, &c.returns, data.window))
+        .collect())
+}
+
 /// The dashboard follows the first run of one reusing method (`--follow`, else the first
 /// SAP-Net method, else the first that reuses; `m` moves to the next), step by step,
 /// beside the first run of the first DQN baseline, episode by episode; the library is
@@ -226,6 +247,11 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
             .find(|m| m.kind == MethodKind::SapNet)
             .or_else(|| ids.iter().find(|m| m.kind.reuses()))
             .cloned(),
+    };
+    // Read before training starts, so that a wrong folder is said at once.
+    let reference = match &cli.run.compare {
+        Some(dir) => reference_bands(dir)?,
+        None => Vec::new(),
     };
     // The followed run and the DQN baseline train side by side.
     let plan = experiment::plan(config, &cli.run.library_root(), 2, &on_interrupt()?)?;
@@ -255,6 +281,7 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
             followable,
             followed: first,
             baseline,
+            reference,
         },
     )?;
     eprintln!(

@@ -68,6 +68,12 @@ pub struct RunArgs {
     #[arg(long, value_name = "METHOD")]
     pub follow: Option<String>,
 
+    /// The dashboard draws a finished protocol's results (a `--headless` output folder)
+    /// under the live curves: for each method on screen, the mean of its runs' moving
+    /// averages and a band of ± one standard deviation.
+    #[arg(long, value_name = "DIR")]
+    pub compare: Option<PathBuf>,
+
     /// Training episodes per run, overriding the config's `protocol.episodes`: the first N
     /// episodes of every run are exactly those of the full protocol (the same seeds).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]

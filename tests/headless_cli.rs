@@ -322,3 +322,31 @@ fn sizes_that_cannot_fit_are_refused_before_allocating() {
         assert!(stderr(&output).contains("larger than 16777216 bytes"));
     }
 }
+
+/// `--compare` reads a results folder for the dashboard: said at once when it is not one
+/// (before any terminal is opened), and refused with --headless.
+#[test]
+fn compare_needs_a_results_folder_and_the_dashboard() {
+    let empty = tempfile::tempdir().unwrap();
+    let dir = empty.path().to_str().unwrap();
+    let output = sapnet(&["--compare", dir]);
+    assert!(!output.status.success());
+    let err = stderr(&output);
+    assert!(
+        err.contains(&format!(
+            "--compare {dir}: expected the output folder of a `sapnet --headless` run"
+        )),
+        "{err}"
+    );
+    assert!(
+        err.contains("summary.json"),
+        "the missing file is named: {err}"
+    );
+    let output = sapnet(&["--headless", "--compare", dir]);
+    assert!(!output.status.success());
+    assert!(
+        stderr(&output).contains("--compare is for the dashboard"),
+        "{}",
+        stderr(&output)
+    );
+}

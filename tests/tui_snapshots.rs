@@ -341,3 +341,32 @@ fn the_zoomed_table_shows_each_policys_activation_over_time() {
     assert!(screen.contains("A per episode"), "{screen}");
     insta::assert_snapshot!("dashboard_zoomed_table_120x40", terminal.backend());
 }
+
+/// `--compare DIR`: a finished protocol's mean ± sd under the live curves of the same
+/// methods, named in the legend.
+#[test]
+fn a_finished_protocol_is_drawn_as_bands_under_the_live_curves() {
+    let mut d = dashboard();
+    let runs = |base: f64| -> Vec<Vec<f64>> {
+        (0..3)
+            .map(|r| {
+                (0..60)
+                    .map(|e| base + f64::from(e) + 10.0 * f64::from(r))
+                    .collect()
+            })
+            .collect()
+    };
+    d.reference = vec![
+        sapnet::tui::reference::Band::from_runs("sapnet", &runs(40.0), 10),
+        sapnet::tui::reference::Band::from_runs("dqn[100]", &runs(5.0), 10),
+        sapnet::tui::reference::Band::from_runs("ucb1", &runs(0.0), 10),
+    ];
+    let terminal = draw_dashboard(&d, (120, 40));
+    let screen = format!("{}", terminal.backend());
+    assert!(screen.contains("sapnet ± sd, 3 runs"), "{screen}");
+    assert!(
+        !screen.contains("ucb1"),
+        "a method not on screen has no band: {screen}"
+    );
+    insta::assert_snapshot!("dashboard_reference_120x40", terminal.backend());
+}

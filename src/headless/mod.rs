@@ -58,7 +58,7 @@ use output::prepare_output;
 pub use plots::{write_all as write_plots, Curve, PlotData};
 pub(crate) use progress::{Progress, Unit};
 pub use records::run_name;
-pub use replot::replot;
+pub use replot::{read as read_plot_data, replot};
 pub use results::{LibraryEntry, RunSummary, Status, Summary};
 
 /// Where results go and whether old ones may be replaced.

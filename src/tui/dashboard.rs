@@ -20,6 +20,7 @@ use crate::trainer::{
 
 use super::graph_view;
 use super::knobs::Knob;
+use super::reference::Band;
 use super::teach::Teach;
 
 /// Points kept per curve; beyond it every other point is dropped and the stride doubles.
@@ -274,6 +275,9 @@ pub struct Dashboard {
     /// The method whose run the dashboard follows, once the UI has said which: events of
     /// a run it stopped following are then left out.
     pub followed: Option<String>,
+    /// A finished protocol's bands (`--compare DIR`), one per method, drawn under the live
+    /// curves of the same methods.
+    pub reference: Vec<Band>,
 }
 
 impl Dashboard {
@@ -296,6 +300,7 @@ impl Dashboard {
             speedometer: VecDeque::new(),
             teach: None,
             followed: None,
+            reference: Vec::new(),
         }
     }
 

@@ -8,12 +8,14 @@
 //! - [`dashboard`]: what the UI keeps of the stream, and what keys do.
 //! - [`teach`]: one activation's spreading, a call at a time, with undo.
 //! - [`knobs`]: teach mode's live edits (T_ω, 𝒜, τ, paths, an edge's weight).
+//! - [`reference`]: a finished protocol's bands beside the live run (`--compare`).
 //! - [`view`], [`step_line`], [`teach_view`], [`graph_view`]: drawing, as pure functions
 //!   of that state.
 
 pub mod dashboard;
 pub mod graph_view;
 pub mod knobs;
+pub mod reference;
 pub mod step_line;
 pub mod teach;
 pub mod teach_view;
@@ -90,12 +92,15 @@ pub struct DashboardRuns {
     pub followed: usize,
     /// Trained beside it, episode by episode (the first DQN baseline).
     pub baseline: Option<RunSpec>,
+    /// A finished protocol's bands to draw under the live curves (`--compare`).
+    pub reference: Vec<reference::Band>,
 }
 
 /// Runs the dashboard until the user quits, then stops and joins the runs.
 pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
     let theme = Theme::from_env();
     let mut dashboard = Dashboard::new(task);
+    dashboard.reference = plan.reference.clone();
     let (events_tx, events) = mpsc::channel();
     let mut runs: Vec<Driven> = Vec::new();
     let mut followed = plan.followed;

@@ -12,6 +12,7 @@ use ratatui::Frame;
 
 use super::dashboard::{Dashboard, Focus, Mode, RunView, SapNetView, HISTORY, SPEEDS};
 use super::graph_view::{self, node_style, Scene};
+use super::reference::Band;
 use super::step_line::step_line;
 use super::theme::Theme;
 
@@ -197,7 +198,7 @@ fn draw_training(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
         }
     }
     if !rewards.is_empty() {
-        draw_rewards(frame, rewards, &dashboard.runs, theme);
+        draw_rewards(frame, rewards, &dashboard.runs, &dashboard.reference, theme);
         draw_loss(frame, loss, dashboard.main_run(), theme);
     }
 }
@@ -445,13 +446,30 @@ pub(super) fn probability_bar(p: f64, width: usize) -> String {
 /// The episode axis follows the first (leading) run, so that its curve fills the chart
 /// however far ahead a baseline of short episodes has raced; the others are drawn over the
 /// same episodes, and the title says where they are.
-fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], theme: Theme) {
+fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], reference: &[Band], theme: Theme) {
     let x_max = runs
         .first()
         .map_or(10.0, |r| f64::from(r.episode).max(10.0));
+    // A finished protocol's band for each method on screen, over the episodes shown.
+    let bands: Vec<&Band> = reference
+        .iter()
+        .filter(|b| runs.iter().any(|r| r.method.label() == b.label))
+        .collect();
+    let shown = |points: &[(f64, f64)]| -> Vec<(f64, f64)> {
+        points
+            .iter()
+            .copied()
+            .filter(|&(x, _)| x <= x_max)
+            .collect()
+    };
+    let band_points: Vec<[Vec<(f64, f64)>; 3]> = bands
+        .iter()
+        .map(|b| [shown(&b.low), shown(&b.mean), shown(&b.high)])
+        .collect();
     let (y_min, y_max) = runs
         .iter()
         .flat_map(|r| r.curve.returns.iter().map(|&(_, y)| y))
+        .chain(band_points.iter().flatten().flatten().map(|&(_, y)| y))
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
             (lo.min(y), hi.max(y))
         });
@@ -471,8 +489,45 @@ fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], theme: Theme) {
             format!("{symbol}{} MA10", run.method)
         })
         .collect();
-    let width = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
+    let width = names
+        .iter()
+        .map(|n| n.chars().count())
+        .chain(
+            reference
+                .iter()
+                .map(|b| format!("{} ± sd, {} runs", b.label, b.runs).chars().count()),
+        )
+        .max()
+        .unwrap_or(0);
     let mut datasets = Vec::new();
+    // The bands first, so the live curves draw over them: the mean a dim line named in
+    // the legend, ± one sd as dim dots.
+    for (band, [low, mean, high]) in bands.iter().zip(&band_points) {
+        let i = runs
+            .iter()
+            .position(|r| r.method.label() == band.label)
+            .unwrap_or(0);
+        for edge in [low, high] {
+            datasets.push(
+                Dataset::default()
+                    .marker(Marker::Braille)
+                    .graph_type(GraphType::Scatter)
+                    .style(theme.dim())
+                    .data(edge),
+            );
+        }
+        datasets.push(
+            Dataset::default()
+                .name(format!(
+                    "{:width$}",
+                    format!("{} ± sd, {} runs", band.label, band.runs)
+                ))
+                .marker(Marker::Braille)
+                .graph_type(GraphType::Line)
+                .style(theme.series(i).add_modifier(Modifier::DIM))
+                .data(mean),
+        );
+    }
     for (i, (run, name)) in runs.iter().zip(names).enumerate() {
         if i == 0 {
             datasets.push(
