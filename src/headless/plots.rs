@@ -105,16 +105,8 @@ fn method_colour(curves: &[Curve], i: usize) -> RGBColor {
         RGBColor(227, 119, 194),
         RGBColor(247, 182, 210),
     ];
-    const OTHERS: [RGBColor; 8] = [
-        RGBColor(31, 119, 180),
-        RGBColor(255, 127, 14),
-        RGBColor(44, 160, 44),
-        RGBColor(148, 103, 189),
-        RGBColor(140, 86, 75),
-        RGBColor(127, 127, 127),
-        RGBColor(23, 190, 207),
-        RGBColor(188, 189, 34),
-    ];
+    // tab10 without its red and pink, which are SAP-Net's.
+    const OTHERS: [usize; 8] = [0, 1, 2, 4, 5, 7, 9, 8];
     let same_kind = curves[..i]
         .iter()
         .filter(|c| c.sapnet == curves[i].sapnet)
@@ -122,7 +114,7 @@ fn method_colour(curves: &[Curve], i: usize) -> RGBColor {
     if curves[i].sapnet {
         SAPNETS[same_kind % SAPNETS.len()]
     } else {
-        OTHERS[same_kind % OTHERS.len()]
+        SOURCE_COLOURS[OTHERS[same_kind % OTHERS.len()]]
     }
 }
 

@@ -26,7 +26,6 @@ pub mod schedule;
 pub mod scratch;
 pub mod ucb1;
 
-use std::borrow::Cow;
 use std::fmt;
 
 use rand::rngs::StdRng;
@@ -96,6 +95,14 @@ pub struct SelectorView {
     pub negative: Vec<u64>,
 }
 
+/// The change of the scores that a positive judgment made: on the judged source (eq. 8,
+/// plus whatever the walk brought back to it) and on all the others together (eq. 10–11).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Deposit {
+    pub own: f64,
+    pub others: f64,
+}
+
 /// Which source acts and what it hears back. See the [module](self) documentation.
 pub trait Selector: Send + fmt::Debug {
     /// Who learns from the run's steps.
@@ -119,10 +126,10 @@ pub trait Selector: Send + fmt::Debug {
     /// Scores and probabilities for display.
     fn view(&self) -> SelectorView;
 
-    /// The scores of [`view`](Self::view) alone, borrowed where the selector keeps them:
-    /// what a live view compares around a judgment, every step.
-    fn scores(&self) -> Cow<'_, [f64]> {
-        Cow::Owned(self.view().scores)
+    /// What the latest positive judgment of [`on_update`](Self::on_update) deposited on
+    /// the scores, for a live view; `None` for selectors that do not deposit.
+    fn last_deposit(&self) -> Option<Deposit> {
+        None
     }
 
     /// The largest probability of picking one source, where the method has probabilities:

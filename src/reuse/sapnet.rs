@@ -3,13 +3,11 @@
 //! paper; the knobs are variants beyond it: a temperature schedule, a judgment over
 //! episodes or over k updates, and activation decay.
 
-use std::borrow::Cow;
-
 use rand::rngs::StdRng;
 use serde::{Deserialize, Serialize};
 
 use super::schedule::Schedule;
-use super::{Activation, Actor, EpisodeEnd, Learning, Selector, SelectorView};
+use super::{Activation, Actor, Deposit, EpisodeEnd, Learning, Selector, SelectorView};
 use crate::dqn::UpdateReport;
 use crate::sapnet::{self, PolicyDescription, SapNet, SapNetError, SapNetParams, TraceStep};
 
@@ -116,6 +114,8 @@ pub struct SapNetSelector {
     window: Vec<(f64, u32)>,
     tracing: bool,
     traced: Vec<Activation>,
+    /// What the latest positive judgment deposited (eq. 8–11).
+    deposit: Deposit,
 }
 
 impl SapNetSelector {
@@ -139,6 +139,7 @@ impl SapNetSelector {
             window: vec![(0.0, 0); n],
             tracing: false,
             traced: Vec::new(),
+            deposit: Deposit::default(),
         })
     }
 
@@ -154,6 +155,8 @@ impl SapNetSelector {
             return;
         }
         self.positive[i] += 1;
+        let own_before = self.net.activations()[i];
+        let total_before: f64 = self.net.activations().iter().sum();
         if self.tracing {
             let mut calls: Vec<TraceStep> = Vec::new();
             self.net.activate_traced(i, true, &mut calls);
@@ -161,6 +164,12 @@ impl SapNetSelector {
         } else {
             self.net.activate(i, true);
         }
+        let own = self.net.activations()[i] - own_before;
+        let total: f64 = self.net.activations().iter().sum::<f64>() - total_before;
+        self.deposit = Deposit {
+            own,
+            others: total - own,
+        };
     }
 }
 
@@ -235,8 +244,8 @@ impl Selector for SapNetSelector {
         }
     }
 
-    fn scores(&self) -> Cow<'_, [f64]> {
-        Cow::Borrowed(self.net.activations())
+    fn last_deposit(&self) -> Option<Deposit> {
+        Some(self.deposit)
     }
 
     fn top_probability(&self) -> Option<f64> {
@@ -291,6 +300,24 @@ mod tests {
         let view = s.view();
         assert_eq!(view.scores, vec![1.0, 1.0]);
         assert_eq!((view.positive, view.negative), (vec![1, 1], vec![1, 0]));
+    }
+
+    /// Table II by hand: two one-layer policies joined at 0.95 (< T_ω = 1). Activating
+    /// one deposits 𝒜 = 1 on it and η/(h·Ω) = 1/0.95 on its only neighbour; the next hop
+    /// back has Ω = 1.9 and stops.
+    #[test]
+    fn a_positive_judgment_reports_what_it_deposited() {
+        let policies = [
+            PolicyDescription::new(vec![8], "t"),
+            PolicyDescription::new(vec![9], "t"),
+        ];
+        let mut s =
+            SapNetSelector::new(&policies, SapNetParams::default(), &SapNetKnobs::default())
+                .unwrap();
+        assert_eq!(s.on_update(0, &report(0.5, 0.4)), Some(true));
+        let deposit = s.last_deposit().unwrap();
+        assert_eq!(deposit.own, 1.0);
+        assert!((deposit.others - 1.0 / 0.95).abs() < 1e-12, "{deposit:?}");
     }
 
     #[test]

@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize, Serializer};
 
 use crate::config::{Method, MethodKind};
 use crate::dqn::UpdateReport;
+pub use crate::reuse::Deposit;
 use crate::sapnet::{PolicyDescription, SapNet, TraceStep};
 
 /// Which learner a run trains: its place in `protocol.methods`, its kind and its label in
@@ -189,32 +190,6 @@ pub struct StepRecord {
     pub deposit: Option<Deposit>,
     /// One of the first `N × replay_start_size` steps, acted in turn without learning.
     pub warm_up: bool,
-}
-
-/// The change of the selector's scores that a judgment made: on the judged source (eq. 8,
-/// plus whatever the walk brought back to it) and on all the others together (eq. 10–11).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Deposit {
-    pub own: f64,
-    pub others: f64,
-}
-
-impl Deposit {
-    /// The change from `before` to `after` with `source` the judged one.
-    pub fn between(before: &[f64], after: &[f64], source: usize) -> Self {
-        let mut deposit = Deposit {
-            own: 0.0,
-            others: 0.0,
-        };
-        for (i, (b, a)) in before.iter().zip(after).enumerate() {
-            if i == source {
-                deposit.own += a - b;
-            } else {
-                deposit.others += a - b;
-            }
-        }
-        deposit
-    }
 }
 
 /// The state of a run's selector at a step.

@@ -30,7 +30,7 @@ use rand::SeedableRng;
 
 use super::control::{Control, Next};
 use super::events::{
-    ActivationSnapshot, ChosenPolicy, Command, Deposit, EpisodeRecord, Event, MethodId, RunRecord,
+    ActivationSnapshot, ChosenPolicy, Command, EpisodeRecord, Event, MethodId, RunRecord,
     SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
 };
 use super::{Divergence, RunOutcome, TrainerError};
@@ -342,9 +342,6 @@ pub fn train(
         }
     };
     let mut last_snapshot = Instant::now();
-    // The selector's scores before a judgment, kept between steps so a live run does not
-    // allocate for them.
-    let mut scores_before: Vec<f64> = Vec::new();
     // The learner whose loss an episode's record shows: the last source that acted, or the
     // method's own learner.
     let mut last_source = 0;
@@ -427,14 +424,9 @@ pub fn train(
                 // A round without an update (update_interval > 1) has nothing to judge.
                 if let (Some(report), Some(i)) = (&report, name) {
                     selector.set_tracing(control.trace());
-                    // A live view shows what a judgment deposited: the scores around it.
-                    if spec.stream.steps {
-                        scores_before.clear();
-                        scores_before.extend_from_slice(&selector.scores());
-                    }
                     judgment = selector.on_update(i, report);
-                    if spec.stream.steps && judgment == Some(true) {
-                        deposit = Some(Deposit::between(&scores_before, &selector.scores(), i));
+                    if judgment == Some(true) {
+                        deposit = selector.last_deposit();
                     }
                     send_traces(selector.as_mut(), steps);
                 }

@@ -41,12 +41,7 @@ pub struct Scene<'a> {
 /// Draws `scene` in `block` over `area`.
 pub fn draw(frame: &mut Frame, area: Rect, block: Block, scene: Scene, theme: Theme) {
     let positions = positions(scene.net.len(), scene.groups);
-    let top = scene
-        .net
-        .activations()
-        .iter()
-        .copied()
-        .fold(0.0_f64, f64::max);
+    let top = highest(scene.net.activations().iter().copied());
     let labels: Vec<String> = scene.names.iter().map(|n| short_label(n)).collect();
     let show_weights = scene.net.len() <= 6;
     // The canvas's x units per terminal cell.
@@ -246,6 +241,12 @@ pub fn short_label(name: &str) -> String {
     } else {
         name.to_string()
     }
+}
+
+/// The largest of `values`, or 0 if none is positive: the scale of the nodes' heat and of
+/// the sparklines.
+pub fn highest(values: impl IntoIterator<Item = f64>) -> f64 {
+    values.into_iter().fold(0.0_f64, f64::max)
 }
 
 /// The style of a table row's name: the same heat as its node.

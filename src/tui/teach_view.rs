@@ -300,7 +300,7 @@ fn draw_values(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     let names = teach.names();
     let net = teach.net();
     let probabilities = net.probabilities();
-    let top = net.activations().iter().copied().fold(0.0_f64, f64::max);
+    let top = graph_view::highest(net.activations().iter().copied());
     let deposited = teach.walk().map(|w| w.deposited);
     // The edit's columns where the panel has room; the edit panel sums them up anyway.
     let edit = teach

@@ -290,12 +290,7 @@ fn draw_policy_table(
     } else {
         view.score_name.to_string()
     };
-    let top = view
-        .net
-        .activations()
-        .iter()
-        .copied()
-        .fold(0.0_f64, f64::max);
+    let top = graph_view::highest(view.net.activations().iter().copied());
     // Columns give way from the right of the wish list as the panel narrows: the graph
     // already shows categories, the counts matter least.
     let full = area.width >= 72;
@@ -309,12 +304,7 @@ fn draw_policy_table(
     // Each policy's score over the last episodes, on one scale for all (the highest in the
     // window), where the panel is wide enough: zoomed (`z`) or on a wide terminal.
     let history = area.width >= 90;
-    let history_top = view
-        .history
-        .iter()
-        .flatten()
-        .copied()
-        .fold(0.0_f64, f64::max);
+    let history_top = graph_view::highest(view.history.iter().flatten().copied());
     let rows = view.policies.iter().enumerate().map(|(i, p)| {
         let a = view.net.activations()[i];
         let probability = view.probabilities.get(i).copied().unwrap_or(0.0);
