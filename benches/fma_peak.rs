@@ -4,10 +4,6 @@
 //!
 //! `cargo bench --bench fma_peak`
 
-// AVX-512 intrinsics are stable since Rust 1.89, the toolchain here; the crate's MSRV
-// (1.85) covers what it ships, and this bench only measures the machine.
-#![allow(clippy::incompatible_msrv)]
-
 use std::hint::black_box;
 use std::time::Instant;
 

@@ -4,8 +4,8 @@ use clap::Parser;
 
 use sapnet::cli::Cli;
 
-// candle allocates a buffer for every tensor op; mimalloc more than halves a DQN update
-// against glibc's malloc.
+// candle allocates a buffer for every tensor op (loading, saving, the reference forward);
+// mimalloc more than halved a DQN update against glibc's malloc while candle ran it.
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
@@ -16,6 +16,11 @@ fn main() -> ExitCode {
         std::env::set_var("RAYON_NUM_THREADS", "1");
     }
     let cli = Cli::parse();
+    // A kernel path the CPU lacks (or a typo) is said before anything runs.
+    if let Err(message) = sapnet::dqn::kernels::Isa::from_env() {
+        eprintln!("error: {message}");
+        return ExitCode::from(2);
+    }
     let result = sapnet::app::run(cli);
     if let Err(err) = &result {
         // `sapnet teach --headless --json | head`: the reader left, nothing to report.

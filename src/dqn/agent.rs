@@ -1,9 +1,9 @@
 //! The DQN learner (ChainerRL's `DQN` agent, with the hyper-parameters of `DqnConfig`).
 
-use candle_core::{Device, Tensor};
 use rand::Rng;
 
-use super::host::with_f32;
+use super::backprop::Workspace;
+use super::kernels::Isa;
 use super::{td_huber_loss, Adam, Batch, DqnError, EpsilonGreedy, QNet, ReplayBuffer};
 use crate::config::DqnConfig;
 
@@ -43,6 +43,8 @@ pub struct DqnAgent {
     /// Reused between updates.
     batch: Batch,
     targets: Vec<f32>,
+    online_work: Workspace,
+    target_work: Workspace,
 }
 
 impl DqnAgent {
@@ -60,6 +62,8 @@ impl DqnAgent {
             last_loss: None,
             batch: Batch::new(),
             targets: Vec::new(),
+            online_work: Workspace::default(),
+            target_work: Workspace::default(),
         })
     }
 
@@ -85,11 +89,11 @@ impl DqnAgent {
         rng: &mut impl Rng,
     ) -> Result<Option<UpdateReport>, DqnError> {
         self.steps += 1;
-        if self.steps % self.config.target_update_interval == 0 {
+        if self.steps.is_multiple_of(self.config.target_update_interval) {
             self.sync_target()?;
         }
         if replay.len() < self.config.replay_start_size
-            || self.steps % self.config.update_interval != 0
+            || !self.steps.is_multiple_of(self.config.update_interval)
             || self.config.gradient_steps == 0
         {
             return Ok(None);
@@ -118,26 +122,27 @@ impl DqnAgent {
     pub fn update(&mut self, batch: &Batch) -> Result<f64, DqnError> {
         assert!(!batch.is_empty(), "cannot learn from an empty batch");
         self.compute_td_targets(batch)?;
-        let obs = Tensor::from_slice(batch.obs(), (batch.len(), batch.obs_size()), &Device::Cpu)?;
-        let (q, layer_inputs) = self.online.forward_train(&obs)?;
+        let isa = Isa::current();
+        let work = &mut self.online_work;
+        let q = self
+            .online
+            .forward_with(isa, batch.obs(), batch.len(), work)?;
         let (actions, targets, delta) = (batch.actions(), &self.targets, self.config.huber_delta);
-        let (loss, grad_q) = with_f32(&q, |q| td_huber_loss(q, actions, targets, delta))??;
+        let (loss, grad_q) = td_huber_loss(q, actions, targets, delta)?;
         if !loss.is_finite() {
             let (step, update) = (self.steps, self.updates + 1);
             return Err(DqnError::NonFiniteLoss { step, update, loss });
         }
-        let grad_q = Tensor::from_vec(grad_q, q.shape(), &Device::Cpu)?;
-        let grads = self.online.backward(&layer_inputs, grad_q)?;
+        self.online.backward_with(isa, work, &grad_q)?;
         // A finite loss can still overflow in the backward pass; with finite gradients and
         // the validated Adam parameters the step keeps every weight finite, so the weights
         // are never worse than "last good".
-        for grad in &grads {
-            if !with_f32(grad, |g| g.iter().all(|x| x.is_finite()))? {
-                let (step, update) = (self.steps, self.updates + 1);
-                return Err(DqnError::NonFiniteGradient { step, update, loss });
-            }
+        if !work.gradients().all_finite() {
+            let (step, update) = (self.steps, self.updates + 1);
+            return Err(DqnError::NonFiniteGradient { step, update, loss });
         }
-        self.optimizer.step(self.online.parameters(), &grads)?;
+        self.optimizer
+            .step(self.online.parameters(), work.gradients())?;
 
         self.updates += 1;
         self.last_loss = Some(loss);
@@ -151,26 +156,26 @@ impl DqnAgent {
     /// `y = r + γ·max_a' Q_target(s', a')` for every transition of `batch`, without the
     /// bootstrap after a terminal state (or a truncation, if `truncation_as_terminal`).
     fn compute_td_targets(&mut self, batch: &Batch) -> Result<(), DqnError> {
-        let shape = (batch.len(), batch.obs_size());
-        let next_obs = Tensor::from_slice(batch.next_obs(), shape, &Device::Cpu)?;
-        let next_q = self.target.forward(&next_obs)?;
+        let next_q = self.target.forward_with(
+            Isa::current(),
+            batch.next_obs(),
+            batch.len(),
+            &mut self.target_work,
+        )?;
         let gamma = self.config.gamma as f32;
         let truncation_is_terminal = self.config.truncation_as_terminal;
-        let targets = &mut self.targets;
-        targets.clear();
-        with_f32(&next_q, |next_q| {
-            let rows = next_q.chunks_exact(next_q.len() / batch.len());
-            for (b, row) in rows.enumerate() {
-                let terminal =
-                    batch.terminated()[b] || (truncation_is_terminal && batch.truncated()[b]);
-                let bootstrap = if terminal {
-                    0.0
-                } else {
-                    gamma * row.iter().copied().fold(f32::MIN, f32::max)
-                };
-                targets.push(batch.rewards()[b] + bootstrap);
-            }
-        })?;
+        self.targets.clear();
+        let rows = next_q.chunks_exact(next_q.len() / batch.len());
+        for (b, row) in rows.enumerate() {
+            let terminal =
+                batch.terminated()[b] || (truncation_is_terminal && batch.truncated()[b]);
+            let bootstrap = if terminal {
+                0.0
+            } else {
+                gamma * row.iter().copied().fold(f32::MIN, f32::max)
+            };
+            self.targets.push(batch.rewards()[b] + bootstrap);
+        }
         Ok(())
     }
 

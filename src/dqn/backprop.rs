@@ -1,154 +1,364 @@
-//! The MLP's forward and backward passes, written out by hand.
-//!
-//! candle's autograd is general: each backward step allocates a zero gradient, adds into
-//! it, and rebuilds ReLU's derivative from four tensor operations. For a DQN minibatch
-//! (32 rows of ~100 units) that bookkeeping cost more than the matrix products, so the
-//! update uses these passes instead (`tests` checks them against candle's autograd):
+//! The MLP's forward and backward passes, written out by hand on the kernels of `kernels/`
+//! (`tests` checks them against candle's autograd):
 //!
 //! ```text
 //! forward:   zₗ = aₗ₋₁·Wₗᵀ + bₗ      aₗ = relu(zₗ)   (no ReLU on the output layer)
 //! backward:  ∂Wₗ = ∂zₗᵀ·aₗ₋₁        ∂bₗ = Σ_rows ∂zₗ
-//!            ∂zₗ₋₁ = (∂zₗ·Wₗ) ⊙ [aₗ₋₁ > 0]
+//!            ∂aₗ₋₁ = (∂zₗ·Wₗ) ⊙ [aₗ₋₁ > 0]
 //! ```
 //!
-//! Bias, ReLU and the ReLU mask are applied in place on the fresh output of each matrix
-//! product, so a layer costs one allocation per pass.
+//! Activations and their gradients are kept transposed, a row per unit and a column per
+//! transition, the columns padded to 16: the forward products and the ∂a products then
+//! vectorise across the minibatch, with the bias, ReLU and ReLU's mask applied in registers.
+//! ∂W vectorises across the layer's inputs instead, so it reads the layer's input
+//! transposed back (one small copy per layer), with a column of ones after the last input:
+//! that column's sums, `Σ_rows ∂zₗ·1`, are ∂bₗ, and an FMA by 1 rounds as an add does. The parameters stay in their candle [`Var`]s
+//! and are read in place.
+//!
+//! [`Var`]: candle_core::Var
 
-use candle_core::{bail, CpuStorage, InplaceOp2, Layout, Result, Tensor};
+use candle_core::{bail, Result, Storage, Tensor};
 
-use super::host::with_f32;
-use super::QNet;
+use super::kernels::{padded, transpose, Finish, Isa, Product, Rows, Start, Strided};
+use super::{Architecture, QNet};
+
+/// Scratch memory of the passes, for one architecture and batch size at a time; kept between
+/// updates so a step allocates nothing.
+#[derive(Debug, Default)]
+pub(crate) struct Workspace {
+    /// Units of every layer, input first.
+    sizes: Vec<usize>,
+    batch: usize,
+    /// `padded(batch)`: the column count of every transposed buffer.
+    columns: usize,
+    /// The input of each layer, then the Q-values: `[units, columns]`.
+    activations: Vec<Vec<f32>>,
+    /// The Q-values `[batch, actions]`.
+    q: Vec<f32>,
+    /// A layer's input and a column of ones `[batch, padded(units + 1)]`, for its weights'
+    /// and bias's gradients.
+    inputs: Vec<f32>,
+    /// ∂z of the layer being differentiated and ∂a of its input, `[units, columns]`.
+    grad_out: Vec<f32>,
+    grad_in: Vec<f32>,
+    gradients: Gradients,
+}
+
+impl Workspace {
+    /// Sizes the forward pass's buffers for `architecture` and `batch`. Buffers are reused
+    /// across shapes (an acting thread runs one network after another); a lane or column
+    /// past the batch or a layer's units may hold another shape's values, which no sum
+    /// reads.
+    fn prepare(&mut self, architecture: &Architecture, batch: usize) {
+        let sizes = architecture.layer_sizes();
+        if sizes == self.sizes && batch == self.batch {
+            return;
+        }
+        let columns = padded(batch);
+        self.activations.resize_with(sizes.len(), Vec::new);
+        for (buffer, &units) in self.activations.iter_mut().zip(&sizes) {
+            buffer.resize(units * columns, 0.0);
+        }
+        self.q.resize(batch * architecture.action_count, 0.0);
+        (self.sizes, self.batch, self.columns) = (sizes, batch, columns);
+    }
+
+    /// Sizes the backward pass's buffers for the shape of the last forward pass.
+    fn prepare_backward(&mut self) {
+        let widest = self.sizes.iter().copied().max().unwrap_or(0);
+        self.inputs.resize(self.batch * padded(widest + 1), 0.0);
+        self.grad_out.resize(widest * self.columns, 0.0);
+        self.grad_in.resize(widest * self.columns, 0.0);
+        let shapes = self.sizes.windows(2).flat_map(|w| {
+            let (inputs, outputs) = (w[0], w[1]);
+            [(outputs, inputs, padded(inputs + 1)), (1, outputs, outputs)]
+        });
+        let fits = self.gradients.parameters.len() == 2 * (self.sizes.len() - 1)
+            && shapes.clone().zip(&self.gradients.parameters).all(
+                |((rows, columns, stride), p)| {
+                    p.columns == columns && p.stride == stride && p.values.len() == rows * stride
+                },
+            );
+        if !fits {
+            self.gradients.parameters = shapes
+                .map(|(rows, columns, stride)| ParameterGradient::zeros(rows, columns, stride))
+                .collect();
+        }
+    }
+
+    /// The gradients of the last [`QNet::backward`].
+    pub(crate) fn gradients(&self) -> &Gradients {
+        &self.gradients
+    }
+}
+
+/// The gradient of every parameter of a network, in the order of [`QNet::parameters`].
+#[derive(Debug, Default, Clone)]
+pub struct Gradients {
+    parameters: Vec<ParameterGradient>,
+}
+
+/// A parameter's gradient: rows of `columns` values, `stride` apart (a weight's rows are
+/// padded to whole vectors, and hold its bias's gradient in column `columns`).
+#[derive(Debug, Clone)]
+struct ParameterGradient {
+    values: Vec<f32>,
+    columns: usize,
+    stride: usize,
+}
+
+impl ParameterGradient {
+    fn zeros(rows: usize, columns: usize, stride: usize) -> Self {
+        Self {
+            values: vec![0.0; rows * stride],
+            columns,
+            stride,
+        }
+    }
+
+    fn rows(&self) -> impl Iterator<Item = &[f32]> {
+        self.values
+            .chunks(self.stride.max(1))
+            .map(|row| &row[..self.columns])
+    }
+}
+
+impl Gradients {
+    /// Gradients given as tensors, one per parameter (from candle's autograd, say).
+    pub fn from_tensors(tensors: &[Tensor]) -> Result<Self> {
+        let parameters = tensors
+            .iter()
+            .map(|t| {
+                let columns = t.dims().last().copied().unwrap_or(1);
+                let values = t.flatten_all()?.to_vec1::<f32>()?;
+                Ok(ParameterGradient {
+                    values,
+                    columns,
+                    stride: columns,
+                })
+            })
+            .collect::<Result<_>>()?;
+        Ok(Self { parameters })
+    }
+
+    pub fn len(&self) -> usize {
+        self.parameters.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.parameters.is_empty()
+    }
+
+    /// Each gradient, densely, as a tensor of `shape` taken from the matching parameter.
+    pub fn to_tensors(&self, shapes: &[Vec<usize>]) -> Result<Vec<Tensor>> {
+        self.parameters
+            .iter()
+            .zip(shapes)
+            .map(|(p, shape)| {
+                let values: Vec<f32> = p.rows().flatten().copied().collect();
+                Tensor::from_vec(values, shape.as_slice(), &candle_core::Device::Cpu)
+            })
+            .collect()
+    }
+
+    /// Whether every value is finite.
+    pub fn all_finite(&self) -> bool {
+        // The largest magnitude's bits, without an early exit, so the loop vectorises.
+        let largest = |row: &[f32]| {
+            row.iter()
+                .fold(0u32, |most, x| most.max(x.to_bits() & 0x7fff_ffff))
+        };
+        self.parameters
+            .iter()
+            .all(|p| p.rows().all(|row| largest(row) < f32::INFINITY.to_bits()))
+    }
+
+    /// `Σ g²` over every value, in `f64`, parameter by parameter.
+    pub fn sum_of_squares(&self) -> f64 {
+        self.parameters
+            .iter()
+            .map(|p| {
+                p.rows()
+                    .flatten()
+                    .map(|&x| f64::from(x).powi(2))
+                    .sum::<f64>()
+            })
+            .sum()
+    }
+
+    pub(crate) fn rows(&self) -> impl Iterator<Item = Rows<'_>> {
+        self.parameters.iter().map(|p| Rows {
+            values: &p.values,
+            columns: p.columns,
+            stride: p.stride,
+        })
+    }
+}
 
 impl QNet {
-    /// Q-values `[batch, action_count]` of `obs`, and the input of every layer (`obs` first),
-    /// which [`QNet::backward`] needs.
-    pub(crate) fn forward_train(&self, obs: &Tensor) -> Result<(Tensor, Vec<Tensor>)> {
-        let mut inputs = Vec::with_capacity(self.layers().len());
-        let mut x = obs.clone();
-        let last = self.layers().len() - 1;
-        for (i, layer) in self.layers().iter().enumerate() {
-            let z = x.matmul(&layer.weight().t()?)?;
-            let bias = layer.bias().expect("every layer has a bias");
-            z.inplace_op2(bias, &AddBias { relu: i < last })?;
-            inputs.push(std::mem::replace(&mut x, z));
+    /// Calls `f` with every parameter's values, read in place, in the order of
+    /// [`QNet::parameters`].
+    fn with_parameters<R>(&self, f: impl FnOnce(&[&[f32]]) -> R) -> Result<R> {
+        let guards: Vec<_> = self
+            .parameters()
+            .iter()
+            .map(|p| p.storage_and_layout())
+            .collect();
+        let mut slices = Vec::with_capacity(guards.len());
+        for (storage, layout) in &guards {
+            let Storage::Cpu(cpu) = &**storage else {
+                bail!("the Q-network's parameters live on the CPU")
+            };
+            let Some((start, end)) = layout.contiguous_offsets() else {
+                bail!("the Q-network's parameters are contiguous")
+            };
+            slices.push(&cpu.as_slice::<f32>()?[start..end]);
         }
-        Ok((x, inputs))
+        Ok(f(&slices))
     }
 
-    /// Gradients of the loss with respect to every parameter, in the order of
-    /// [`QNet::parameters`], given `grad_q = ∂loss/∂q` and the inputs
-    /// [`QNet::forward_train`] returned.
-    pub(crate) fn backward(&self, inputs: &[Tensor], grad_q: Tensor) -> Result<Vec<Tensor>> {
-        let layers = self.layers();
-        let mut grads = vec![None; 2 * layers.len()];
-        let mut grad_z = grad_q;
-        for (l, (layer, input)) in layers.iter().zip(inputs).enumerate().rev() {
-            grads[2 * l] = Some(grad_z.t()?.matmul(input)?);
-            grads[2 * l + 1] = Some(column_sums(&grad_z)?);
-            if l > 0 {
-                let grad_input = grad_z.matmul(layer.weight())?;
-                grad_input.inplace_op2(input, &ReluMask)?;
-                grad_z = grad_input;
-            }
-        }
-        Ok(grads
-            .into_iter()
-            .map(|g| g.expect("every layer visited"))
-            .collect())
-    }
-}
-
-/// `Σ_rows t` of a `[rows, columns]` tensor. candle's `sum(0)` walks the rows with a strided
-/// index per element and cost more than the matrix products here.
-fn column_sums(t: &Tensor) -> Result<Tensor> {
-    let (_, columns) = t.dims2()?;
-    let sums = with_f32(t, |values| {
-        let mut sums = vec![0.0f32; columns];
-        for row in values.chunks_exact(columns) {
-            for (s, &v) in sums.iter_mut().zip(row) {
-                *s += v;
-            }
-        }
-        sums
-    })?;
-    Tensor::from_vec(sums, columns, t.device())
-}
-
-/// `z ← z + b` row by row, then ReLU if asked.
-struct AddBias {
-    relu: bool,
-}
-
-impl InplaceOp2 for AddBias {
-    fn name(&self) -> &'static str {
-        "add-bias"
-    }
-
-    fn cpu_fwd(
+    /// Q-values `[batch, action_count]` of the observations `obs` (`[batch,
+    /// observation_size]`, row-major), computed on `isa`. `work` keeps every layer's input
+    /// for [`QNet::backward`].
+    pub(crate) fn forward_with<'w>(
         &self,
-        z: &mut CpuStorage,
-        z_l: &Layout,
-        b: &CpuStorage,
-        b_l: &Layout,
-    ) -> Result<()> {
-        let (z, b) = f32_slices(z, z_l, b, b_l)?;
-        for row in z.chunks_exact_mut(b.len()) {
-            for (z, &b) in row.iter_mut().zip(b) {
-                let v = *z + b;
-                *z = if self.relu { v.max(0.0) } else { v };
-            }
-        }
-        Ok(())
-    }
-}
-
-/// `∂a ← ∂a ⊙ [a > 0]`: ReLU's derivative, read from its output.
-struct ReluMask;
-
-impl InplaceOp2 for ReluMask {
-    fn name(&self) -> &'static str {
-        "relu-mask"
-    }
-
-    fn cpu_fwd(
-        &self,
-        g: &mut CpuStorage,
-        g_l: &Layout,
-        a: &CpuStorage,
-        a_l: &Layout,
-    ) -> Result<()> {
-        let (g, a) = f32_slices(g, g_l, a, a_l)?;
-        if g.len() != a.len() {
+        isa: Isa,
+        obs: &[f32],
+        batch: usize,
+        work: &'w mut Workspace,
+    ) -> Result<&'w [f32]> {
+        let architecture = self.architecture();
+        if obs.len() != batch * architecture.observation_size {
             bail!(
-                "relu-mask: {} gradients for {} activations",
-                g.len(),
-                a.len()
+                "{} observation values for a batch of {batch} observations of {}",
+                obs.len(),
+                architecture.observation_size
             )
         }
-        // Branch-free: the sign of a ReLU unit is a coin flip the predictor cannot learn.
-        for (g, &a) in g.iter_mut().zip(a) {
-            let keep = u32::from(a > 0.0).wrapping_neg();
-            *g = f32::from_bits(g.to_bits() & keep);
-        }
-        Ok(())
+        work.prepare(architecture, batch);
+        let columns = work.columns;
+        let sizes = &work.sizes;
+        transpose(
+            obs,
+            sizes[0],
+            batch,
+            sizes[0],
+            &mut work.activations[0],
+            columns,
+        );
+        let layers = sizes.len() - 1;
+        self.with_parameters(|p| {
+            for l in 0..layers {
+                let (inputs, outputs) = (sizes[l], sizes[l + 1]);
+                let (done, next) = work.activations.split_at_mut(l + 1);
+                Product {
+                    rows: outputs,
+                    depth: inputs,
+                    columns,
+                    left: Strided {
+                        data: p[2 * l],
+                        row_stride: inputs,
+                        column_stride: 1,
+                    },
+                    right: &done[l],
+                    right_stride: columns,
+                    start: Start::Bias(p[2 * l + 1]),
+                    finish: if l + 1 < layers {
+                        Finish::Relu
+                    } else {
+                        Finish::Keep
+                    },
+                }
+                .run(isa, &mut next[0], columns);
+            }
+        })?;
+        let actions = sizes[layers];
+        transpose(
+            &work.activations[layers],
+            columns,
+            actions,
+            batch,
+            &mut work.q,
+            actions,
+        );
+        Ok(&work.q)
     }
-}
 
-/// The contiguous `f32` data of an in-place op's destination and source.
-fn f32_slices<'a>(
-    dst: &'a mut CpuStorage,
-    dst_l: &Layout,
-    src: &'a CpuStorage,
-    src_l: &Layout,
-) -> Result<(&'a mut [f32], &'a [f32])> {
-    let (CpuStorage::F32(dst), CpuStorage::F32(src)) = (dst, src) else {
-        bail!("expected f32 tensors")
-    };
-    let (Some((d0, d1)), Some((s0, s1))) = (dst_l.contiguous_offsets(), src_l.contiguous_offsets())
-    else {
-        bail!("expected contiguous tensors")
-    };
-    Ok((&mut dst[d0..d1], &src[s0..s1]))
+    /// Gradients of the loss with respect to every parameter, into `work`, given `grad_q =
+    /// ∂loss/∂q` (`[batch, action_count]`) for the batch `work`'s last forward pass saw.
+    pub(crate) fn backward_with(
+        &self,
+        isa: Isa,
+        work: &mut Workspace,
+        grad_q: &[f32],
+    ) -> Result<()> {
+        let (batch, columns) = (work.batch, work.columns);
+        let sizes = work.sizes.clone();
+        let layers = sizes.len().saturating_sub(1);
+        if sizes != self.architecture().layer_sizes() || grad_q.len() != batch * sizes[layers] {
+            bail!("backward without the matching forward pass")
+        }
+        work.prepare_backward();
+        transpose(
+            grad_q,
+            sizes[layers],
+            batch,
+            sizes[layers],
+            &mut work.grad_out,
+            columns,
+        );
+        self.with_parameters(|p| {
+            for l in (0..layers).rev() {
+                let (inputs, outputs) = (sizes[l], sizes[l + 1]);
+                let stride = padded(inputs + 1);
+                let input = &work.activations[l];
+                transpose(input, columns, inputs, batch, &mut work.inputs, stride);
+                for row in work.inputs.chunks_exact_mut(stride).take(batch) {
+                    row[inputs] = 1.0;
+                }
+                let (weight, bias) = match &mut work.gradients.parameters[2 * l..] {
+                    [weight, bias, ..] => (weight, bias),
+                    _ => unreachable!("two gradients per layer"),
+                };
+                Product {
+                    rows: outputs,
+                    depth: batch,
+                    columns: stride,
+                    left: Strided {
+                        data: &work.grad_out,
+                        row_stride: columns,
+                        column_stride: 1,
+                    },
+                    right: &work.inputs,
+                    right_stride: stride,
+                    start: Start::Zero,
+                    finish: Finish::Keep,
+                }
+                .run(isa, &mut weight.values, stride);
+                for (o, db) in bias.values.iter_mut().enumerate() {
+                    *db = weight.values[o * stride + inputs];
+                }
+                if l > 0 {
+                    Product {
+                        rows: inputs,
+                        depth: outputs,
+                        columns,
+                        left: Strided {
+                            data: p[2 * l],
+                            row_stride: 1,
+                            column_stride: inputs,
+                        },
+                        right: &work.grad_out,
+                        right_stride: columns,
+                        start: Start::Zero,
+                        finish: Finish::MaskBy(input),
+                    }
+                    .run(isa, &mut work.grad_in, columns);
+                    std::mem::swap(&mut work.grad_out, &mut work.grad_in);
+                }
+            }
+        })
+    }
 }
 
 #[cfg(test)]
@@ -175,37 +385,83 @@ mod tests {
         x
     }
 
+    fn max_difference(a: &Tensor, b: &Tensor) -> f32 {
+        (a - b)
+            .unwrap()
+            .abs()
+            .unwrap()
+            .flatten_all()
+            .unwrap()
+            .max(0)
+            .unwrap()
+            .to_scalar::<f32>()
+            .unwrap()
+    }
+
+    /// Every path against candle's autograd, within rounding, and against each other, to the
+    /// bit; batches of 9 (a padded tail) and 40.
     #[test]
-    fn matches_candle_autograd() {
+    fn matches_candle_autograd_on_every_path() {
         let mut rng = StdRng::seed_from_u64(0);
-        let net = QNet::new(Architecture::new(4, &[7, 5, 6], 3), &mut rng).unwrap();
+        let net = QNet::new(Architecture::new(4, &[7, 21, 6], 3), &mut rng).unwrap();
         // Non-zero biases, so the ReLU masks differ from layer to layer.
         for var in net.parameters().iter().skip(1).step_by(2) {
             var.set(&Tensor::randn(0f32, 0.5, var.shape(), &Device::Cpu).unwrap())
                 .unwrap();
         }
-        let obs = Tensor::randn(0f32, 1.0, (9, 4), &Device::Cpu).unwrap();
-        let weights = Tensor::randn(0f32, 1.0, (9, 3), &Device::Cpu).unwrap();
+        let shapes: Vec<Vec<usize>> = net.parameters().iter().map(|p| p.dims().to_vec()).collect();
+        for batch in [9, 40] {
+            let obs = Tensor::randn(0f32, 1.0, (batch, 4), &Device::Cpu).unwrap();
+            let weights = Tensor::randn(0f32, 1.0, (batch, 3), &Device::Cpu).unwrap();
+            let reference_q = autograd_forward(&net, &obs);
+            let loss = (&reference_q * &weights).unwrap().sum_all().unwrap();
+            let reference = loss.backward().unwrap();
 
-        let reference_q = autograd_forward(&net, &obs);
-        let loss = (&reference_q * &weights).unwrap().sum_all().unwrap();
-        let reference = loss.backward().unwrap();
-
-        let (q, inputs) = net.forward_train(&obs).unwrap();
-        assert_eq!(
-            q.to_vec2::<f32>().unwrap(),
-            reference_q.to_vec2::<f32>().unwrap()
-        );
-        assert_eq!(
-            q.to_vec2::<f32>().unwrap(),
-            net.forward(&obs).unwrap().to_vec2::<f32>().unwrap()
-        );
-        let grads = net.backward(&inputs, weights).unwrap();
-        for (var, grad) in net.parameters().iter().zip(&grads) {
-            let want = reference.get(var).unwrap();
-            assert_eq!(grad.dims(), want.dims());
-            let diff = (grad - want).unwrap().abs().unwrap().max_all().unwrap();
-            assert!(diff.to_scalar::<f32>().unwrap() < 1e-5);
+            let obs_values = obs.flatten_all().unwrap().to_vec1::<f32>().unwrap();
+            let grad_q = weights.flatten_all().unwrap().to_vec1::<f32>().unwrap();
+            let mut seen: Option<(Vec<u32>, Vec<u32>)> = None;
+            for isa in Isa::ALL.into_iter().filter(|i| i.supported()) {
+                let mut work = Workspace::default();
+                let q = net
+                    .forward_with(isa, &obs_values, batch, &mut work)
+                    .unwrap();
+                let q = Tensor::from_slice(q, (batch, 3), &Device::Cpu).unwrap();
+                assert!(max_difference(&q, &reference_q) < 1e-5, "{isa:?}");
+                let q_bits = q
+                    .flatten_all()
+                    .unwrap()
+                    .to_vec1::<f32>()
+                    .unwrap()
+                    .iter()
+                    .map(|x| x.to_bits())
+                    .collect();
+                net.backward_with(isa, &mut work, &grad_q).unwrap();
+                let grads = work.gradients().to_tensors(&shapes).unwrap();
+                let mut grad_bits = Vec::new();
+                for (var, grad) in net.parameters().iter().zip(&grads) {
+                    let want = reference.get(var).unwrap();
+                    assert_eq!(grad.dims(), want.dims());
+                    assert!(max_difference(grad, want) < 1e-4, "{isa:?}");
+                    let values = grad.flatten_all().unwrap().to_vec1::<f32>().unwrap();
+                    grad_bits.extend(values.iter().map(|x| x.to_bits()));
+                }
+                match &seen {
+                    None => seen = Some((q_bits, grad_bits)),
+                    Some(first) => assert_eq!(first, &(q_bits, grad_bits), "{isa:?}"),
+                }
+            }
         }
+    }
+
+    #[test]
+    fn a_backward_needs_its_forward() {
+        let net = QNet::new(Architecture::new(2, &[3], 2), &mut StdRng::seed_from_u64(1)).unwrap();
+        let mut work = Workspace::default();
+        assert!(net
+            .backward_with(Isa::Portable, &mut work, &[0.0; 4])
+            .is_err());
+        assert!(net
+            .forward_with(Isa::Portable, &[0.0; 3], 2, &mut work)
+            .is_err());
     }
 }

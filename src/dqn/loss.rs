@@ -32,7 +32,7 @@ pub fn td_huber_loss(
     let batch = targets.len();
     assert_eq!(actions.len(), batch, "one action per row");
     assert!(
-        batch > 0 && q.len() % batch == 0,
+        batch > 0 && q.len().is_multiple_of(batch),
         "one row of Q-values per target"
     );
     let action_count = q.len() / batch;

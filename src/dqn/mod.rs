@@ -11,13 +11,14 @@ mod agent;
 mod backprop;
 mod error;
 mod exploration;
-mod host;
+pub mod kernels;
 mod loss;
 mod optim;
 mod qnet;
 mod replay;
 
 pub use agent::{DqnAgent, UpdateReport};
+pub use backprop::Gradients;
 pub use error::DqnError;
 pub use exploration::EpsilonGreedy;
 pub use loss::{huber, td_huber_loss};

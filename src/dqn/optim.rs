@@ -11,13 +11,15 @@
 //! with Table I's large ε (1e-3) Chainer's form takes smaller steps early on.
 //!
 //! candle-nn's `AdamW` spends about ten tensor operations (each an allocation) per parameter
-//! per step; this one reads the gradient and writes the parameter and moments in place.
+//! per step; this one reads the gradient and writes the parameter and moments in place, on
+//! the kernels' instruction set (`kernels/elementwise.rs`: the same bits on every path).
 
 use std::cell::RefCell;
 
-use candle_core::{bail, CpuStorage, InplaceOp2, Layout, Result, Tensor, Var};
+use candle_core::{bail, CpuStorage, InplaceOp1, Layout, Result, Var};
 
-use super::host::with_f32;
+use super::kernels::{adam_rows, AdamStep, Isa, Rows};
+use super::Gradients;
 use crate::config::DqnConfig;
 
 /// Adam state for one list of parameters.
@@ -55,105 +57,76 @@ impl Adam {
 
     /// One step on `parameters` (the same list, in the same order, as at construction)
     /// with their gradients `grads`, one per parameter.
-    pub fn step(&mut self, parameters: &[Var], grads: &[Tensor]) -> Result<()> {
+    pub fn step(&mut self, parameters: &[Var], grads: &Gradients) -> Result<()> {
         assert_eq!(
             parameters.len(),
             self.moments.len(),
             "parameter list changed"
         );
         assert_eq!(grads.len(), parameters.len(), "one gradient per parameter");
-        let grads: Vec<Tensor> = grads
-            .iter()
-            .map(Tensor::contiguous)
-            .collect::<Result<_>>()?;
+        // PyTorch's `clip_grad_norm_`: every gradient times `max / (‖g‖ + 1e-6)` if below 1.
         let clip = match self.max_grad_norm {
-            Some(max_norm) => clip_coefficient(&grads, max_norm)?,
+            Some(max_norm) => (max_norm / (grads.sum_of_squares().sqrt() + 1e-6)).min(1.0),
             None => 1.0,
         };
         self.t += 1;
         let correction1 = 1.0 - self.beta1.powi(self.t);
         let correction2 = 1.0 - self.beta2.powi(self.t);
-        let step_size = self.learning_rate * correction2.sqrt() / correction1;
-        for ((parameter, grad), (m, v)) in parameters.iter().zip(&grads).zip(&mut self.moments) {
+        let step = AdamStep {
+            step_size: (self.learning_rate * correction2.sqrt() / correction1) as f32,
+            beta1: self.beta1 as f32,
+            beta2: self.beta2 as f32,
+            epsilon: self.epsilon as f32,
+            clip: clip as f32,
+        };
+        let isa = Isa::current();
+        for ((parameter, grad), (m, v)) in
+            parameters.iter().zip(grads.rows()).zip(&mut self.moments)
+        {
             let kernel = AdamKernel {
-                m: RefCell::new(m),
-                v: RefCell::new(v),
-                step_size: step_size as f32,
-                beta1: self.beta1 as f32,
-                beta2: self.beta2 as f32,
-                epsilon: self.epsilon as f32,
-                clip: clip as f32,
+                isa,
+                step,
+                grad,
+                moments: RefCell::new((m, v)),
             };
-            parameter.as_tensor().inplace_op2(grad, &kernel)?;
+            parameter.as_tensor().inplace_op1(&kernel)?;
         }
         Ok(())
     }
 }
 
-/// PyTorch's `clip_grad_norm_`: scale every gradient by `max / (‖g‖ + 1e-6)` when below 1.
-fn clip_coefficient(grads: &[Tensor], max_norm: f64) -> Result<f64> {
-    let mut sum_sq = 0.0f64;
-    for grad in grads {
-        sum_sq += with_f32(grad, |g| {
-            g.iter().map(|&x| f64::from(x).powi(2)).sum::<f64>()
-        })?;
-    }
-    Ok((max_norm / (sum_sq.sqrt() + 1e-6)).min(1.0))
-}
-
 struct AdamKernel<'a> {
-    /// `InplaceOp2::cpu_fwd` takes `&self`; the moments are this step's only other writes.
-    m: RefCell<&'a mut Vec<f32>>,
-    v: RefCell<&'a mut Vec<f32>>,
-    step_size: f32,
-    beta1: f32,
-    beta2: f32,
-    epsilon: f32,
-    clip: f32,
+    isa: Isa,
+    step: AdamStep,
+    grad: Rows<'a>,
+    /// `InplaceOp1::cpu_fwd` takes `&self`; the moments are this step's only other writes.
+    moments: RefCell<(&'a mut Vec<f32>, &'a mut Vec<f32>)>,
 }
 
-impl InplaceOp2 for AdamKernel<'_> {
+impl InplaceOp1 for AdamKernel<'_> {
     fn name(&self) -> &'static str {
         "adam-step"
     }
 
-    fn cpu_fwd(
-        &self,
-        dst: &mut CpuStorage,
-        dst_l: &Layout,
-        src: &CpuStorage,
-        src_l: &Layout,
-    ) -> Result<()> {
-        let (CpuStorage::F32(theta), CpuStorage::F32(grad)) = (dst, src) else {
+    fn cpu_fwd(&self, storage: &mut CpuStorage, layout: &Layout) -> Result<()> {
+        let CpuStorage::F32(theta) = storage else {
             bail!("adam-step works on f32 parameters")
         };
-        let (Some((t0, t1)), Some((g0, g1))) =
-            (dst_l.contiguous_offsets(), src_l.contiguous_offsets())
-        else {
-            bail!("adam-step needs contiguous parameters and gradients")
+        let Some((start, end)) = layout.contiguous_offsets() else {
+            bail!("adam-step needs contiguous parameters")
         };
-        let (theta, grad) = (&mut theta[t0..t1], &grad[g0..g1]);
-        let (mut m, mut v) = (self.m.borrow_mut(), self.v.borrow_mut());
-        if grad.len() != theta.len() || m.len() != theta.len() {
+        let theta = &mut theta[start..end];
+        let (m, v) = &mut *self.moments.borrow_mut();
+        let rows = theta.len() / self.grad.columns.max(1);
+        if m.len() != theta.len() || rows * self.grad.columns != theta.len() {
             bail!(
-                "adam-step: {} values, {} gradients, {} moments",
+                "adam-step: {} values, rows of {} gradients, {} moments",
                 theta.len(),
-                grad.len(),
+                self.grad.columns,
                 m.len()
             )
         }
-        let (b1, b2) = (self.beta1, self.beta2);
-        for (((p, &g), m), v) in theta
-            .iter_mut()
-            .zip(grad)
-            .zip(m.iter_mut())
-            .zip(v.iter_mut())
-        {
-            let g = g * self.clip;
-            *m += (1.0 - b1) * (g - *m);
-            *v += (1.0 - b2) * (g * g - *v);
-            *p -= self.step_size * *m / (v.sqrt() + self.epsilon);
-        }
+        adam_rows(self.isa, &self.step, theta, m, v, self.grad);
         Ok(())
     }
 }
@@ -161,7 +134,7 @@ impl InplaceOp2 for AdamKernel<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use candle_core::Device;
+    use candle_core::{Device, Tensor};
 
     fn config() -> DqnConfig {
         DqnConfig::default()
@@ -169,7 +142,8 @@ mod tests {
 
     fn step(adam: &mut Adam, theta: &Var, loss: &Tensor) {
         let grad = loss.backward().unwrap().get(theta).unwrap().clone();
-        adam.step(std::slice::from_ref(theta), &[grad]).unwrap();
+        let grads = Gradients::from_tensors(&[grad]).unwrap();
+        adam.step(std::slice::from_ref(theta), &grads).unwrap();
     }
 
     /// Chainer's update written out for one scalar parameter.

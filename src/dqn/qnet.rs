@@ -1,13 +1,16 @@
 //! The Q-network: a multilayer perceptron with ReLU between layers and a linear output,
 //! one Q-value per action.
 
-use candle_core::{DType, Device, Tensor, Var};
+use std::cell::RefCell;
+
+use candle_core::{DType, Device, Module, Tensor, Var};
 use candle_nn::Linear;
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use super::host::with_f32;
+use super::backprop::Workspace;
+use super::kernels::Isa;
 use super::DqnError;
 
 /// The shape of a Q-network.
@@ -39,12 +42,20 @@ impl Architecture {
         Ok(())
     }
 
-    /// `(out, in)` of each linear layer, input side first.
-    pub fn layer_shapes(&self) -> Vec<(usize, usize)> {
+    /// Units of every layer: the observation, each hidden layer, the actions.
+    pub fn layer_sizes(&self) -> Vec<usize> {
         let mut sizes = vec![self.observation_size];
         sizes.extend(&self.hidden);
         sizes.push(self.action_count);
-        sizes.windows(2).map(|w| (w[1], w[0])).collect()
+        sizes
+    }
+
+    /// `(out, in)` of each linear layer, input side first.
+    pub fn layer_shapes(&self) -> Vec<(usize, usize)> {
+        self.layer_sizes()
+            .windows(2)
+            .map(|w| (w[1], w[0]))
+            .collect()
     }
 
     /// Name and shape of every parameter, in the order of [`QNet::parameters`]:
@@ -93,8 +104,7 @@ pub enum Init {
 #[derive(Debug)]
 pub struct QNet {
     architecture: Architecture,
-    /// Detached views of the parameters: the passes in `backprop.rs` never need candle to
-    /// record a graph.
+    /// candle-nn's layers over the same parameters: [`QNet::reference_forward`].
     layers: Vec<Linear>,
     /// Weight then bias of each layer; the layers share their storage.
     parameters: Vec<Var>,
@@ -205,18 +215,42 @@ impl QNet {
             .collect()
     }
 
-    pub(super) fn layers(&self) -> &[Linear] {
-        &self.layers
+    /// Q-values `[batch, action_count]` of observations `[batch, observation_size]`, on this
+    /// CPU's kernels (the training path: the same bits on every CPU).
+    pub fn forward(&self, obs: &Tensor) -> candle_core::Result<Tensor> {
+        let (batch, _) = obs.dims2()?;
+        let values = obs.to_dtype(DType::F32)?.flatten_all()?.to_vec1::<f32>()?;
+        let mut work = Workspace::default();
+        let q = self.forward_with(Isa::current(), &values, batch, &mut work)?;
+        Tensor::from_slice(q, (batch, self.architecture.action_count), &Device::Cpu)
     }
 
-    /// Q-values `[batch, action_count]` of observations `[batch, observation_size]`.
-    /// Not differentiable by candle's autograd; training uses `backprop.rs`.
-    pub fn forward(&self, obs: &Tensor) -> candle_core::Result<Tensor> {
-        Ok(self.forward_train(obs)?.0)
+    /// The same Q-values through candle-nn's `Linear` layers and candle's matrix products:
+    /// the reference the kernels are checked against (equal within rounding, not to the bit).
+    pub fn reference_forward(&self, obs: &Tensor) -> candle_core::Result<Tensor> {
+        let last = self.layers.len() - 1;
+        let mut x = obs.clone();
+        for (i, layer) in self.layers.iter().enumerate() {
+            x = layer.forward(&x)?;
+            if i < last {
+                x = x.relu()?;
+            }
+        }
+        Ok(x)
     }
 
     /// Q-values of one observation.
     pub fn q_values(&self, obs: &[f32]) -> Result<Vec<f32>, DqnError> {
+        self.with_q_values(obs, <[f32]>::to_vec)
+    }
+
+    /// The action of highest Q-value; ties go to the lowest index, as `argmax` does.
+    pub fn greedy_action(&self, obs: &[f32]) -> Result<usize, DqnError> {
+        self.with_q_values(obs, argmax)
+    }
+
+    /// Calls `f` with the Q-values of one observation.
+    fn with_q_values<R>(&self, obs: &[f32], f: impl FnOnce(&[f32]) -> R) -> Result<R, DqnError> {
         let expected = self.architecture.observation_size;
         if obs.len() != expected {
             return Err(DqnError::ObservationSize {
@@ -224,13 +258,11 @@ impl QNet {
                 got: obs.len(),
             });
         }
-        let x = Tensor::from_slice(obs, (1, expected), &Device::Cpu)?;
-        Ok(with_f32(&self.forward(&x)?, <[f32]>::to_vec)?)
-    }
-
-    /// The action of highest Q-value; ties go to the lowest index, as `argmax` does.
-    pub fn greedy_action(&self, obs: &[f32]) -> Result<usize, DqnError> {
-        Ok(argmax(&self.q_values(obs)?))
+        thread_local! {
+            /// Acting is one forward pass per step: its buffers are kept per thread.
+            static ACTING: RefCell<Workspace> = RefCell::default();
+        }
+        ACTING.with_borrow_mut(|work| Ok(f(self.forward_with(Isa::current(), obs, 1, work)?)))
     }
 
     /// Overwrites this network's parameters with `source`'s (the hard target update).

@@ -223,8 +223,8 @@ mod tests {
             action: i % 2,
             reward: i as f64,
             next_obs: obs,
-            terminated: i % 3 == 0,
-            truncated: i % 5 == 0,
+            terminated: i.is_multiple_of(3),
+            truncated: i.is_multiple_of(5),
         }
     }
 
@@ -261,8 +261,8 @@ mod tests {
             let i = batch.obs()[b] as usize;
             assert_eq!(batch.rewards()[b], i as f32);
             assert_eq!(batch.actions()[b] as usize, i % 2);
-            assert_eq!(batch.terminated()[b], i % 3 == 0);
-            assert_eq!(batch.truncated()[b], i % 5 == 0);
+            assert_eq!(batch.terminated()[b], i.is_multiple_of(3));
+            assert_eq!(batch.truncated()[b], i.is_multiple_of(5));
         }
         let capacity = batch.obs.capacity();
         buffer.sample_into(32, &mut batch, &mut rng);

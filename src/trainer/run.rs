@@ -454,7 +454,7 @@ pub fn train(
             if snapshots
                 && (control.is_slow()
                     || (spec.stream.snapshot_interval != Duration::MAX
-                        && steps % 16 == 0
+                        && steps.is_multiple_of(16)
                         && last_snapshot.elapsed() >= spec.stream.snapshot_interval))
             {
                 let _ = events.send(snapshot(selector.as_ref(), &tally, steps, episode));

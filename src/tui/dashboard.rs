@@ -100,7 +100,7 @@ impl Curve {
         if self.stride == 0 {
             self.stride = 1;
         }
-        if self.seen % self.stride != 0 {
+        if !self.seen.is_multiple_of(self.stride) {
             return;
         }
         let mean = self.window.iter().sum::<f64>() / self.window.len() as f64;

@@ -1,0 +1,80 @@
+//! The products with AVX2 and FMA: tiles of up to 6 output rows by 2 vectors of 8 columns,
+//! twelve accumulators in the sixteen registers.
+
+#![cfg(target_arch = "x86_64")]
+
+use std::arch::x86_64::*;
+
+use super::{Finish, Product, Start};
+
+const WIDTH: usize = 8;
+const ROWS: usize = 6;
+
+/// # Safety
+/// The CPU has AVX2 and FMA and `p.check` has passed for `out` (so the columns are a
+/// multiple of 16, two vectors).
+#[target_feature(enable = "avx2,fma")]
+pub(super) unsafe fn product(p: &Product, out: &mut [f32], out_stride: usize) {
+    for j in (0..p.columns).step_by(2 * WIDTH) {
+        let mut r = 0;
+        while r + ROWS <= p.rows {
+            tile::<ROWS>(p, out, out_stride, r, j);
+            r += ROWS;
+        }
+        match p.rows - r {
+            0 => {}
+            1 => tile::<1>(p, out, out_stride, r, j),
+            2 => tile::<2>(p, out, out_stride, r, j),
+            3 => tile::<3>(p, out, out_stride, r, j),
+            4 => tile::<4>(p, out, out_stride, r, j),
+            _ => tile::<5>(p, out, out_stride, r, j),
+        }
+    }
+}
+
+/// Rows `r0..r0 + R`, columns `j..j + 16`.
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+unsafe fn tile<const R: usize>(
+    p: &Product,
+    out: &mut [f32],
+    out_stride: usize,
+    r0: usize,
+    j: usize,
+) {
+    let left = p.left.data.as_ptr();
+    let (lr, lk) = (p.left.row_stride, p.left.column_stride);
+    let right = p.right.as_ptr().add(j);
+    let mut acc = [[_mm256_setzero_ps(); 2]; R];
+    if let Start::Bias(bias) = p.start {
+        for (r, row) in acc.iter_mut().enumerate() {
+            *row = [_mm256_set1_ps(*bias.get_unchecked(r0 + r)); 2];
+        }
+    }
+    for k in 0..p.depth {
+        let x = right.add(k * p.right_stride);
+        let xs = [_mm256_loadu_ps(x), _mm256_loadu_ps(x.add(WIDTH))];
+        for (r, row) in acc.iter_mut().enumerate() {
+            let l = _mm256_set1_ps(*left.add((r0 + r) * lr + k * lk));
+            for (a, &xv) in row.iter_mut().zip(&xs) {
+                *a = _mm256_fmadd_ps(l, xv, *a);
+            }
+        }
+    }
+    let zero = _mm256_setzero_ps();
+    for (r, row) in acc.iter().enumerate() {
+        let at = (r0 + r) * out_stride + j;
+        for (v, &a) in row.iter().enumerate() {
+            let at = at + v * WIDTH;
+            let value = match p.finish {
+                Finish::Keep => a,
+                Finish::Relu => _mm256_max_ps(a, zero),
+                Finish::MaskBy(by) => {
+                    let by = _mm256_loadu_ps(by.as_ptr().add(at));
+                    _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(by, zero), a)
+                }
+            };
+            _mm256_storeu_ps(out.as_mut_ptr().add(at), value);
+        }
+    }
+}

@@ -1,0 +1,114 @@
+//! The products with AVX-512: tiles of 12 output rows by 2 vectors of 16 columns, or 6 rows
+//! by 4 vectors, every accumulator in a register (24 of the 32), one broadcast of the left
+//! operand per row and step of the sum.
+
+#![cfg(target_arch = "x86_64")]
+
+use std::arch::x86_64::*;
+
+use super::{Finish, Product, Start};
+
+const WIDTH: usize = 16;
+
+/// # Safety
+/// The CPU has AVX-512F and `p.check` has passed for `out`.
+#[target_feature(enable = "avx512f")]
+pub(super) unsafe fn product(p: &Product, out: &mut [f32], out_stride: usize) {
+    let mut j = 0;
+    while j < p.columns {
+        match (p.columns - j) / WIDTH {
+            4.. => {
+                rows::<6, 4>(p, out, out_stride, j);
+                j += 4 * WIDTH;
+            }
+            2 | 3 => {
+                rows::<12, 2>(p, out, out_stride, j);
+                j += 2 * WIDTH;
+            }
+            _ => {
+                rows::<12, 1>(p, out, out_stride, j);
+                j += WIDTH;
+            }
+        }
+    }
+}
+
+/// Every row of the columns `j..j + 16·V`, `R` rows at a time, then 6, then the rest.
+#[target_feature(enable = "avx512f")]
+unsafe fn rows<const R: usize, const V: usize>(
+    p: &Product,
+    out: &mut [f32],
+    out_stride: usize,
+    j: usize,
+) {
+    let mut r = 0;
+    while r + R <= p.rows {
+        tile::<R, V>(p, out, out_stride, r, j);
+        r += R;
+    }
+    while r + 6 <= p.rows {
+        tile::<6, V>(p, out, out_stride, r, j);
+        r += 6;
+    }
+    match p.rows - r {
+        0 => {}
+        1 => tile::<1, V>(p, out, out_stride, r, j),
+        2 => tile::<2, V>(p, out, out_stride, r, j),
+        3 => tile::<3, V>(p, out, out_stride, r, j),
+        4 => tile::<4, V>(p, out, out_stride, r, j),
+        _ => tile::<5, V>(p, out, out_stride, r, j),
+    }
+}
+
+/// Rows `r0..r0 + R`, columns `j..j + 16·V`.
+#[target_feature(enable = "avx512f")]
+#[inline]
+unsafe fn tile<const R: usize, const V: usize>(
+    p: &Product,
+    out: &mut [f32],
+    out_stride: usize,
+    r0: usize,
+    j: usize,
+) {
+    let left = p.left.data.as_ptr();
+    let (lr, lk) = (p.left.row_stride, p.left.column_stride);
+    let right = p.right.as_ptr().add(j);
+    let mut acc = [[_mm512_setzero_ps(); V]; R];
+    if let Start::Bias(bias) = p.start {
+        for (r, row) in acc.iter_mut().enumerate() {
+            *row = [_mm512_set1_ps(*bias.get_unchecked(r0 + r)); V];
+        }
+    }
+    for k in 0..p.depth {
+        let x = right.add(k * p.right_stride);
+        let mut xs = [_mm512_setzero_ps(); V];
+        for (v, xv) in xs.iter_mut().enumerate() {
+            *xv = _mm512_loadu_ps(x.add(v * WIDTH));
+        }
+        for (r, row) in acc.iter_mut().enumerate() {
+            let l = _mm512_set1_ps(*left.add((r0 + r) * lr + k * lk));
+            for (a, &xv) in row.iter_mut().zip(&xs) {
+                *a = _mm512_fmadd_ps(l, xv, *a);
+            }
+        }
+    }
+    let zero = _mm512_setzero_ps();
+    for (r, row) in acc.iter().enumerate() {
+        let at = (r0 + r) * out_stride + j;
+        for (v, &a) in row.iter().enumerate() {
+            let at = at + v * WIDTH;
+            let value = match p.finish {
+                Finish::Keep => a,
+                Finish::Relu => _mm512_max_ps(a, zero),
+                Finish::MaskBy(by) => {
+                    let keep = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(
+                        _mm512_loadu_ps(by.as_ptr().add(at)),
+                        zero,
+                    );
+                    _mm512_maskz_mov_ps(keep, a)
+                }
+            };
+            _mm512_storeu_ps(out.as_mut_ptr().add(at), value);
+        }
+    }
+}

@@ -1,0 +1,188 @@
+//! Adam's update, one source compiled once per instruction set: the compiler vectorises the
+//! loop but, as Rust never fuses a multiply and an add on its own, each lane rounds as the
+//! scalar loop does.
+
+use super::Isa;
+
+/// Chainer's Adam for one step (see `optim.rs`), with the step's bias-corrected step size
+/// and the gradient's clipping factor.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AdamStep {
+    pub step_size: f32,
+    pub beta1: f32,
+    pub beta2: f32,
+    pub epsilon: f32,
+    pub clip: f32,
+}
+
+/// Moments smaller than this are set to zero. A weight whose gradient stays 0 (a dead ReLU
+/// unit's) has moments that shrink geometrically, by β₁ and β₂ a step, into f32's
+/// subnormal range, and arithmetic on subnormals costs x86 a microcode assist each: Adam
+/// ran 35× slower on them (measured, BENCHMARKS.md). Above `1e-30` every intermediate of
+/// the update stays normal (the smallest normal is 1.2e-38); the step such a moment gives,
+/// `α·m / (√v + ε)`, is below 1e-30·α/ε, far under any weight's last bit. A flush written
+/// as a comparison rounds nothing, so every path gives the same bits (FTZ/DAZ modes would
+/// not: they are x86's, and ARM's differ).
+pub(crate) const MOMENT_FLOOR: f32 = 1e-30;
+
+/// Gradients smaller than this count as zero, so that `g²` stays normal too.
+pub(crate) const GRADIENT_FLOOR: f32 = 1e-18;
+
+/// `x`, or `+0` if `|x| < floor`.
+#[inline(always)]
+fn flush(x: f32, floor: f32) -> f32 {
+    if x.abs() < floor {
+        0.0
+    } else {
+        x
+    }
+}
+
+/// A gradient stored in rows of `columns` values that lie `stride` apart.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Rows<'a> {
+    pub values: &'a [f32],
+    pub columns: usize,
+    pub stride: usize,
+}
+
+/// One Adam step on a parameter (`theta`, and its moments `m` and `v`, stored densely in
+/// rows of `grad.columns` values).
+///
+/// # Panics
+/// If the slices do not hold the same number of rows.
+pub(crate) fn adam_rows(
+    isa: Isa,
+    step: &AdamStep,
+    theta: &mut [f32],
+    m: &mut [f32],
+    v: &mut [f32],
+    grad: Rows,
+) {
+    let Rows {
+        values: grad,
+        columns,
+        stride: grad_stride,
+    } = grad;
+    if columns == 0 {
+        return;
+    }
+    let rows = theta.len() / columns;
+    assert!(theta.len() == rows * columns && m.len() == theta.len() && v.len() == theta.len());
+    assert!(grad_stride >= columns && grad.len() >= rows.saturating_sub(1) * grad_stride + columns);
+    match isa {
+        // SAFETY: the CPU has the features (`Isa::supported`, checked by the caller's
+        // choice of path); the body is safe Rust.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 if isa.supported() => unsafe {
+            adam_avx512(step, theta, m, v, grad, columns, grad_stride)
+        },
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 if isa.supported() => unsafe {
+            adam_avx2(step, theta, m, v, grad, columns, grad_stride)
+        },
+        _ => adam_body(step, theta, m, v, grad, columns, grad_stride),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn adam_avx512(
+    step: &AdamStep,
+    theta: &mut [f32],
+    m: &mut [f32],
+    v: &mut [f32],
+    grad: &[f32],
+    columns: usize,
+    grad_stride: usize,
+) {
+    adam_body(step, theta, m, v, grad, columns, grad_stride)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn adam_avx2(
+    step: &AdamStep,
+    theta: &mut [f32],
+    m: &mut [f32],
+    v: &mut [f32],
+    grad: &[f32],
+    columns: usize,
+    grad_stride: usize,
+) {
+    adam_body(step, theta, m, v, grad, columns, grad_stride)
+}
+
+/// `m ← m + (1 − β₁)(g − m)`, `v ← v + (1 − β₂)(g² − v)`, `θ ← θ − α·m / (√v + ε)`,
+/// with tiny values set to zero (see [`MOMENT_FLOOR`]).
+#[inline(always)]
+fn adam_body(
+    step: &AdamStep,
+    theta: &mut [f32],
+    m: &mut [f32],
+    v: &mut [f32],
+    grad: &[f32],
+    columns: usize,
+    grad_stride: usize,
+) {
+    let (b1, b2) = (step.beta1, step.beta2);
+    let rows = theta
+        .chunks_exact_mut(columns)
+        .zip(m.chunks_exact_mut(columns))
+        .zip(v.chunks_exact_mut(columns))
+        .zip(grad.chunks(grad_stride));
+    for (((theta, m), v), grad) in rows {
+        let values = theta.iter_mut().zip(m).zip(v).zip(&grad[..columns]);
+        for (((p, m), v), &g) in values {
+            let g = flush(g * step.clip, GRADIENT_FLOOR);
+            *m = flush(*m + (1.0 - b1) * (g - *m), MOMENT_FLOOR);
+            *v = flush(*v + (1.0 - b2) * (g * g - *v), MOMENT_FLOOR);
+            *p -= step.step_size * *m / (v.sqrt() + step.epsilon);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{rngs::StdRng, Rng, SeedableRng};
+
+    #[test]
+    fn every_path_gives_the_same_bits() {
+        let mut rng = StdRng::seed_from_u64(5);
+        let (rows, columns, stride) = (7, 37, 48);
+        let grad: Vec<f32> = (0..rows * stride)
+            .map(|_| rng.random_range(-3.0..3.0))
+            .collect();
+        let start: Vec<f32> = (0..rows * columns)
+            .map(|_| rng.random_range(-1.0..1.0))
+            .collect();
+        let step = AdamStep {
+            step_size: 1e-3,
+            beta1: 0.9,
+            beta2: 0.999,
+            epsilon: 1e-3,
+            clip: 0.7,
+        };
+        let mut results = Vec::new();
+        for isa in Isa::ALL.into_iter().filter(|i| i.supported()) {
+            let (mut theta, mut m, mut v) = (start.clone(), start.clone(), start.clone());
+            for value in v.iter_mut() {
+                *value = value.abs();
+            }
+            for _ in 0..3 {
+                let rows = Rows {
+                    values: &grad,
+                    columns,
+                    stride,
+                };
+                adam_rows(isa, &step, &mut theta, &mut m, &mut v, rows);
+            }
+            let bits = |x: &[f32]| x.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
+            results.push((bits(&theta), bits(&m), bits(&v)));
+        }
+        for other in &results[1..] {
+            assert_eq!(&results[0], other);
+        }
+    }
+}
