@@ -89,7 +89,10 @@ impl DqnAgent {
         rng: &mut impl Rng,
     ) -> Result<Option<UpdateReport>, DqnError> {
         self.steps += 1;
-        if self.steps.is_multiple_of(self.config.target_update_interval) {
+        if self
+            .steps
+            .is_multiple_of(self.config.target_update_interval)
+        {
             self.sync_target()?;
         }
         if replay.len() < self.config.replay_start_size

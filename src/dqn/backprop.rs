@@ -19,7 +19,9 @@
 
 use candle_core::{bail, Result, Storage, Tensor};
 
-use super::kernels::{padded, transpose, Finish, Isa, Product, Rows, Start, Strided};
+use super::kernels::{
+    largest_magnitude_bits, padded, transpose, Buffer, Finish, Isa, Product, Rows, Start, Strided,
+};
 use super::{Architecture, QNet};
 
 /// Scratch memory of the passes, for one architecture and batch size at a time; kept between
@@ -32,15 +34,15 @@ pub(crate) struct Workspace {
     /// `padded(batch)`: the column count of every transposed buffer.
     columns: usize,
     /// The input of each layer, then the Q-values: `[units, columns]`.
-    activations: Vec<Vec<f32>>,
+    activations: Vec<Buffer>,
     /// The Q-values `[batch, actions]`.
     q: Vec<f32>,
     /// A layer's input and a column of ones `[batch, padded(units + 1)]`, for its weights'
     /// and bias's gradients.
-    inputs: Vec<f32>,
+    inputs: Buffer,
     /// ∂z of the layer being differentiated and ∂a of its input, `[units, columns]`.
-    grad_out: Vec<f32>,
-    grad_in: Vec<f32>,
+    grad_out: Buffer,
+    grad_in: Buffer,
     gradients: Gradients,
 }
 
@@ -55,9 +57,9 @@ impl Workspace {
             return;
         }
         let columns = padded(batch);
-        self.activations.resize_with(sizes.len(), Vec::new);
+        self.activations.resize_with(sizes.len(), Buffer::default);
         for (buffer, &units) in self.activations.iter_mut().zip(&sizes) {
-            buffer.resize(units * columns, 0.0);
+            buffer.resize(units * columns);
         }
         self.q.resize(batch * architecture.action_count, 0.0);
         (self.sizes, self.batch, self.columns) = (sizes, batch, columns);
@@ -66,9 +68,9 @@ impl Workspace {
     /// Sizes the backward pass's buffers for the shape of the last forward pass.
     fn prepare_backward(&mut self) {
         let widest = self.sizes.iter().copied().max().unwrap_or(0);
-        self.inputs.resize(self.batch * padded(widest + 1), 0.0);
-        self.grad_out.resize(widest * self.columns, 0.0);
-        self.grad_in.resize(widest * self.columns, 0.0);
+        self.inputs.resize(self.batch * padded(widest + 1));
+        self.grad_out.resize(widest * self.columns);
+        self.grad_in.resize(widest * self.columns);
         let shapes = self.sizes.windows(2).flat_map(|w| {
             let (inputs, outputs) = (w[0], w[1]);
             [(outputs, inputs, padded(inputs + 1)), (1, outputs, outputs)]
@@ -102,7 +104,7 @@ pub struct Gradients {
 /// padded to whole vectors, and hold its bias's gradient in column `columns`).
 #[derive(Debug, Clone)]
 struct ParameterGradient {
-    values: Vec<f32>,
+    values: Buffer,
     columns: usize,
     stride: usize,
 }
@@ -110,7 +112,7 @@ struct ParameterGradient {
 impl ParameterGradient {
     fn zeros(rows: usize, columns: usize, stride: usize) -> Self {
         Self {
-            values: vec![0.0; rows * stride],
+            values: Buffer::zeros(rows * stride),
             columns,
             stride,
         }
@@ -130,7 +132,9 @@ impl Gradients {
             .iter()
             .map(|t| {
                 let columns = t.dims().last().copied().unwrap_or(1);
-                let values = t.flatten_all()?.to_vec1::<f32>()?;
+                let dense = t.flatten_all()?.to_vec1::<f32>()?;
+                let mut values = Buffer::zeros(dense.len());
+                values.copy_from_slice(&dense);
                 Ok(ParameterGradient {
                     values,
                     columns,
@@ -163,14 +167,9 @@ impl Gradients {
 
     /// Whether every value is finite.
     pub fn all_finite(&self) -> bool {
-        // The largest magnitude's bits, without an early exit, so the loop vectorises.
-        let largest = |row: &[f32]| {
-            row.iter()
-                .fold(0u32, |most, x| most.max(x.to_bits() & 0x7fff_ffff))
-        };
-        self.parameters
-            .iter()
-            .all(|p| p.rows().all(|row| largest(row) < f32::INFINITY.to_bits()))
+        let isa = Isa::current();
+        self.rows()
+            .all(|rows| largest_magnitude_bits(isa, rows) < f32::INFINITY.to_bits())
     }
 
     /// `Σ g²` over every value, in `f64`, parameter by parameter.
@@ -239,6 +238,7 @@ impl QNet {
         let columns = work.columns;
         let sizes = &work.sizes;
         transpose(
+            isa,
             obs,
             sizes[0],
             batch,
@@ -274,6 +274,7 @@ impl QNet {
         })?;
         let actions = sizes[layers];
         transpose(
+            isa,
             &work.activations[layers],
             columns,
             actions,
@@ -300,6 +301,7 @@ impl QNet {
         }
         work.prepare_backward();
         transpose(
+            isa,
             grad_q,
             sizes[layers],
             batch,
@@ -312,7 +314,7 @@ impl QNet {
                 let (inputs, outputs) = (sizes[l], sizes[l + 1]);
                 let stride = padded(inputs + 1);
                 let input = &work.activations[l];
-                transpose(input, columns, inputs, batch, &mut work.inputs, stride);
+                transpose(isa, input, columns, inputs, batch, &mut work.inputs, stride);
                 for row in work.inputs.chunks_exact_mut(stride).take(batch) {
                     row[inputs] = 1.0;
                 }

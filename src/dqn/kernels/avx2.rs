@@ -78,3 +78,52 @@ unsafe fn tile<const R: usize>(
         }
     }
 }
+
+/// The 8 × 8 blocks of `transpose`: rows `0..rows` and columns `0..columns`, both multiples
+/// of 8, by the classic unpack, shuffle and lane-permute network.
+///
+/// # Safety
+/// The CPU has AVX2; `src` and `dst` hold every block (checked by `transpose`).
+#[target_feature(enable = "avx2")]
+pub(super) unsafe fn transpose_blocks(
+    src: &[f32],
+    src_stride: usize,
+    rows: usize,
+    columns: usize,
+    dst: &mut [f32],
+    dst_stride: usize,
+) {
+    let (src, dst) = (src.as_ptr(), dst.as_mut_ptr());
+    for i in (0..rows).step_by(8) {
+        for j in (0..columns).step_by(8) {
+            let r: [__m256; 8] =
+                std::array::from_fn(|k| _mm256_loadu_ps(src.add((i + k) * src_stride + j)));
+            let t = [
+                _mm256_unpacklo_ps(r[0], r[1]),
+                _mm256_unpackhi_ps(r[0], r[1]),
+                _mm256_unpacklo_ps(r[2], r[3]),
+                _mm256_unpackhi_ps(r[2], r[3]),
+                _mm256_unpacklo_ps(r[4], r[5]),
+                _mm256_unpackhi_ps(r[4], r[5]),
+                _mm256_unpacklo_ps(r[6], r[7]),
+                _mm256_unpackhi_ps(r[6], r[7]),
+            ];
+            let u = [
+                _mm256_shuffle_ps::<0x44>(t[0], t[2]),
+                _mm256_shuffle_ps::<0xEE>(t[0], t[2]),
+                _mm256_shuffle_ps::<0x44>(t[1], t[3]),
+                _mm256_shuffle_ps::<0xEE>(t[1], t[3]),
+                _mm256_shuffle_ps::<0x44>(t[4], t[6]),
+                _mm256_shuffle_ps::<0xEE>(t[4], t[6]),
+                _mm256_shuffle_ps::<0x44>(t[5], t[7]),
+                _mm256_shuffle_ps::<0xEE>(t[5], t[7]),
+            ];
+            for k in 0..4 {
+                let low = _mm256_permute2f128_ps::<0x20>(u[k], u[k + 4]);
+                let high = _mm256_permute2f128_ps::<0x31>(u[k], u[k + 4]);
+                _mm256_storeu_ps(dst.add((j + k) * dst_stride + i), low);
+                _mm256_storeu_ps(dst.add((j + k + 4) * dst_stride + i), high);
+            }
+        }
+    }
+}

@@ -142,6 +142,43 @@ fn adam_body(
     }
 }
 
+/// `max |x|` of a gradient's rows, as bits: see `kernels::largest_magnitude_bits`.
+pub(super) fn largest_magnitude_bits(isa: Isa, rows: Rows) -> u32 {
+    match isa {
+        // SAFETY: as in `adam_rows`.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 if isa.supported() => unsafe { largest_avx512(rows) },
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 if isa.supported() => unsafe { largest_avx2(rows) },
+        _ => largest_body(rows),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn largest_avx512(rows: Rows) -> u32 {
+    largest_body(rows)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn largest_avx2(rows: Rows) -> u32 {
+    largest_body(rows)
+}
+
+#[inline(always)]
+fn largest_body(rows: Rows) -> u32 {
+    rows.values
+        .chunks(rows.stride.max(1))
+        .map(|row| {
+            row[..rows.columns]
+                .iter()
+                .fold(0u32, |most, x| most.max(x.to_bits() & 0x7fff_ffff))
+        })
+        .max()
+        .unwrap_or(0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -19,11 +19,13 @@
 
 mod avx2;
 mod avx512;
+mod buffer;
 mod elementwise;
 mod portable;
 
 use std::sync::OnceLock;
 
+pub(crate) use buffer::Buffer;
 pub(crate) use elementwise::{adam_rows, AdamStep, Rows};
 
 /// Lanes the column count of a product is padded to: one AVX-512 vector, two of AVX2.
@@ -227,9 +229,11 @@ impl Product<'_> {
     }
 }
 
-/// `dst[j·dst_stride + i] = src[i·src_stride + j]` for `i < rows`, `j < columns`, in
-/// blocks of 16 × 16 so that both sides stay in L1 (a layer's activations need not).
+/// `dst[j·dst_stride + i] = src[i·src_stride + j]` for `i < rows`, `j < columns`: 8 × 8
+/// blocks in AVX registers where the CPU has AVX2, the edges (and other CPUs) one value
+/// at a time. A copy rounds nothing: every path gives the same result.
 pub(crate) fn transpose(
+    isa: Isa,
     src: &[f32],
     src_stride: usize,
     rows: usize,
@@ -237,20 +241,51 @@ pub(crate) fn transpose(
     dst: &mut [f32],
     dst_stride: usize,
 ) {
-    const BLOCK: usize = 16;
-    for i0 in (0..rows).step_by(BLOCK) {
-        let i1 = (i0 + BLOCK).min(rows);
-        for j0 in (0..columns).step_by(BLOCK) {
-            let j1 = (j0 + BLOCK).min(columns);
-            for j in j0..j1 {
-                let out = &mut dst[j * dst_stride + i0..][..i1 - i0];
-                let column = src[i0 * src_stride + j..].iter().step_by(src_stride);
-                for (d, &x) in out.iter_mut().zip(column) {
-                    *d = x;
+    if rows == 0 || columns == 0 {
+        return;
+    }
+    assert!(src_stride >= columns && src.len() >= (rows - 1) * src_stride + columns);
+    assert!(dst_stride >= rows && dst.len() >= (columns - 1) * dst_stride + rows);
+    let (full_rows, full_columns) =
+        transpose_blocks(isa, src, src_stride, rows, columns, dst, dst_stride);
+    let one_by_one =
+        |dst: &mut [f32], i_range: std::ops::Range<usize>, j_range: std::ops::Range<usize>| {
+            for i in i_range {
+                for j in j_range.clone() {
+                    dst[j * dst_stride + i] = src[i * src_stride + j];
                 }
             }
-        }
+        };
+    one_by_one(dst, 0..full_rows, full_columns..columns);
+    one_by_one(dst, full_rows..rows, 0..columns);
+}
+
+/// The whole 8 × 8 blocks of `transpose` on AVX2, if the path and the CPU have it: returns
+/// the rows and columns it covered.
+fn transpose_blocks(
+    isa: Isa,
+    src: &[f32],
+    src_stride: usize,
+    rows: usize,
+    columns: usize,
+    dst: &mut [f32],
+    dst_stride: usize,
+) -> (usize, usize) {
+    #[cfg(target_arch = "x86_64")]
+    if isa != Isa::Portable && Isa::Avx2.supported() {
+        let covered = (rows / 8 * 8, columns / 8 * 8);
+        // SAFETY: the CPU has AVX2; `transpose` bounded both slices.
+        unsafe { avx2::transpose_blocks(src, src_stride, covered.0, covered.1, dst, dst_stride) };
+        return covered;
     }
+    let _ = (isa, src, src_stride, rows, columns, dst, dst_stride);
+    (0, 0)
+}
+
+/// `max |x|` over every value of `rows` of a gradient, as bits (`< 0x7f80_0000` iff all are
+/// finite), without an early exit so that the loop vectorises.
+pub(crate) fn largest_magnitude_bits(isa: Isa, rows: Rows) -> u32 {
+    elementwise::largest_magnitude_bits(isa, rows)
 }
 
 #[cfg(test)]
@@ -398,8 +433,20 @@ mod tests {
     fn transpose_swaps_rows_and_columns() {
         let src = [1.0, 2.0, 3.0, 0.0, 4.0, 5.0, 6.0, 0.0]; // 2×3, stride 4
         let mut dst = [0.0; 6];
-        transpose(&src, 4, 2, 3, &mut dst, 2);
+        transpose(Isa::Portable, &src, 4, 2, 3, &mut dst, 2);
         assert_eq!(dst, [1.0, 4.0, 2.0, 5.0, 3.0, 6.0]);
+        // Blocks and edges, on every path.
+        let (rows, columns) = (19, 21);
+        let src: Vec<f32> = (0..rows * 24).map(|x| x as f32).collect();
+        for isa in supported() {
+            let mut dst = vec![-1.0; columns * 20];
+            transpose(isa, &src, 24, rows, columns, &mut dst, 20);
+            for i in 0..rows {
+                for j in 0..columns {
+                    assert_eq!(dst[j * 20 + i], src[i * 24 + j], "{isa:?} {i} {j}");
+                }
+            }
+        }
     }
 
     #[test]
