@@ -70,14 +70,14 @@ def main():
     if chosen:
         library = {p["name"]: p for p in summary.get("library") or []}
         print()
-        print("| SAP-Net run | chosen policy | hidden layers | source greedy score | activation | test returns |")
+        print("| SAP-Net run | chosen policy | hidden layers | source greedy score | final score (A for SAP-Net) | test returns |")
         print("| --- | --- | --- | --- | --- | --- |")
         for r in chosen:
             c = r["chosen"]
             score = library.get(c["name"], {}).get("final_score")
             print(
                 f"| {r['run'] + 1} | {c['name']} | {c['hidden']} | {score if score is not None else '-'} | "
-                f"{c['activation']:.4g} | {', '.join(f'{x:.0f}' for x in r['test_returns'])} |"
+                f"{c.get('score', c.get('activation')):.4g} | {', '.join(f'{x:.0f}' for x in r['test_returns'])} |"
             )
     print()
     print(f"Experiment wall time: {summary['wall_s']:.0f} s")

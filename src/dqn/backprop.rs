@@ -20,7 +20,8 @@
 use candle_core::{bail, Result, Storage, Tensor};
 
 use super::kernels::{
-    largest_magnitude_bits, padded, transpose, Buffer, Finish, Isa, Product, Rows, Start, Strided,
+    largest_magnitude_bits, padded, sum_of_squares, transpose, Buffer, Finish, Isa, Product, Rows,
+    Start, Strided,
 };
 use super::{Architecture, QNet};
 
@@ -172,17 +173,10 @@ impl Gradients {
             .all(|rows| largest_magnitude_bits(isa, rows) < f32::INFINITY.to_bits())
     }
 
-    /// `Σ g²` over every value, in `f64`, parameter by parameter.
+    /// `Σ g²` over every value, in `f64`, row by row (`kernels::sum_of_squares`).
     pub fn sum_of_squares(&self) -> f64 {
-        self.parameters
-            .iter()
-            .map(|p| {
-                p.rows()
-                    .flatten()
-                    .map(|&x| f64::from(x).powi(2))
-                    .sum::<f64>()
-            })
-            .sum()
+        let isa = Isa::current();
+        self.rows().map(|rows| sum_of_squares(isa, rows)).sum()
     }
 
     pub(crate) fn rows(&self) -> impl Iterator<Item = Rows<'_>> {

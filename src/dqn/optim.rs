@@ -18,7 +18,7 @@ use std::cell::RefCell;
 
 use candle_core::{bail, CpuStorage, InplaceOp1, Layout, Result, Var};
 
-use super::kernels::{adam_rows, AdamStep, Isa, Rows};
+use super::kernels::{adam_rows, AdamStep, Buffer, Isa, Rows};
 use super::Gradients;
 use crate::config::DqnConfig;
 
@@ -33,7 +33,7 @@ pub struct Adam {
     /// Steps taken, `t` of the bias correction.
     t: i32,
     /// First and second moments of each parameter.
-    moments: Vec<(Vec<f32>, Vec<f32>)>,
+    moments: Vec<(Buffer, Buffer)>,
 }
 
 impl Adam {
@@ -49,7 +49,7 @@ impl Adam {
                 .iter()
                 .map(|p| {
                     let n = p.elem_count();
-                    (vec![0.0; n], vec![0.0; n])
+                    (Buffer::zeros(n), Buffer::zeros(n))
                 })
                 .collect(),
         }
@@ -100,7 +100,7 @@ struct AdamKernel<'a> {
     step: AdamStep,
     grad: Rows<'a>,
     /// `InplaceOp1::cpu_fwd` takes `&self`; the moments are this step's only other writes.
-    moments: RefCell<(&'a mut Vec<f32>, &'a mut Vec<f32>)>,
+    moments: RefCell<(&'a mut Buffer, &'a mut Buffer)>,
 }
 
 impl InplaceOp1 for AdamKernel<'_> {

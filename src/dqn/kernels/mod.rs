@@ -26,7 +26,7 @@ mod portable;
 use std::sync::OnceLock;
 
 pub(crate) use buffer::Buffer;
-pub(crate) use elementwise::{adam_rows, AdamStep, Rows};
+pub(crate) use elementwise::{adam_rows, sum_of_squares, AdamStep, Rows};
 
 /// Lanes the column count of a product is padded to: one AVX-512 vector, two of AVX2.
 pub(crate) const LANES: usize = 16;
@@ -425,6 +425,23 @@ mod tests {
             let bits = |v: &Vec<f32>| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             for other in &results[1..] {
                 prop_assert_eq!(bits(&results[0]), bits(other));
+            }
+        }
+    }
+
+    /// Sums long enough for the AVX-512 path to take them in several steps (it keeps 32 KiB
+    /// of the right operand in L1: 128 steps at 64 columns, 512 at 16) still give the
+    /// portable path's bits.
+    #[test]
+    fn long_sums_taken_in_steps_give_the_same_bits() {
+        for (rows, depth, columns) in [(13, 300, 64), (7, 1100, 16), (20, 257, 96)] {
+            let results = outputs(rows, depth, columns, 11);
+            for other in &results[1..] {
+                assert_eq!(
+                    results[0].iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                    other.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                    "{rows}×{depth}×{columns}"
+                );
             }
         }
     }
