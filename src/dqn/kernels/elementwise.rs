@@ -4,6 +4,35 @@
 
 use super::Isa;
 
+/// `fn $name(isa, args…) -> T`: `$body(args…)` compiled once for AVX-512, once for AVX2 and
+/// once for the baseline, run on `isa` if the CPU has it. The body is safe Rust with no
+/// reductions the compiler could reorder, so every copy computes the same bits.
+macro_rules! per_isa {
+    ($(#[$doc:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),*) -> $ret:ty = $body:ident) => {
+        $(#[$doc])*
+        $vis fn $name(isa: Isa, $($arg: $ty),*) -> $ret {
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx512f")]
+            unsafe fn avx512($($arg: $ty),*) -> $ret {
+                $body($($arg),*)
+            }
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx2,fma")]
+            unsafe fn avx2($($arg: $ty),*) -> $ret {
+                $body($($arg),*)
+            }
+            match isa {
+                // SAFETY: the CPU has the features (`Isa::supported`); the body is safe.
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx512 if isa.supported() => unsafe { avx512($($arg),*) },
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx2 if isa.supported() => unsafe { avx2($($arg),*) },
+                _ => $body($($arg),*),
+            }
+        }
+    };
+}
+
 /// Chainer's Adam for one step (see `optim.rs`), with the step's bias-corrected step size
 /// and the gradient's clipping factor.
 #[derive(Debug, Clone, Copy)]
@@ -59,78 +88,30 @@ pub(crate) fn adam_rows(
     v: &mut [f32],
     grad: Rows,
 ) {
-    let Rows {
-        values: grad,
-        columns,
-        stride: grad_stride,
-    } = grad;
-    if columns == 0 {
+    if grad.columns == 0 {
         return;
     }
-    let rows = theta.len() / columns;
-    assert!(theta.len() == rows * columns && m.len() == theta.len() && v.len() == theta.len());
-    assert!(grad_stride >= columns && grad.len() >= rows.saturating_sub(1) * grad_stride + columns);
-    match isa {
-        // SAFETY: the CPU has the features (`Isa::supported`, checked by the caller's
-        // choice of path); the body is safe Rust.
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if isa.supported() => unsafe {
-            adam_avx512(step, theta, m, v, grad, columns, grad_stride)
-        },
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 if isa.supported() => unsafe {
-            adam_avx2(step, theta, m, v, grad, columns, grad_stride)
-        },
-        _ => adam_body(step, theta, m, v, grad, columns, grad_stride),
-    }
+    let rows = theta.len() / grad.columns;
+    assert!(theta.len() == rows * grad.columns && m.len() == theta.len() && v.len() == theta.len());
+    assert!(
+        grad.stride >= grad.columns
+            && grad.values.len() >= rows.saturating_sub(1) * grad.stride + grad.columns
+    );
+    adam(isa, step, theta, m, v, grad)
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn adam_avx512(
-    step: &AdamStep,
-    theta: &mut [f32],
-    m: &mut [f32],
-    v: &mut [f32],
-    grad: &[f32],
-    columns: usize,
-    grad_stride: usize,
-) {
-    adam_body(step, theta, m, v, grad, columns, grad_stride)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn adam_avx2(
-    step: &AdamStep,
-    theta: &mut [f32],
-    m: &mut [f32],
-    v: &mut [f32],
-    grad: &[f32],
-    columns: usize,
-    grad_stride: usize,
-) {
-    adam_body(step, theta, m, v, grad, columns, grad_stride)
-}
+per_isa!(fn adam(step: &AdamStep, theta: &mut [f32], m: &mut [f32], v: &mut [f32], grad: Rows) -> () = adam_body);
 
 /// `m ← m + (1 − β₁)(g − m)`, `v ← v + (1 − β₂)(g² − v)`, `θ ← θ − α·m / (√v + ε)`,
 /// with tiny values set to zero (see [`MOMENT_FLOOR`]).
 #[inline(always)]
-fn adam_body(
-    step: &AdamStep,
-    theta: &mut [f32],
-    m: &mut [f32],
-    v: &mut [f32],
-    grad: &[f32],
-    columns: usize,
-    grad_stride: usize,
-) {
-    let (b1, b2) = (step.beta1, step.beta2);
+fn adam_body(step: &AdamStep, theta: &mut [f32], m: &mut [f32], v: &mut [f32], grad: Rows) {
+    let (b1, b2, columns) = (step.beta1, step.beta2, grad.columns);
     let rows = theta
         .chunks_exact_mut(columns)
         .zip(m.chunks_exact_mut(columns))
         .zip(v.chunks_exact_mut(columns))
-        .zip(grad.chunks(grad_stride));
+        .zip(grad.values.chunks(grad.stride));
     for (((theta, m), v), grad) in rows {
         let values = theta.iter_mut().zip(m).zip(v).zip(&grad[..columns]);
         for (((p, m), v), &g) in values {
@@ -142,29 +123,10 @@ fn adam_body(
     }
 }
 
-/// `max |x|` of a gradient's rows, as bits: see `kernels::largest_magnitude_bits`.
-pub(super) fn largest_magnitude_bits(isa: Isa, rows: Rows) -> u32 {
-    match isa {
-        // SAFETY: as in `adam_rows`.
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if isa.supported() => unsafe { largest_avx512(rows) },
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 if isa.supported() => unsafe { largest_avx2(rows) },
-        _ => largest_body(rows),
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn largest_avx512(rows: Rows) -> u32 {
-    largest_body(rows)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn largest_avx2(rows: Rows) -> u32 {
-    largest_body(rows)
-}
+per_isa!(
+    /// `max |x|` of a gradient's rows, as bits: see `kernels::largest_magnitude_bits`.
+    pub(super) fn largest_magnitude_bits(rows: Rows) -> u32 = largest_body
+);
 
 #[inline(always)]
 fn largest_body(rows: Rows) -> u32 {
@@ -179,31 +141,12 @@ fn largest_body(rows: Rows) -> u32 {
         .unwrap_or(0)
 }
 
-/// `Σ x²` in `f64` over a gradient's rows, in eight running sums (value `n` of a row into
-/// sum `n mod 8`, the sums then added pairwise), so that the adds do not wait on each
-/// other; the order is fixed, so every path gives the same bits.
-pub(crate) fn sum_of_squares(isa: Isa, rows: Rows) -> f64 {
-    match isa {
-        // SAFETY: as in `adam_rows`.
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if isa.supported() => unsafe { squares_avx512(rows) },
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 if isa.supported() => unsafe { squares_avx2(rows) },
-        _ => squares_body(rows),
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn squares_avx512(rows: Rows) -> f64 {
-    squares_body(rows)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn squares_avx2(rows: Rows) -> f64 {
-    squares_body(rows)
-}
+per_isa!(
+    /// `Σ x²` in `f64` over a gradient's rows, in eight running sums (value `n` of a row into
+    /// sum `n mod 8`, the sums then added pairwise), so that the adds do not wait on each
+    /// other; the order is fixed, so every path gives the same bits.
+    pub(crate) fn sum_of_squares(rows: Rows) -> f64 = squares_body
+);
 
 #[inline(always)]
 fn squares_body(rows: Rows) -> f64 {
