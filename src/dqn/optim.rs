@@ -13,6 +13,8 @@
 //! candle-nn's `AdamW` spends about ten tensor operations (each an allocation) per parameter
 //! per step; this one reads the gradient and writes the parameter and moments in place, on
 //! the kernels' instruction set (`kernels/elementwise.rs`: the same bits on every path).
+//! Moments below 1e-30 and gradients below 1e-18 are set to zero there: subnormal moments
+//! (a dead unit's weights) made each step 35× slower on x86.
 
 use std::cell::RefCell;
 
