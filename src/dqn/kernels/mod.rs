@@ -12,8 +12,8 @@
 //! The vector paths only run 16 or 8 of these chains at once, one per lane, across the
 //! output's columns; no sum is ever split between lanes. An FMA rounds once whether the
 //! hardware or `f32::mul_add` does it, so a run gives the same numbers on an AVX-512 server,
-//! an AVX2 laptop and an ARM machine. The element-wise passes (Adam) are one source compiled
-//! once per instruction set: Rust never contracts `a * b + c` into an FMA, so the vectorised
+//! an AVX2 laptop and an ARM machine. The element-wise passes (Adam, the finiteness check,
+//! the clipping norm) are one source compiled once per instruction set: Rust never contracts `a * b + c` into an FMA, so the vectorised
 //! loops round exactly as the scalar loop does. `tests` checks the paths against each other
 //! bit for bit.
 
@@ -113,7 +113,8 @@ impl Isa {
     }
 }
 
-/// A matrix read one scalar at a time, so any strides do: `at(r, k) = data[r·rows + k·columns]`.
+/// A matrix read one scalar at a time, so any strides do:
+/// `at(r, k) = data[r·row_stride + k·column_stride]`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Strided<'a> {
     pub data: &'a [f32],
