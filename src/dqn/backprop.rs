@@ -53,10 +53,10 @@ impl Workspace {
     /// past the batch or a layer's units may hold another shape's values, which no sum
     /// reads.
     fn prepare(&mut self, architecture: &Architecture, batch: usize) {
-        let sizes = architecture.layer_sizes();
-        if sizes == self.sizes && batch == self.batch {
+        if self.shaped_for(architecture) && batch == self.batch {
             return;
         }
+        let sizes = architecture.layer_sizes();
         let columns = padded(batch);
         self.activations.resize_with(sizes.len(), Buffer::default);
         for (buffer, &units) in self.activations.iter_mut().zip(&sizes) {
@@ -64,6 +64,15 @@ impl Workspace {
         }
         self.q.resize(batch * architecture.action_count, 0.0);
         (self.sizes, self.batch, self.columns) = (sizes, batch, columns);
+    }
+
+    /// Whether the buffers are laid out for `architecture`'s layers (compared without
+    /// allocating: this runs every pass).
+    fn shaped_for(&self, architecture: &Architecture) -> bool {
+        let sizes = std::iter::once(architecture.observation_size)
+            .chain(architecture.hidden.iter().copied())
+            .chain([architecture.action_count]);
+        self.sizes.iter().copied().eq(sizes)
     }
 
     /// Sizes the backward pass's buffers for the shape of the last forward pass.
@@ -288,12 +297,12 @@ impl QNet {
         grad_q: &[f32],
     ) -> Result<()> {
         let (batch, columns) = (work.batch, work.columns);
-        let sizes = work.sizes.clone();
-        let layers = sizes.len().saturating_sub(1);
-        if sizes != self.architecture().layer_sizes() || grad_q.len() != batch * sizes[layers] {
+        let layers = work.sizes.len().saturating_sub(1);
+        if !work.shaped_for(self.architecture()) || grad_q.len() != batch * work.sizes[layers] {
             bail!("backward without the matching forward pass")
         }
         work.prepare_backward();
+        let sizes = &work.sizes;
         transpose(
             isa,
             grad_q,
