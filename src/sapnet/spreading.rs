@@ -124,6 +124,10 @@ pub fn activate<S: TraceSink>(
     activations: &mut [f64],
     sink: &mut S,
 ) {
+    if !S::WANTS_STOPPED && deposits_stop_at_neighbours(graph, spreading, i) {
+        activate_neighbours(graph, spreading, i, coefficient, activations, sink);
+        return;
+    }
     let mut spreader = Spreader::start(
         graph,
         spreading,
@@ -134,6 +138,53 @@ pub fn activate<S: TraceSink>(
     );
     while let Some(step) = spreader.step(activations) {
         sink.record(step);
+    }
+}
+
+/// Whether every walk of two edges from `i` reaches T_ω, so that the only deposits are
+/// eq. 10's on `i`'s neighbours (Table II's graphs: same-category weight 0.95, T_ω = 1).
+fn deposits_stop_at_neighbours(graph: &Graph, spreading: Spreading, i: usize) -> bool {
+    graph.neighbours(i).all(|(j, w)| {
+        // Ω as the walk sums it; a walk that stops at j, or leaves it only over edges that
+        // reach T_ω, deposits nothing past j.
+        let omega = 0.0 + w;
+        omega >= spreading.threshold || omega + graph.lightest(j) >= spreading.threshold
+    })
+}
+
+/// `activate` when [`deposits_stop_at_neighbours`]: eq. 8, then eq. 10's deposit on each
+/// neighbour the threshold lets through, in the walk's order and with its arithmetic
+/// (`h = 1`, so `η / (h·Ω)` is `η / Ω` exactly), without the walk's stack: training
+/// activates after every positive step, and the stack's allocations and bookkeeping cost
+/// more than the deposits.
+fn activate_neighbours<S: TraceSink>(
+    graph: &Graph,
+    spreading: Spreading,
+    i: usize,
+    coefficient: f64,
+    activations: &mut [f64],
+    sink: &mut S,
+) {
+    assert_eq!(activations.len(), graph.len(), "one activation per policy");
+    activations[i] += coefficient;
+    let eta = coefficient / graph.degree(i) as f64;
+    for (j, w) in graph.neighbours(i) {
+        let omega = 0.0 + w;
+        let walked_back = spreading.paths == Paths::Simple && j == i;
+        if omega >= spreading.threshold || walked_back {
+            continue;
+        }
+        let delta = eta / omega;
+        activations[j] += delta;
+        sink.record(TraceStep {
+            from: i,
+            to: j,
+            h: 1,
+            omega,
+            eta,
+            delta,
+            stopped: false,
+        });
     }
 }
 
