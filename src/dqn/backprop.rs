@@ -53,7 +53,7 @@ impl Workspace {
     /// past the batch or a layer's units may hold another shape's values, which no sum
     /// reads.
     fn prepare(&mut self, architecture: &Architecture, batch: usize) {
-        if self.shaped_for(architecture) && batch == self.batch {
+        if self.is_for(architecture, batch) {
             return;
         }
         let sizes = architecture.layer_sizes();
@@ -66,13 +66,23 @@ impl Workspace {
         (self.sizes, self.batch, self.columns) = (sizes, batch, columns);
     }
 
+    /// Whether the last forward pass ran `architecture` on `batch` observations.
+    pub(crate) fn is_for(&self, architecture: &Architecture, batch: usize) -> bool {
+        batch == self.batch && self.shaped_for(architecture)
+    }
+
     /// Whether the buffers are laid out for `architecture`'s layers (compared without
     /// allocating: this runs every pass).
     fn shaped_for(&self, architecture: &Architecture) -> bool {
-        let sizes = std::iter::once(architecture.observation_size)
-            .chain(architecture.hidden.iter().copied())
-            .chain([architecture.action_count]);
-        self.sizes.iter().copied().eq(sizes)
+        let hidden = &architecture.hidden;
+        match self.sizes.as_slice() {
+            [inputs, middle @ .., outputs] => {
+                *inputs == architecture.observation_size
+                    && *outputs == architecture.action_count
+                    && middle == hidden.as_slice()
+            }
+            _ => false,
+        }
     }
 
     /// Sizes the backward pass's buffers for the shape of the last forward pass.
@@ -198,25 +208,17 @@ impl Gradients {
 }
 
 impl QNet {
-    /// Calls `f` with every parameter's values, read in place, in the order of
-    /// [`QNet::parameters`].
-    fn with_parameters<R>(&self, f: impl FnOnce(&[&[f32]]) -> R) -> Result<R> {
-        let guards: Vec<_> = self
-            .parameters()
-            .iter()
-            .map(|p| p.storage_and_layout())
-            .collect();
-        let mut slices = Vec::with_capacity(guards.len());
-        for (storage, layout) in &guards {
-            let Storage::Cpu(cpu) = &**storage else {
-                bail!("the Q-network's parameters live on the CPU")
-            };
-            let Some((start, end)) = layout.contiguous_offsets() else {
-                bail!("the Q-network's parameters are contiguous")
-            };
-            slices.push(&cpu.as_slice::<f32>()?[start..end]);
-        }
-        Ok(f(&slices))
+    /// Calls `f` with layer `l`'s weights and bias, read in place (locking two parameters,
+    /// not all of them: nothing is collected, so a pass allocates nothing).
+    fn with_layer<R>(&self, l: usize, f: impl FnOnce(&[f32], &[f32]) -> R) -> Result<R> {
+        let parameters = self.parameters();
+        let (weight, bias) = (&parameters[2 * l], &parameters[2 * l + 1]);
+        let (weight, weight_layout) = weight.storage_and_layout();
+        let (bias, bias_layout) = bias.storage_and_layout();
+        Ok(f(
+            cpu_values(&weight, weight_layout)?,
+            cpu_values(&bias, bias_layout)?,
+        ))
     }
 
     /// Q-values `[batch, action_count]` of the observations `obs` (`[batch,
@@ -250,31 +252,31 @@ impl QNet {
             columns,
         );
         let layers = sizes.len() - 1;
-        self.with_parameters(|p| {
-            for l in 0..layers {
-                let (inputs, outputs) = (sizes[l], sizes[l + 1]);
-                let (done, next) = work.activations.split_at_mut(l + 1);
+        for l in 0..layers {
+            let (inputs, outputs) = (sizes[l], sizes[l + 1]);
+            let (done, next) = work.activations.split_at_mut(l + 1);
+            self.with_layer(l, |weight, bias| {
                 Product {
                     rows: outputs,
                     depth: inputs,
                     columns,
                     left: Strided {
-                        data: p[2 * l],
+                        data: weight,
                         row_stride: inputs,
                         column_stride: 1,
                     },
                     right: &done[l],
                     right_stride: columns,
-                    start: Start::Bias(p[2 * l + 1]),
+                    start: Start::Bias(bias),
                     finish: if l + 1 < layers {
                         Finish::Relu
                     } else {
                         Finish::Keep
                     },
                 }
-                .run(isa, &mut next[0], columns);
-            }
-        })?;
+                .run(isa, &mut next[0], columns)
+            })?;
+        }
         let actions = sizes[layers];
         transpose(
             isa,
@@ -312,44 +314,44 @@ impl QNet {
             &mut work.grad_out,
             columns,
         );
-        self.with_parameters(|p| {
-            for l in (0..layers).rev() {
-                let (inputs, outputs) = (sizes[l], sizes[l + 1]);
-                let stride = padded(inputs + 1);
-                let input = &work.activations[l];
-                transpose(isa, input, columns, inputs, batch, &mut work.inputs, stride);
-                for row in work.inputs.chunks_exact_mut(stride).take(batch) {
-                    row[inputs] = 1.0;
-                }
-                let (weight, bias) = match &mut work.gradients.parameters[2 * l..] {
-                    [weight, bias, ..] => (weight, bias),
-                    _ => unreachable!("two gradients per layer"),
-                };
-                Product {
-                    rows: outputs,
-                    depth: batch,
-                    columns: stride,
-                    left: Strided {
-                        data: &work.grad_out,
-                        row_stride: columns,
-                        column_stride: 1,
-                    },
-                    right: &work.inputs,
-                    right_stride: stride,
-                    start: Start::Zero,
-                    finish: Finish::Keep,
-                }
-                .run(isa, &mut weight.values, stride);
-                for (o, db) in bias.values.iter_mut().enumerate() {
-                    *db = weight.values[o * stride + inputs];
-                }
-                if l > 0 {
+        for l in (0..layers).rev() {
+            let (inputs, outputs) = (sizes[l], sizes[l + 1]);
+            let stride = padded(inputs + 1);
+            let input = &work.activations[l];
+            transpose(isa, input, columns, inputs, batch, &mut work.inputs, stride);
+            for row in work.inputs.chunks_exact_mut(stride).take(batch) {
+                row[inputs] = 1.0;
+            }
+            let (weight, bias) = match &mut work.gradients.parameters[2 * l..] {
+                [weight, bias, ..] => (weight, bias),
+                _ => unreachable!("two gradients per layer"),
+            };
+            Product {
+                rows: outputs,
+                depth: batch,
+                columns: stride,
+                left: Strided {
+                    data: &work.grad_out,
+                    row_stride: columns,
+                    column_stride: 1,
+                },
+                right: &work.inputs,
+                right_stride: stride,
+                start: Start::Zero,
+                finish: Finish::Keep,
+            }
+            .run(isa, &mut weight.values, stride);
+            for (o, db) in bias.values.iter_mut().enumerate() {
+                *db = weight.values[o * stride + inputs];
+            }
+            if l > 0 {
+                self.with_layer(l, |weight, _| {
                     Product {
                         rows: inputs,
                         depth: outputs,
                         columns,
                         left: Strided {
-                            data: p[2 * l],
+                            data: weight,
                             row_stride: 1,
                             column_stride: inputs,
                         },
@@ -358,12 +360,24 @@ impl QNet {
                         start: Start::Zero,
                         finish: Finish::MaskBy(input),
                     }
-                    .run(isa, &mut work.grad_in, columns);
-                    std::mem::swap(&mut work.grad_out, &mut work.grad_in);
-                }
+                    .run(isa, &mut work.grad_in, columns)
+                })?;
+                std::mem::swap(&mut work.grad_out, &mut work.grad_in);
             }
-        })
+        }
+        Ok(())
     }
+}
+
+/// A parameter's values in place: its CPU storage between the layout's offsets.
+fn cpu_values<'a>(storage: &'a Storage, layout: &candle_core::Layout) -> Result<&'a [f32]> {
+    let Storage::Cpu(cpu) = storage else {
+        bail!("the Q-network's parameters live on the CPU")
+    };
+    let Some((start, end)) = layout.contiguous_offsets() else {
+        bail!("the Q-network's parameters are contiguous")
+    };
+    Ok(&cpu.as_slice::<f32>()?[start..end])
 }
 
 #[cfg(test)]
