@@ -25,11 +25,14 @@ impl Buffer {
 
     /// Grows with zeros or shrinks to `len` values; the values kept stay.
     pub(crate) fn resize(&mut self, len: usize) {
+        let kept_lines = self.lines.len();
         self.lines.resize(len.div_ceil(16), Line::default());
         let old = std::mem::replace(&mut self.len, len);
-        if len > old {
-            // Values past the old length in its last line may be left from a longer past.
-            self[old..].fill(0.0);
+        // New lines come zeroed; values past the old length in the lines kept may be left
+        // from a longer past.
+        let stale = old..len.min(16 * kept_lines);
+        if !stale.is_empty() {
+            self[stale].fill(0.0);
         }
     }
 }
@@ -65,5 +68,12 @@ mod tests {
         assert_eq!(&buffer[..2], &[3.0, 3.0]);
         assert!(buffer[2..].iter().all(|&x| x == 0.0));
         assert_eq!(buffer.len(), 40);
+        // Shrinking within a line and past lines, then growing again.
+        buffer.fill(5.0);
+        buffer.resize(20);
+        buffer.resize(3);
+        buffer.resize(48);
+        assert_eq!(&buffer[..3], &[5.0; 3]);
+        assert!(buffer[3..].iter().all(|&x| x == 0.0));
     }
 }
