@@ -4,6 +4,7 @@ use rand::Rng;
 
 use super::backprop::Workspace;
 use super::kernels::Isa;
+use super::scratch::{with_scratch, UpdateWork};
 use super::{td_huber_loss, Adam, Batch, DqnError, EpsilonGreedy, QNet, ReplayBuffer};
 use crate::config::DqnConfig;
 
@@ -43,8 +44,6 @@ pub struct DqnAgent {
     /// Reused between updates.
     batch: Batch,
     targets: Vec<f32>,
-    online_work: Workspace,
-    target_work: Workspace,
 }
 
 impl DqnAgent {
@@ -62,8 +61,6 @@ impl DqnAgent {
             last_loss: None,
             batch: Batch::new(),
             targets: Vec::new(),
-            online_work: Workspace::default(),
-            target_work: Workspace::default(),
         })
     }
 
@@ -124,9 +121,17 @@ impl DqnAgent {
     /// If `batch` is empty.
     pub fn update(&mut self, batch: &Batch) -> Result<f64, DqnError> {
         assert!(!batch.is_empty(), "cannot learn from an empty batch");
-        self.compute_td_targets(batch)?;
+        with_scratch(|scratch| {
+            let work = scratch.for_shape(self.online.architecture(), batch.len());
+            self.update_with(batch, work)
+        })
+    }
+
+    /// [`update`](Self::update) with this thread's buffers for the network's shape.
+    fn update_with(&mut self, batch: &Batch, work: &mut UpdateWork) -> Result<f64, DqnError> {
+        self.compute_td_targets(batch, &mut work.target)?;
         let isa = Isa::current();
-        let work = &mut self.online_work;
+        let work = &mut work.online;
         let q = self
             .online
             .forward_with(isa, batch.obs(), batch.len(), work)?;
@@ -158,13 +163,10 @@ impl DqnAgent {
 
     /// `y = r + γ·max_a' Q_target(s', a')` for every transition of `batch`, without the
     /// bootstrap after a terminal state (or a truncation, if `truncation_as_terminal`).
-    fn compute_td_targets(&mut self, batch: &Batch) -> Result<(), DqnError> {
-        let next_q = self.target.forward_with(
-            Isa::current(),
-            batch.next_obs(),
-            batch.len(),
-            &mut self.target_work,
-        )?;
+    fn compute_td_targets(&mut self, batch: &Batch, work: &mut Workspace) -> Result<(), DqnError> {
+        let next_q =
+            self.target
+                .forward_with(Isa::current(), batch.next_obs(), batch.len(), work)?;
         let gamma = self.config.gamma as f32;
         let truncation_is_terminal = self.config.truncation_as_terminal;
         self.targets.clear();

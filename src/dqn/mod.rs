@@ -16,6 +16,7 @@ mod loss;
 mod optim;
 mod qnet;
 mod replay;
+mod scratch;
 
 pub use agent::{DqnAgent, UpdateReport};
 pub use backprop::Gradients;
