@@ -7,8 +7,9 @@ use anyhow::{bail, Result};
 use crate::dqn::Architecture;
 use crate::trainer::RunSpec;
 
-/// Copies of a learning network's parameters: online, target, gradients, Adam's two
-/// moments.
+/// Copies of a learning network's parameters: online, target, Adam's two moments, and the
+/// gradients (a thread keeps one set per network shape, `dqn/scratch.rs`; counted per
+/// learner here, an upper bound).
 const LEARNER_COPIES: f64 = 5.0;
 
 /// Bytes one stored transition takes: two observations of `obs` f32s, the action (u32),
