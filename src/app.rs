@@ -12,7 +12,7 @@ use crate::config::{Config, MethodKind};
 use crate::experiment;
 use crate::headless::{self, OutputOptions, RunOptions};
 use crate::teach::config::TeachConfig;
-use crate::trainer::StreamOptions;
+use crate::trainer::{RunSpec, StreamOptions};
 use crate::tui::{self, teach::Teach};
 use crate::{assets, env, random_episodes, trainer};
 
@@ -120,6 +120,9 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     if cli.run.follow.is_some() {
         anyhow::bail!("--follow is for the dashboard: --headless runs every method");
     }
+    if cli.run.follow_run != 1 {
+        anyhow::bail!("--follow-run is for the dashboard: --headless runs every run");
+    }
     let dir = match &cli.run.out {
         Some(dir) => dir.clone(),
         None => default_out_dir(cli.run.config.as_deref()),
@@ -220,9 +223,9 @@ fn reference_bands(dir: &Path) -> Result<Vec<tui::reference::Band>> {
         .collect())
 }
 
-/// The dashboard follows the first run of one reusing method (`--follow`, else the first
-/// SAP-Net method, else the first that reuses; `m` moves to the next), step by step,
-/// beside the first run of the first DQN baseline, episode by episode; the library is
+/// The dashboard follows one run (`--follow-run`, else run 1) of one reusing method
+/// (`--follow`, else the first SAP-Net method, else the first that reuses; `m` moves to the
+/// next), step by step, beside the same run of the first DQN baseline, episode by episode; the library is
 /// loaded (or trained, with a progress bar) before the screen switches.
 fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
     let ids = experiment::method_ids(config);
@@ -255,25 +258,11 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
     };
     // The followed run and the DQN baseline train side by side.
     let plan = experiment::plan(config, &cli.run.library_root(), 2, &on_interrupt()?)?;
-    let followable: Vec<_> = plan
-        .specs
-        .iter()
-        .filter(|s| s.run == 0 && s.method.kind.reuses())
-        .map(|s| {
-            let mut spec = s.clone();
-            spec.stream = StreamOptions::live();
-            spec
-        })
-        .collect();
+    let (followable, baseline) = dashboard_specs(&plan.specs, cli.run.follow_run)?;
     let first = followable
         .iter()
         .position(|s| Some(&s.method) == followed.as_ref())
         .unwrap_or(0);
-    let baseline = plan
-        .specs
-        .iter()
-        .find(|s| s.run == 0 && s.method.kind == MethodKind::Dqn)
-        .cloned();
     let task = env::make(&config.env).id().to_string();
     tui::run_dashboard(
         &task,
@@ -289,6 +278,31 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
          protocol's results"
     );
     Ok(())
+}
+
+/// Run `run` (from 1, `--follow-run`) of every reusing method, streaming every step, and of
+/// the first DQN baseline: what the dashboard can train.
+fn dashboard_specs(specs: &[RunSpec], run: u32) -> Result<(Vec<RunSpec>, Option<RunSpec>)> {
+    let runs = specs.iter().map(|s| s.run + 1).max().unwrap_or(0);
+    anyhow::ensure!(
+        (1..=runs).contains(&run),
+        "--follow-run {run}: expected a run from 1 to {runs} (the config's runs per method)"
+    );
+    let index = run - 1;
+    let followable = specs
+        .iter()
+        .filter(|s| s.run == index && s.method.kind.reuses())
+        .map(|s| {
+            let mut spec = s.clone();
+            spec.stream = StreamOptions::live();
+            spec
+        })
+        .collect();
+    let baseline = specs
+        .iter()
+        .find(|s| s.run == index && s.method.kind == MethodKind::Dqn)
+        .cloned();
+    Ok((followable, baseline))
 }
 
 fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
@@ -427,4 +441,57 @@ fn default_out_dir(config: Option<&Path>) -> PathBuf {
         .duration_since(UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());
     PathBuf::from("out").join(format!("{stem}-{seconds}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::DqnConfig;
+    use crate::env::EnvConfig;
+
+    /// Two runs of a reusing method and of a DQN baseline, as a plan lists them.
+    fn specs() -> Vec<RunSpec> {
+        let spec = |run, label: &str, kind| {
+            let mut s = RunSpec::scratch(
+                run,
+                label,
+                EnvConfig::CartPole(Default::default()),
+                DqnConfig::default(),
+                vec![4],
+                10,
+                1,
+                u64::from(run) + 7,
+            );
+            s.method.kind = kind;
+            s
+        };
+        (0..2)
+            .flat_map(|run| {
+                [
+                    spec(run, "sapnet", MethodKind::SapNet),
+                    spec(run, "dqn[4]", MethodKind::Dqn),
+                ]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_dashboard_trains_the_run_asked_for() {
+        let (followable, baseline) = dashboard_specs(&specs(), 2).unwrap();
+        assert_eq!(followable.len(), 1);
+        assert_eq!((followable[0].run, followable[0].seed), (1, 8));
+        assert_eq!(followable[0].stream, StreamOptions::live());
+        assert_eq!(baseline.map(|b| (b.run, b.seed)), Some((1, 8)));
+        let (first, _) = dashboard_specs(&specs(), 1).unwrap();
+        assert_eq!(first[0].run, 0);
+    }
+
+    #[test]
+    fn a_run_the_config_does_not_have_is_refused_with_the_range() {
+        for run in [0, 3] {
+            let err = dashboard_specs(&specs(), run).unwrap_err().to_string();
+            assert!(err.contains(&format!("--follow-run {run}")), "{err}");
+            assert!(err.contains("from 1 to 2"), "{err}");
+        }
+    }
 }

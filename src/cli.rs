@@ -68,6 +68,12 @@ pub struct RunArgs {
     #[arg(long, value_name = "METHOD")]
     pub follow: Option<String>,
 
+    /// The dashboard trains run N (from 1) of the followed method and of the DQN baseline
+    /// instead of run 1, with the seeds a headless protocol gives run N: to watch a run
+    /// the results single out.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub follow_run: u32,
+
     /// The dashboard draws a finished protocol's results (a `--headless` output folder)
     /// under the live curves: for each method on screen, the mean of its runs' moving
     /// averages and a band of ± one standard deviation.
