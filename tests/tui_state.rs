@@ -7,9 +7,11 @@ use std::time::Duration;
 use common::tui_script;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::layout::Rect;
+use sapnet::teach::config::TeachConfig;
 use sapnet::trainer::Command;
 use sapnet::tui::dashboard::{Action, Dashboard, Focus, Mode, CURVE_POINTS, SPEEDS};
-use sapnet::tui::{graph_view, view};
+use sapnet::tui::teach::Teach;
+use sapnet::tui::{graph_view, teach_view, view};
 
 fn key(c: char) -> KeyEvent {
     KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
@@ -193,6 +195,53 @@ fn teach_mode_pauses_steps_a_copy_and_leaves_training_untouched() {
         d.sapnet.as_ref().unwrap().net.activations(),
         live.as_slice()
     );
+}
+
+/// A terminal cell, `(column, row)`.
+type Cell = (u16, u16);
+
+/// Cells of `main` (teach mode's panels) over policy `target`, in the left part (the graph)
+/// and the right (the activations table).
+fn cells_over(main: Rect, teach: &Teach, target: usize) -> (Vec<Cell>, Vec<Cell>) {
+    (main.x..main.right())
+        .flat_map(|c| (main.y..main.bottom()).map(move |r| (c, r)))
+        .filter(|&(c, r)| teach_view::policy_at(main, teach, c, r) == Some(target))
+        .partition(|&(c, _)| c < main.x + main.width / 2)
+}
+
+#[test]
+fn in_teach_mode_a_click_picks_a_node_or_a_row() {
+    let mut d = scripted(10);
+    d.on_key(key('t'));
+    assert_eq!(d.mode, Mode::Teach);
+    let screen = Rect::new(0, 0, 120, 40);
+    let main = Rect::new(0, 0, 120, 39); // above the status line
+    let n = d.teach.as_ref().unwrap().net().len();
+    for target in (0..n).rev() {
+        let (nodes, rows) = cells_over(main, d.teach.as_ref().unwrap(), target);
+        assert!(!nodes.is_empty() && !rows.is_empty(), "policy {target}");
+        // A row is one line of the table.
+        assert!(rows.iter().all(|&(_, r)| r == rows[0].1));
+        d.on_click(nodes[0].0, nodes[0].1, screen);
+        assert_eq!(d.teach.as_ref().unwrap().cursor(), target);
+        d.on_click(rows[0].0, rows[0].1, screen);
+        assert_eq!(d.teach.as_ref().unwrap().cursor(), target);
+    }
+    // The status line, and the trace panel's corner, pick nothing.
+    d.on_click(5, 39, screen);
+    d.on_click(119, 38, screen);
+    assert_eq!(d.teach.as_ref().unwrap().cursor(), 0);
+
+    // Stand-alone teach mode: Fig. 2 on a small terminal.
+    let lesson = TeachConfig::load(None).unwrap();
+    let mut teach = Teach::new(lesson.names, lesson.net);
+    let screen = Rect::new(0, 0, 80, 24);
+    let (_, rows) = cells_over(Rect::new(0, 0, 80, 23), &teach, 3);
+    teach_view::click(&mut teach, screen, rows[0].0, rows[0].1);
+    assert_eq!(teach.cursor(), 3);
+    // Below the size the screen needs, a click does nothing.
+    teach_view::click(&mut teach, Rect::new(0, 0, 60, 20), 1, 1);
+    assert_eq!(teach.cursor(), 3);
 }
 
 #[test]

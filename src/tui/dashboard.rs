@@ -37,10 +37,6 @@ pub const SPEEDS: [Duration; 6] = [
     Duration::from_millis(1000),
 ];
 
-/// How far from a node (canvas units; the nodes sit on the unit circle) a click still
-/// picks it.
-const CLICK_REACH: f64 = 0.25;
-
 /// Episodes of scores kept for the table's sparklines.
 pub const HISTORY: usize = 40;
 
@@ -595,12 +591,18 @@ impl Dashboard {
     /// A left click at `(column, row)` of a screen of `area`: on a node or a table row it
     /// picks that policy and focuses its panel.
     pub fn on_click(&mut self, column: u16, row: u16, area: Rect) {
+        if self.help {
+            return;
+        }
+        if self.mode == Mode::Teach {
+            if let Some(teach) = &mut self.teach {
+                super::teach_view::click(teach, area, column, row);
+            }
+            return;
+        }
         let Some(view) = &self.sapnet else {
             return;
         };
-        if self.mode == Mode::Teach || self.help {
-            return;
-        }
         let layout = super::view::training_layout(area, self.zoomed());
         let inside = |r: Rect| r.contains(Position::new(column, row));
         if inside(layout.table) {
@@ -615,7 +617,7 @@ impl Dashboard {
         } else if inside(layout.graph) {
             let positions = graph_view::positions(view.policies.len(), Some(&view.categories()));
             if let Some(i) = graph_view::canvas_point(layout.graph, column, row)
-                .and_then(|point| graph_view::node_at(&positions, point, CLICK_REACH))
+                .and_then(|point| graph_view::node_at(&positions, point, graph_view::CLICK_REACH))
             {
                 self.cursor = i;
             }

@@ -192,6 +192,9 @@ pub fn nearest_ahead(positions: &[(f64, f64)], from: usize, (dx, dy): (f64, f64)
         .map(|(j, _)| j)
 }
 
+/// How near a click must land to a node, in canvas units (the circle's radius is 1).
+pub const CLICK_REACH: f64 = 0.25;
+
 /// The node nearest to `point` (canvas units), if one lies within `reach`.
 pub fn node_at(positions: &[(f64, f64)], (x, y): (f64, f64), reach: f64) -> Option<usize> {
     positions

@@ -38,32 +38,26 @@ pub const FRAME: Duration = Duration::from_millis(33);
 
 /// Leaves the alternate screen and raw mode, and stops mouse reporting, however the UI
 /// ends; ratatui's panic hook restores the screen for panics, and the unwinding drops this.
-struct TerminalGuard {
-    mouse: bool,
-}
+struct TerminalGuard;
 
 impl Drop for TerminalGuard {
     fn drop(&mut self) {
         crate::signals::set_interactive(false);
-        if self.mouse {
-            let _ = crossterm::execute!(std::io::stdout(), crossterm::event::DisableMouseCapture);
-        }
+        let _ = crossterm::execute!(std::io::stdout(), crossterm::event::DisableMouseCapture);
         ratatui::restore();
     }
 }
 
-/// Raw mode and the alternate screen (and mouse reporting, for the dashboard's clicks),
+/// Raw mode, the alternate screen and mouse reporting (clicks pick a node or a row),
 /// with the guard that leaves them. If opening fails half-way, raw mode is undone here
 /// (nothing else was changed yet).
-fn open_terminal(mouse: bool) -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
+fn open_terminal() -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
     match ratatui::try_init() {
         Ok(terminal) => {
             crate::signals::set_interactive(true);
-            let guard = TerminalGuard { mouse };
-            if mouse {
-                crossterm::execute!(std::io::stdout(), crossterm::event::EnableMouseCapture)
-                    .context("turning on mouse reporting")?;
-            }
+            let guard = TerminalGuard;
+            crossterm::execute!(std::io::stdout(), crossterm::event::EnableMouseCapture)
+                .context("turning on mouse reporting")?;
             Ok((terminal, guard))
         }
         Err(err) => {
@@ -119,7 +113,7 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
         let leads = runs.is_empty();
         runs.push(Driven { handle, leads });
     }
-    let (mut terminal, guard) = open_terminal(true)?;
+    let (mut terminal, guard) = open_terminal()?;
     let result = (|| -> Result<()> {
         loop {
             for event in events.try_iter() {
@@ -203,7 +197,7 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
 /// Runs stand-alone teach mode until the user quits.
 pub fn run_teach(mut teach: Teach) -> Result<()> {
     let theme = Theme::from_env();
-    let (mut terminal, _guard) = open_terminal(false)?;
+    let (mut terminal, _guard) = open_terminal()?;
     let mut help = false;
     loop {
         if crate::signals::received().is_some() {
@@ -222,8 +216,16 @@ pub fn run_teach(mut teach: Teach) -> Result<()> {
         if !term::poll(wait).context("reading the keyboard")? {
             continue;
         }
-        let term::Event::Key(key) = term::read().context("reading the keyboard")? else {
-            continue;
+        let key = match term::read().context("reading the keyboard")? {
+            term::Event::Key(key) => key,
+            term::Event::Mouse(mouse) => {
+                if !help && mouse.kind == MouseEventKind::Down(MouseButton::Left) {
+                    let size = terminal.size().context("reading the terminal's size")?;
+                    teach_view::click(&mut teach, size.into(), mouse.column, mouse.row);
+                }
+                continue;
+            }
+            _ => continue,
         };
         if key.kind != KeyEventKind::Press {
             continue;

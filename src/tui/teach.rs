@@ -156,6 +156,14 @@ impl Teach {
         }
     }
 
+    /// Picks policy `i` (a click on its node or row); out of range changes nothing.
+    pub fn pick(&mut self, i: usize) {
+        if i < self.net.len() {
+            self.cursor = i;
+            self.edge = 0;
+        }
+    }
+
     /// What `+` and `−` change.
     pub fn knob(&self) -> Knob {
         self.knob

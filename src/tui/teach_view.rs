@@ -1,7 +1,7 @@
 //! Drawing teach mode: one activation's spreading (Algorithms 1 and 2), every quantity
 //! beside its equation, and the live edits' effect on the walk.
 
-use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::layout::{Constraint, Layout, Position, Rect};
 use ratatui::style::{Modifier, Style};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Cell, Paragraph, Row, Table, Wrap};
@@ -11,7 +11,7 @@ use super::graph_view::{self, node_style, Scene};
 use super::knobs::{EditReport, Knob};
 use super::teach::Teach;
 use super::theme::Theme;
-use super::view::{draw_help, probability_bar, too_small};
+use super::view::{draw_help, probability_bar, too_small, MIN_HEIGHT, MIN_WIDTH};
 use crate::sapnet::TraceStep;
 
 /// Draws stand-alone teach mode (`sapnet teach`).
@@ -45,7 +45,7 @@ pub fn draw(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {
 
 /// Teach mode's own keys, for its `?`.
 pub(super) const TEACH_HELP: &[(&str, &str)] = &[
-    ("↑↓←→ hjkl", "pick a policy"),
+    ("↑↓←→ hjkl, click", "pick a policy (its node or its row)"),
     ("a", "activate the picked policy (A += 𝒜, eq. 8)"),
     ("s", "make the next spread call (eq. 9–11)"),
     ("r", "run the spreading to its end (s, u, c stop it)"),
@@ -69,23 +69,84 @@ const TEACH_HINTS: &str =
     "↑↓ pick · a activate · s step · r run · u undo · c reset · 1–5 +/− edit · ? help · q quit";
 const TEACH_HINTS_SHORT: &str = "↑↓ a s r u c · 1–5 +/− e · ? help · q quit";
 
-/// Teach mode's panels, in the dashboard or on their own.
-pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+/// Where teach mode's panels go.
+struct Panels {
+    graph: Rect,
+    call: Rect,
+    values: Rect,
+    stack: Rect,
+    edits: Rect,
+    trace: Rect,
+}
+
+/// Teach mode's panels in `area`, for a net of `n` policies.
+fn panels(area: Rect, n: usize) -> Panels {
     let [left, right] =
         Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)]).areas(area);
     // Below 100 columns the call's lines wrap: give them the rows.
     let call_rows = if area.width < 100 { 11 } else { 9 };
     let [graph, call] =
         Layout::vertical([Constraint::Min(8), Constraint::Length(call_rows)]).areas(left);
-    let n = teach.net().len() as u16;
     let short = area.height < 30;
     let [values, stack, edits, trace] = Layout::vertical([
-        Constraint::Length((n + 3).min(right.height / 3)),
+        Constraint::Length((n as u16 + 3).min(right.height / 3)),
         Constraint::Length(if short { 5 } else { 7 }),
         Constraint::Length(6),
         Constraint::Min(3),
     ])
     .areas(right);
+    Panels {
+        graph,
+        call,
+        values,
+        stack,
+        edits,
+        trace,
+    }
+}
+
+/// The policy under the cell `(column, row)` of teach mode's panels drawn in `area`: a node
+/// of the graph, or a row of the activations table.
+pub fn policy_at(area: Rect, teach: &Teach, column: u16, row: u16) -> Option<usize> {
+    let n = teach.net().len();
+    let panels = panels(area, n);
+    let at = Position::new(column, row);
+    if panels.graph.contains(at) {
+        let positions = graph_view::positions(n, teach.groups());
+        return graph_view::canvas_point(panels.graph, column, row)
+            .and_then(|point| graph_view::node_at(&positions, point, graph_view::CLICK_REACH));
+    }
+    if panels.values.contains(at) && row < panels.values.bottom() - 1 {
+        // Below the border and the header row.
+        let i = usize::from(row.checked_sub(panels.values.y + 2)?);
+        return (i < n).then_some(i);
+    }
+    None
+}
+
+/// A left click at `(column, row)` of a `screen` showing teach mode (its panels above the
+/// status line, in the dashboard or on their own): picks the policy under it, if any.
+pub fn click(teach: &mut Teach, screen: Rect, column: u16, row: u16) {
+    if screen.width < MIN_WIDTH || screen.height < MIN_HEIGHT {
+        return;
+    }
+    let [main, _status] =
+        Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(screen);
+    if let Some(i) = policy_at(main, teach, column, row) {
+        teach.pick(i);
+    }
+}
+
+/// Teach mode's panels, in the dashboard or on their own.
+pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+    let Panels {
+        graph,
+        call,
+        values,
+        stack,
+        edits,
+        trace,
+    } = panels(area, teach.net().len());
 
     let walk = teach.walk();
     let next = walk.as_ref().and_then(|w| w.pending.last().copied());
