@@ -139,14 +139,7 @@ pub fn click(teach: &mut Teach, screen: Rect, column: u16, row: u16) {
 
 /// Teach mode's panels, in the dashboard or on their own.
 pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
-    let Panels {
-        graph,
-        call,
-        values,
-        stack,
-        edits,
-        trace,
-    } = panels(area, teach.net().len());
+    let panels = panels(area, teach.net().len());
 
     let walk = teach.walk();
     let next = walk.as_ref().and_then(|w| w.pending.last().copied());
@@ -171,17 +164,17 @@ pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     );
     graph_view::draw(
         frame,
-        graph,
+        panels.graph,
         Block::bordered().title(Span::styled(format!(" {title} "), theme.title())),
         scene,
         theme,
     );
 
-    draw_call(frame, call, teach, theme);
-    draw_edits(frame, edits, teach, theme);
-    draw_values(frame, values, teach, theme);
-    draw_stack(frame, stack, teach, theme);
-    draw_trace(frame, trace, teach, theme);
+    draw_call(frame, panels.call, teach, theme);
+    draw_edits(frame, panels.edits, teach, theme);
+    draw_values(frame, panels.values, teach, theme);
+    draw_stack(frame, panels.stack, teach, theme);
+    draw_trace(frame, panels.trace, teach, theme);
 }
 
 /// The call about to be made, with eq. 10's test, beside the one just made.
