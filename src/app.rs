@@ -225,8 +225,8 @@ fn reference_bands(dir: &Path) -> Result<Vec<tui::reference::Band>> {
 
 /// The dashboard follows one run (`--follow-run`, else run 1) of one reusing method
 /// (`--follow`, else the first SAP-Net method, else the first that reuses; `m` moves to the
-/// next), step by step, beside the same run of the first DQN baseline, episode by episode; the library is
-/// loaded (or trained, with a progress bar) before the screen switches.
+/// next), step by step, beside the same run of the first DQN baseline, episode by episode;
+/// the library is loaded (or trained, with a progress bar) before the screen switches.
 fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
     let ids = experiment::method_ids(config);
     let followed = match &cli.run.follow {
