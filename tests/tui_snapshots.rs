@@ -9,6 +9,7 @@ use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
 use sapnet::teach::config::TeachConfig;
+use sapnet::trainer::Event;
 use sapnet::tui::dashboard::Dashboard;
 use sapnet::tui::teach::Teach;
 use sapnet::tui::theme::Theme;
@@ -369,4 +370,31 @@ fn a_finished_protocol_is_drawn_as_bands_under_the_live_curves() {
         "a method not on screen has no band: {screen}"
     );
     insta::assert_snapshot!("dashboard_reference_120x40", terminal.backend());
+}
+
+#[test]
+fn a_run_other_than_the_first_is_named_in_the_status_line() {
+    let d = dashboard();
+    assert!(!status_line(&draw_dashboard(&d, (120, 40))).contains(" run "));
+    // `--follow-run 3`: the runs announce themselves as run index 2.
+    let mut d = Dashboard::new("CartPole-v1");
+    for event in [tui_script::sapnet_start(), tui_script::baseline_start()] {
+        let event = match event {
+            Event::RunStarted {
+                method,
+                planned_episodes,
+                sapnet,
+                ..
+            } => Event::RunStarted {
+                run: 2,
+                method,
+                planned_episodes,
+                sapnet,
+            },
+            other => other,
+        };
+        d.on_event(event);
+    }
+    let line = status_line(&draw_dashboard(&d, (120, 40)));
+    assert!(line.contains("sapnet run 3 ep 0/5000"), "{line}");
 }

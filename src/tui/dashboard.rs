@@ -215,6 +215,8 @@ impl SapNetView {
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunView {
     pub method: MethodId,
+    /// Which run of its method (from 0; `--follow-run` picks another than the first).
+    pub run: u32,
     pub planned_episodes: u32,
     pub episode: u32,
     pub curve: Curve,
@@ -226,9 +228,10 @@ pub struct RunView {
 }
 
 impl RunView {
-    fn new(method: MethodId, planned_episodes: u32) -> Self {
+    fn new(method: MethodId, run: u32, planned_episodes: u32) -> Self {
         Self {
             method,
+            run,
             planned_episodes,
             episode: 0,
             curve: Curve::default(),
@@ -344,15 +347,15 @@ impl Dashboard {
     pub fn on_event(&mut self, event: Event) {
         match event {
             Event::RunStarted {
+                run,
                 method,
                 planned_episodes,
                 sapnet,
-                ..
             } => {
                 if self.is_stale(&method, sapnet.is_some()) {
                     return;
                 }
-                let run = RunView::new(method, planned_episodes);
+                let run = RunView::new(method, run, planned_episodes);
                 if let Some(start) = sapnet {
                     let n = start.net.len();
                     self.sapnet = Some(SapNetView {
@@ -428,13 +431,13 @@ impl Dashboard {
                     run.ended = Some(record);
                 }
             }
-            Event::RunFailed { method, error, .. } => {
+            Event::RunFailed { run, method, error } => {
                 match self.runs.iter_mut().find(|r| r.method == method) {
                     Some(run) => run.failed = Some(error),
                     // It failed before it started (its networks would not build): it still
                     // gets its row, SAP-Net's first, so that the failure is seen.
                     None => {
-                        let mut run = RunView::new(method, 0);
+                        let mut run = RunView::new(method, run, 0);
                         run.failed = Some(error);
                         if run.method.kind == MethodKind::SapNet {
                             self.runs.insert(0, run);

@@ -639,7 +639,15 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
         hints
     };
     let episode = run.map_or("-".to_string(), |r| {
-        format!("{} ep {}/{}", r.method, r.episode, r.planned_episodes)
+        // Run 1 goes without saying; another (`--follow-run`) is named.
+        let which = match r.run {
+            0 => String::new(),
+            run => format!(" run {}", run + 1),
+        };
+        format!(
+            "{}{which} ep {}/{}",
+            r.method, r.episode, r.planned_episodes
+        )
     });
     let speed = match dashboard.steps_per_second {
         Some(s) => format!("{s:.0} steps/s"),
