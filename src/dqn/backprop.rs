@@ -20,8 +20,8 @@
 use candle_core::{bail, Result, Storage, Tensor};
 
 use super::kernels::{
-    largest_magnitude_bits, padded, sum_of_squares, transpose, Buffer, Finish, Isa, Product, Rows,
-    Start, Strided,
+    largest_magnitude_bits, padded, sum_of_squares, Buffer, Finish, Isa, Product, Rows, Start,
+    Strided, Transpose,
 };
 use super::{Architecture, QNet};
 
@@ -242,15 +242,13 @@ impl QNet {
         work.prepare(architecture, batch);
         let columns = work.columns;
         let sizes = &work.sizes;
-        transpose(
-            isa,
-            obs,
-            sizes[0],
-            batch,
-            sizes[0],
-            &mut work.activations[0],
-            columns,
-        );
+        Transpose {
+            src: obs,
+            src_stride: sizes[0],
+            rows: batch,
+            columns: sizes[0],
+        }
+        .run(isa, &mut work.activations[0], columns);
         let layers = sizes.len() - 1;
         for l in 0..layers {
             let (inputs, outputs) = (sizes[l], sizes[l + 1]);
@@ -278,15 +276,13 @@ impl QNet {
             })?;
         }
         let actions = sizes[layers];
-        transpose(
-            isa,
-            &work.activations[layers],
-            columns,
-            actions,
-            batch,
-            &mut work.q,
-            actions,
-        );
+        Transpose {
+            src: &work.activations[layers],
+            src_stride: columns,
+            rows: actions,
+            columns: batch,
+        }
+        .run(isa, &mut work.q, actions);
         Ok(&work.q)
     }
 
@@ -305,20 +301,24 @@ impl QNet {
         }
         work.prepare_backward();
         let sizes = &work.sizes;
-        transpose(
-            isa,
-            grad_q,
-            sizes[layers],
-            batch,
-            sizes[layers],
-            &mut work.grad_out,
-            columns,
-        );
+        Transpose {
+            src: grad_q,
+            src_stride: sizes[layers],
+            rows: batch,
+            columns: sizes[layers],
+        }
+        .run(isa, &mut work.grad_out, columns);
         for l in (0..layers).rev() {
             let (inputs, outputs) = (sizes[l], sizes[l + 1]);
             let stride = padded(inputs + 1);
             let input = &work.activations[l];
-            transpose(isa, input, columns, inputs, batch, &mut work.inputs, stride);
+            Transpose {
+                src: input,
+                src_stride: columns,
+                rows: inputs,
+                columns: batch,
+            }
+            .run(isa, &mut work.inputs, stride);
             for row in work.inputs.chunks_exact_mut(stride).take(batch) {
                 row[inputs] = 1.0;
             }

@@ -5,7 +5,7 @@
 
 use std::arch::x86_64::*;
 
-use super::{Finish, Product, Start};
+use super::{Finish, Product, Start, Transpose};
 
 const WIDTH: usize = 8;
 const ROWS: usize = 6;
@@ -79,21 +79,15 @@ unsafe fn tile<const R: usize>(
     }
 }
 
-/// The 8 × 8 blocks of `transpose`: rows `0..rows` and columns `0..columns`, both multiples
-/// of 8, by the classic unpack, shuffle and lane-permute network.
+/// The 8 × 8 blocks of a [`Transpose`] whose rows and columns are multiples of 8, by the
+/// classic unpack, shuffle and lane-permute network.
 ///
 /// # Safety
-/// The CPU has AVX2; `src` and `dst` hold every block (checked by `transpose`).
+/// The CPU has AVX2; `t.src` and `dst` hold every block (checked by `Transpose::run`).
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn transpose_blocks(
-    src: &[f32],
-    src_stride: usize,
-    rows: usize,
-    columns: usize,
-    dst: &mut [f32],
-    dst_stride: usize,
-) {
-    let (src, dst) = (src.as_ptr(), dst.as_mut_ptr());
+pub(super) unsafe fn transpose_blocks(t: &Transpose, dst: &mut [f32], dst_stride: usize) {
+    let (rows, columns, src_stride) = (t.rows, t.columns, t.src_stride);
+    let (src, dst) = (t.src.as_ptr(), dst.as_mut_ptr());
     for i in (0..rows).step_by(8) {
         for j in (0..columns).step_by(8) {
             let r: [__m256; 8] =

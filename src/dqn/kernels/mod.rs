@@ -230,57 +230,64 @@ impl Product<'_> {
     }
 }
 
-/// `dst[j·dst_stride + i] = src[i·src_stride + j]` for `i < rows`, `j < columns`: 8 × 8
-/// blocks in AVX registers where the CPU has AVX2, the edges (and other CPUs) one value
-/// at a time. A copy rounds nothing: every path gives the same result.
-pub(crate) fn transpose(
-    isa: Isa,
-    src: &[f32],
-    src_stride: usize,
-    rows: usize,
-    columns: usize,
-    dst: &mut [f32],
-    dst_stride: usize,
-) {
-    if rows == 0 || columns == 0 {
-        return;
-    }
-    assert!(src_stride >= columns && src.len() >= (rows - 1) * src_stride + columns);
-    assert!(dst_stride >= rows && dst.len() >= (columns - 1) * dst_stride + rows);
-    let (full_rows, full_columns) =
-        transpose_blocks(isa, src, src_stride, rows, columns, dst, dst_stride);
-    let one_by_one =
-        |dst: &mut [f32], i_range: std::ops::Range<usize>, j_range: std::ops::Range<usize>| {
-            for i in i_range {
-                for j in j_range.clone() {
-                    dst[j * dst_stride + i] = src[i * src_stride + j];
-                }
-            }
-        };
-    one_by_one(dst, 0..full_rows, full_columns..columns);
-    one_by_one(dst, full_rows..rows, 0..columns);
+/// `rows × columns` values of `src`, rows `src_stride` apart, to be copied transposed.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Transpose<'a> {
+    pub src: &'a [f32],
+    pub src_stride: usize,
+    pub rows: usize,
+    pub columns: usize,
 }
 
-/// The whole 8 × 8 blocks of `transpose` on AVX2, if the path and the CPU have it: returns
-/// the rows and columns it covered.
-fn transpose_blocks(
-    isa: Isa,
-    src: &[f32],
-    src_stride: usize,
-    rows: usize,
-    columns: usize,
-    dst: &mut [f32],
-    dst_stride: usize,
-) -> (usize, usize) {
-    #[cfg(target_arch = "x86_64")]
-    if isa != Isa::Portable && Isa::Avx2.supported() {
-        let covered = (rows / 8 * 8, columns / 8 * 8);
-        // SAFETY: the CPU has AVX2; `transpose` bounded both slices.
-        unsafe { avx2::transpose_blocks(src, src_stride, covered.0, covered.1, dst, dst_stride) };
-        return covered;
+impl Transpose<'_> {
+    /// `dst[j·dst_stride + i] = src[i·src_stride + j]` for `i < rows`, `j < columns`: 8 × 8
+    /// blocks in AVX registers where the CPU has AVX2, the edges (and other CPUs) one value
+    /// at a time. A copy rounds nothing: every path gives the same result.
+    ///
+    /// # Panics
+    /// If a slice is too short for the shapes.
+    pub(crate) fn run(&self, isa: Isa, dst: &mut [f32], dst_stride: usize) {
+        let Transpose {
+            src,
+            src_stride,
+            rows,
+            columns,
+        } = *self;
+        if rows == 0 || columns == 0 {
+            return;
+        }
+        assert!(src_stride >= columns && src.len() >= (rows - 1) * src_stride + columns);
+        assert!(dst_stride >= rows && dst.len() >= (columns - 1) * dst_stride + rows);
+        let (full_rows, full_columns) = self.blocks(isa, dst, dst_stride);
+        let one_by_one =
+            |dst: &mut [f32], i_range: std::ops::Range<usize>, j_range: std::ops::Range<usize>| {
+                for i in i_range {
+                    for j in j_range.clone() {
+                        dst[j * dst_stride + i] = src[i * src_stride + j];
+                    }
+                }
+            };
+        one_by_one(dst, 0..full_rows, full_columns..columns);
+        one_by_one(dst, full_rows..rows, 0..columns);
     }
-    let _ = (isa, src, src_stride, rows, columns, dst, dst_stride);
-    (0, 0)
+
+    /// The whole 8 × 8 blocks on AVX2, if the path and the CPU have it: returns the rows and
+    /// columns they covered.
+    fn blocks(&self, isa: Isa, dst: &mut [f32], dst_stride: usize) -> (usize, usize) {
+        #[cfg(target_arch = "x86_64")]
+        if isa != Isa::Portable && Isa::Avx2.supported() {
+            let covered = Transpose {
+                rows: self.rows / 8 * 8,
+                columns: self.columns / 8 * 8,
+                ..*self
+            };
+            // SAFETY: the CPU has AVX2; `run` bounded both slices.
+            unsafe { avx2::transpose_blocks(&covered, dst, dst_stride) };
+            return (covered.rows, covered.columns);
+        }
+        let _ = (isa, dst, dst_stride);
+        (0, 0)
+    }
 }
 
 /// `max |x|` over every value of `rows` of a gradient, as bits (`< 0x7f80_0000` iff all are
@@ -451,14 +458,26 @@ mod tests {
     fn transpose_swaps_rows_and_columns() {
         let src = [1.0, 2.0, 3.0, 0.0, 4.0, 5.0, 6.0, 0.0]; // 2×3, stride 4
         let mut dst = [0.0; 6];
-        transpose(Isa::Portable, &src, 4, 2, 3, &mut dst, 2);
+        Transpose {
+            src: &src,
+            src_stride: 4,
+            rows: 2,
+            columns: 3,
+        }
+        .run(Isa::Portable, &mut dst, 2);
         assert_eq!(dst, [1.0, 4.0, 2.0, 5.0, 3.0, 6.0]);
         // Blocks and edges, on every path.
         let (rows, columns) = (19, 21);
         let src: Vec<f32> = (0..rows * 24).map(|x| x as f32).collect();
         for isa in supported() {
             let mut dst = vec![-1.0; columns * 20];
-            transpose(isa, &src, 24, rows, columns, &mut dst, 20);
+            Transpose {
+                src: &src,
+                src_stride: 24,
+                rows,
+                columns,
+            }
+            .run(isa, &mut dst, 20);
             for i in 0..rows {
                 for j in 0..columns {
                     assert_eq!(dst[j * 20 + i], src[i * 24 + j], "{isa:?} {i} {j}");
