@@ -120,7 +120,7 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     if cli.run.follow.is_some() {
         anyhow::bail!("--follow is for the dashboard: --headless runs every method");
     }
-    if cli.run.follow_run != 1 {
+    if cli.run.follow_run.is_some() {
         anyhow::bail!("--follow-run is for the dashboard: --headless runs every run");
     }
     let dir = match &cli.run.out {
@@ -223,7 +223,7 @@ fn reference_bands(dir: &Path) -> Result<Vec<tui::reference::Band>> {
         .collect())
 }
 
-/// The dashboard follows one run (`--follow-run`, else run 1) of one reusing method
+/// The dashboard follows one run (`--follow-run`, else run 0) of one reusing method
 /// (`--follow`, else the first SAP-Net method, else the first that reuses; `m` moves to the
 /// next), step by step, beside the same run of the first DQN baseline, episode by episode;
 /// the library is loaded (or trained, with a progress bar) before the screen switches.
@@ -258,7 +258,7 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
     };
     // The followed run and the DQN baseline train side by side.
     let plan = experiment::plan(config, &cli.run.library_root(), 2, &on_interrupt()?)?;
-    let (followable, baseline) = dashboard_specs(&plan.specs, cli.run.follow_run)?;
+    let (followable, baseline) = dashboard_specs(&plan.specs, cli.run.follow_run.unwrap_or(0))?;
     let first = followable
         .iter()
         .position(|s| Some(&s.method) == followed.as_ref())
@@ -280,15 +280,17 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
     Ok(())
 }
 
-/// Run `run` (from 1, `--follow-run`) of every reusing method, streaming every step, and of
+/// Run `run` (from 0, as in the results' files; `--follow-run`) of every reusing method, streaming every step, and of
 /// the first DQN baseline: what the dashboard can train.
 fn dashboard_specs(specs: &[RunSpec], run: u32) -> Result<(Vec<RunSpec>, Option<RunSpec>)> {
     let runs = specs.iter().map(|s| s.run + 1).max().unwrap_or(0);
     anyhow::ensure!(
-        (1..=runs).contains(&run),
-        "--follow-run {run}: expected a run from 1 to {runs} (the config's runs per method)"
+        run < runs,
+        "--follow-run {run}: expected a run from 0 to {} (the config's {runs} runs per method, \
+         numbered from 0 as in the results' files)",
+        runs.saturating_sub(1)
     );
-    let index = run - 1;
+    let index = run;
     let followable = specs
         .iter()
         .filter(|s| s.run == index && s.method.kind.reuses())
@@ -477,21 +479,21 @@ mod tests {
 
     #[test]
     fn the_dashboard_trains_the_run_asked_for() {
-        let (followable, baseline) = dashboard_specs(&specs(), 2).unwrap();
+        let (followable, baseline) = dashboard_specs(&specs(), 1).unwrap();
         assert_eq!(followable.len(), 1);
         assert_eq!((followable[0].run, followable[0].seed), (1, 8));
         assert_eq!(followable[0].stream, StreamOptions::live());
         assert_eq!(baseline.map(|b| (b.run, b.seed)), Some((1, 8)));
-        let (first, _) = dashboard_specs(&specs(), 1).unwrap();
+        let (first, _) = dashboard_specs(&specs(), 0).unwrap();
         assert_eq!(first[0].run, 0);
     }
 
     #[test]
     fn a_run_the_config_does_not_have_is_refused_with_the_range() {
-        for run in [0, 3] {
+        for run in [2, 3] {
             let err = dashboard_specs(&specs(), run).unwrap_err().to_string();
             assert!(err.contains(&format!("--follow-run {run}")), "{err}");
-            assert!(err.contains("from 1 to 2"), "{err}");
+            assert!(err.contains("from 0 to 1"), "{err}");
         }
     }
 }

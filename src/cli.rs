@@ -62,17 +62,17 @@ pub struct RunArgs {
     #[arg(long)]
     pub quick: bool,
 
-    /// The dashboard trains and shows run 1 of this method (its label in results, e.g.
+    /// The dashboard trains and shows run 0 of this method (its label in results, e.g.
     /// `ucb1`, `sapnet-episode`), beside the first DQN baseline. Default: the first
     /// SAP-Net method, else the first that reuses the library.
     #[arg(long, value_name = "METHOD")]
     pub follow: Option<String>,
 
-    /// The dashboard trains run N (from 1) of the followed method and of the DQN baseline
-    /// instead of run 1, with the seeds a headless protocol gives run N: to watch a run
-    /// the results single out.
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub follow_run: u32,
+    /// The dashboard trains run N of the followed method and of the DQN baseline instead of
+    /// run 0, with the seeds a headless protocol gives run N: to watch a run the results
+    /// single out. Runs are numbered from 0, as in the results' files (`sapnet-run2`).
+    #[arg(long, value_name = "N")]
+    pub follow_run: Option<u32>,
 
     /// The dashboard draws a finished protocol's results (a `--headless` output folder)
     /// under the live curves: for each method on screen, the mean of its runs' moving

@@ -376,7 +376,7 @@ fn a_finished_protocol_is_drawn_as_bands_under_the_live_curves() {
 fn a_run_other_than_the_first_is_named_in_the_status_line() {
     let d = dashboard();
     assert!(!status_line(&draw_dashboard(&d, (120, 40))).contains(" run "));
-    // `--follow-run 3`: the runs announce themselves as run index 2.
+    // `--follow-run 2`: the runs announce themselves as run 2, as the results' files do.
     let mut d = Dashboard::new("CartPole-v1");
     for event in [tui_script::sapnet_start(), tui_script::baseline_start()] {
         let event = match event {
@@ -396,5 +396,5 @@ fn a_run_other_than_the_first_is_named_in_the_status_line() {
         d.on_event(event);
     }
     let line = status_line(&draw_dashboard(&d, (120, 40)));
-    assert!(line.contains("sapnet run 3 ep 0/5000"), "{line}");
+    assert!(line.contains("sapnet run 2 ep 0/5000"), "{line}");
 }

@@ -69,7 +69,7 @@ pub enum Action {
     Send(Command),
     /// Pause or resume every run.
     SendAll(Command),
-    /// Stop following this method's run and follow the next method's run 1 instead.
+    /// Stop following this method's run and follow the next method's same run instead.
     FollowNext,
     Quit,
 }

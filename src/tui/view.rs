@@ -639,10 +639,11 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
         hints
     };
     let episode = run.map_or("-".to_string(), |r| {
-        // Run 1 goes without saying; another (`--follow-run`) is named.
+        // Run 0 goes without saying; another (`--follow-run`) is named, from 0 as in the
+        // results' files.
         let which = match r.run {
             0 => String::new(),
-            run => format!(" run {}", run + 1),
+            run => format!(" run {run}"),
         };
         format!(
             "{}{which} ep {}/{}",
