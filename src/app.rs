@@ -34,8 +34,9 @@ pub fn run(cli: Cli) -> Result<()> {
     }
 }
 
-/// The config the user named, or `embedded` (with `label` for messages), with `--seed`
-/// applied.
+/// The config the user named, or `embedded` (with `label` for messages), with `--quick`,
+/// then `--seed` and `--episodes` applied (an explicit `--episodes` wins over `--quick`'s
+/// 1/20).
 fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
     let mut config = match &cli.run.config {
         Some(path) => Config::from_file(path)?,
@@ -43,6 +44,9 @@ fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
     };
     for warning in config.warnings() {
         eprintln!("warning: {warning}");
+    }
+    if cli.run.quick {
+        config.quick();
     }
     if let Some(seed) = cli.run.seed {
         config.seed = seed;
@@ -98,10 +102,7 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     if cli.run.resume {
         return resume_experiment(cli);
     }
-    let mut config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
-    if cli.run.quick {
-        config.quick();
-    }
+    let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
     if !cli.run.headless {
         if cli.run.out.is_some() || cli.run.force || cli.run.jobs.is_some() || cli.run.trace {
             anyhow::bail!(
@@ -133,8 +134,22 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     };
 
     let options = run_options(cli);
-    let summary = headless::run(&config, &output, &options, &on_interrupt()?)?;
+    let summary = headless::run(&config, &output, &options, &on_interrupt()?)
+        .map_err(|error| in_config_file(error, cli))?;
     report(&summary, &output.dir)
+}
+
+/// Names the config's file in an error one of its fields caused (a field only the library
+/// can check: [`experiment::ConfigField`]).
+fn in_config_file(error: anyhow::Error, cli: &Cli) -> anyhow::Error {
+    if error.downcast_ref::<experiment::ConfigField>().is_none() {
+        return error;
+    }
+    let origin = match &cli.run.config {
+        Some(path) => path.display().to_string(),
+        None => "embedded assets/cartpole.ron".to_string(),
+    };
+    error.context(format!("config {origin}"))
 }
 
 /// `--headless --resume --out DIR`.
@@ -257,7 +272,8 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
         None => Vec::new(),
     };
     // The followed run and the DQN baseline train side by side.
-    let plan = experiment::plan(config, &cli.run.library_root(), 2, &on_interrupt()?)?;
+    let plan = experiment::plan(config, &cli.run.library_root(), 2, &on_interrupt()?)
+        .map_err(|error| in_config_file(error, cli))?;
     let (followable, baseline) = dashboard_specs(&plan.specs, cli.run.follow_run.unwrap_or(0))?;
     let first = followable
         .iter()

@@ -146,6 +146,41 @@ fn an_unwritable_out_is_exit_code_2() {
         "{}",
         stderr(&output)
     );
+    // --out naming the file itself is said so, not with the OS's "File exists".
+    let output = run_short(&file, "1");
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output).contains("expected a directory for the results, and it is a file"),
+        "{}",
+        stderr(&output)
+    );
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "not a directory");
+}
+
+/// `--quick` cuts the protocol to 1/20 of its episodes, and an explicit `--episodes` wins
+/// over that (it once divided `--episodes` by 20 too).
+#[test]
+fn episodes_wins_over_quick() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let output = sapnet(&[
+        "--headless",
+        "--quick",
+        "--episodes",
+        "7",
+        "--config",
+        &config("short_cartpole.ron"),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let runs = summary["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2, "--quick keeps at most 2 runs");
+    for run in runs {
+        assert_eq!(run["episodes"], 7);
+    }
 }
 
 #[test]
@@ -270,8 +305,14 @@ fn a_coefficient_that_would_overflow_is_refused_before_any_run() {
     assert_eq!(output.status.code(), Some(2));
     let message = stderr(&output);
     assert_eq!(message.matches("too large").count(), 1, "{message}");
-    assert!(message.contains("method sapnet"), "{message}");
-    assert!(!out.join("runs").exists(), "no run started");
+    assert!(
+        message.contains(&format!(
+            "config {}: method sapnet: field `sapnet.coefficient`",
+            big.display()
+        )),
+        "the file and the field are named: {message}"
+    );
+    assert!(!out.exists(), "no run started, and no empty folder is left");
 }
 
 /// Issue 13: a network of 40 GB a copy tried to allocate (here 4 TB a copy, more than any

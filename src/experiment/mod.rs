@@ -8,5 +8,5 @@ pub mod plan;
 pub mod schedule;
 
 pub use library_copy::{policy_info, LibraryCopies};
-pub use plan::{method_ids, plan, run_specs, Plan};
+pub use plan::{method_ids, plan, run_specs, ConfigField, Plan};
 pub use schedule::{schedule, Observer};

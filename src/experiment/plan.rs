@@ -4,13 +4,15 @@
 use std::sync::mpsc::Receiver;
 use std::sync::Arc;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use super::memory;
 use crate::config::Config;
+use crate::reuse::ReuseError;
+use crate::sapnet::SapNetError;
 use crate::seeds;
 use crate::sources::{self, LibraryRoot};
-use crate::trainer::{Command, MethodId, RunSpec, SourcePolicy, StreamOptions};
+use crate::trainer::{Command, MethodId, RunSpec, SourcePolicy, StreamOptions, TrainerError};
 
 /// The runs of a protocol and the library they reuse.
 #[derive(Debug)]
@@ -59,9 +61,38 @@ pub fn plan(
         .iter()
         .filter(|s| s.run == 0 && s.method.kind.reuses())
     {
-        crate::trainer::selector(spec).with_context(|| format!("method {}", spec.method))?;
+        crate::trainer::selector(spec).map_err(|error| refused_method(spec, error))?;
     }
     Ok(Plan { specs, sources })
+}
+
+/// A method whose selector cannot be built over this library. When a field of the config
+/// is to blame, the error's context is a [`ConfigField`], so that a front end can name the
+/// config's file too.
+fn refused_method(spec: &RunSpec, error: TrainerError) -> anyhow::Error {
+    let method = spec.method.to_string();
+    match error {
+        TrainerError::Reuse(ReuseError::SapNet(SapNetError::ActivationOverflow { .. })) => {
+            anyhow::Error::new(error).context(ConfigField {
+                method,
+                field: "sapnet.coefficient",
+            })
+        }
+        error => anyhow::Error::new(error).context(format!("method {method}")),
+    }
+}
+
+/// The config field a refused method is refused for.
+#[derive(Debug)]
+pub struct ConfigField {
+    pub method: String,
+    pub field: &'static str,
+}
+
+impl std::fmt::Display for ConfigField {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "method {}: field `{}`", self.method, self.field)
+    }
 }
 
 /// One spec per (method, run), each with its own seed derived from the run seed, the

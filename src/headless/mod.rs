@@ -93,8 +93,15 @@ pub fn run(
     options: &RunOptions,
     commands: &Receiver<Command>,
 ) -> Result<Summary> {
+    let created = !output.dir.exists();
     let replaced = prepare_output(output)?;
     let summary = protocol(config, &output.dir, options, None, commands);
+    if summary.is_err() && created {
+        // Refused before anything was written (a library that cannot load, a config the
+        // library cannot take): leave no empty folder behind. A folder holding anything is
+        // kept: it is a failed run's record.
+        let _ = std::fs::remove_dir(&output.dir);
+    }
     // Delete last: the old results go only once the new ones are written.
     if let (Ok(_), Some(replaced)) = (&summary, &replaced) {
         if let Err(err) = std::fs::remove_dir_all(replaced) {

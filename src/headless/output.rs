@@ -36,6 +36,12 @@ const REPLACED: &str = ".replaced";
 /// once the new ones are written: a directory where nothing can be written loses nothing.
 pub(super) fn prepare_output(output: &OutputOptions) -> Result<Option<PathBuf>> {
     let dir = &output.dir;
+    if dir.exists() && !dir.is_dir() {
+        bail!(
+            "--out {}: expected a directory for the results, and it is a file",
+            dir.display()
+        );
+    }
     std::fs::create_dir_all(dir)
         .with_context(|| format!("creating the output directory {}", dir.display()))?;
     let existing: Vec<&str> = RESULT_FILES
