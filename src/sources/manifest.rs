@@ -77,58 +77,92 @@ impl LibraryTraining {
         self.tasks.iter().map(|t| t.count).sum()
     }
 
-    /// The settings in which `other` trains its sources differently, as `field: ours vs
-    /// theirs`. The seed, the test episodes, the count and the task are left out: a run
-    /// with another `--seed` reuses the same library on purpose, tests only measure, and a
-    /// run checks the count and the task itself.
-    pub fn differences(&self, other: &Self) -> Vec<String> {
-        self.compare(other, false)
+    /// The settings in which `library` (a library's record) trained its sources otherwise
+    /// than this config describes, as `field: the config's X, the library's Y`, the DQN's
+    /// settings field by field. The seed, the test episodes, the count and the task are
+    /// left out: a run with another `--seed` reuses the same library on purpose, tests only
+    /// measure, and a run checks the count and the task itself.
+    pub fn differences(&self, library: &Self) -> Vec<String> {
+        self.compare(library, false)
     }
 
-    /// Every setting in which `other` differs, the seed and the count included.
-    pub fn all_differences(&self, other: &Self) -> Vec<String> {
-        self.compare(other, true)
+    /// Every setting in which `library` differs, the seed and the count included.
+    pub fn all_differences(&self, library: &Self) -> Vec<String> {
+        self.compare(library, true)
     }
 
-    fn compare(&self, other: &Self, all: bool) -> Vec<String> {
+    fn compare(&self, library: &Self, all: bool) -> Vec<String> {
         let mut found = Vec::new();
-        let mut compare = |field: &str, ours: String, theirs: String| {
-            if ours != theirs {
-                found.push(format!("{field}: {ours} vs {theirs}"));
+        let mut compare = |field: &str, config: String, library: String| {
+            if config != library {
+                found.push(format!(
+                    "{field}: the config's {config}, the library's {library}"
+                ));
             }
         };
         if all {
-            compare("source tasks", tasks(&self.tasks), tasks(&other.tasks));
+            compare("source tasks", tasks(&self.tasks), tasks(&library.tasks));
         }
         compare(
             "sources.hidden_layers",
             format!("{:?}", self.hidden_layers),
-            format!("{:?}", other.hidden_layers),
+            format!("{:?}", library.hidden_layers),
         );
         compare(
             "sources.units",
             format!("{:?}", self.units),
-            format!("{:?}", other.units),
+            format!("{:?}", library.units),
         );
         compare(
             "sources.training_episodes",
             self.training_episodes.to_string(),
-            other.training_episodes.to_string(),
+            library.training_episodes.to_string(),
         );
-        compare("the sources' dqn", ron(&self.dqn), ron(&other.dqn));
+        for (field, config, library) in dqn_differences(&self.dqn, &library.dqn) {
+            compare(&format!("the sources' dqn.{field}"), config, library);
+        }
         if all {
             compare(
                 "protocol.test_episodes",
                 self.test_episodes.to_string(),
-                other.test_episodes.to_string(),
+                library.test_episodes.to_string(),
             );
-            compare("seed", self.seed.to_string(), other.seed.to_string());
+            compare("seed", self.seed.to_string(), library.seed.to_string());
         }
         found
     }
 }
 
-/// `cartpole(length=1.0) ×3, cartpole ×2`.
+/// The DQN settings that differ, as (field, ours, theirs) in RON: one line per field rather
+/// than the whole section twice.
+fn dqn_differences(ours: &DqnConfig, theirs: &DqnConfig) -> Vec<(String, String, String)> {
+    let fields = |dqn: &DqnConfig| match serde_json::to_value(dqn) {
+        Ok(serde_json::Value::Object(fields)) => fields,
+        _ => serde_json::Map::new(),
+    };
+    let (ours_fields, theirs_fields) = (fields(ours), fields(theirs));
+    if ours_fields.is_empty() || theirs_fields.is_empty() {
+        // Not a map (cannot happen for a struct): say the whole section.
+        return vec![("(all)".into(), ron(ours), ron(theirs))];
+    }
+    ours_fields
+        .iter()
+        .filter(|(name, value)| theirs_fields.get(*name) != Some(value))
+        .map(|(name, value)| {
+            let text = |v: Option<&serde_json::Value>| match v {
+                Some(serde_json::Value::String(s)) => s.clone(),
+                Some(v) => v.to_string(),
+                None => "-".into(),
+            };
+            (
+                name.clone(),
+                text(Some(value)),
+                text(theirs_fields.get(name)),
+            )
+        })
+        .collect()
+}
+
 fn tasks(tasks: &[SourceTask]) -> String {
     tasks
         .iter()
@@ -228,7 +262,13 @@ mod tests {
         theirs.dqn.learning_rate *= 2.0;
         let found = ours.differences(&theirs);
         assert_eq!(found.len(), 2, "{found:?}");
-        assert_eq!(found[0], "sources.training_episodes: 5000 vs 3");
-        assert!(found[1].starts_with("the sources' dqn: "), "{found:?}");
+        assert_eq!(
+            found[0],
+            "sources.training_episodes: the config's 5000, the library's 3"
+        );
+        assert_eq!(
+            found[1],
+            "the sources' dqn.learning_rate: the config's 0.001, the library's 0.002"
+        );
     }
 }

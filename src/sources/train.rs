@@ -203,7 +203,7 @@ fn resumable(
                     } else {
                         "partly trained"
                     },
-                    found.training.all_differences(training).join("; ")
+                    training.all_differences(&found.training).join("; ")
                 );
             }
             Ok(Vec::new())
