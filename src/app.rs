@@ -223,14 +223,23 @@ fn report(summary: &headless::Summary, dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The bands of a finished protocol's methods (`--compare DIR`), from its episodes.csv.
-fn reference_bands(dir: &Path) -> Result<Vec<tui::reference::Band>> {
+/// The bands of a finished protocol's methods (`--compare DIR`), from its episodes.csv;
+/// refused when that protocol trained on another task than `task`, the dashboard's (its
+/// returns would be drawn on the wrong scale).
+fn reference_bands(dir: &Path, task: &str) -> Result<Vec<tui::reference::Band>> {
     let data = headless::read_plot_data(dir).with_context(|| {
         format!(
             "--compare {}: expected the output folder of a `sapnet --headless` run",
             dir.display()
         )
     })?;
+    anyhow::ensure!(
+        data.task == task,
+        "--compare {}: its results are on {}, the dashboard trains on {task}: compare with a \
+         protocol on the same task",
+        dir.display(),
+        data.task
+    );
     Ok(data
         .curves
         .iter()
@@ -268,7 +277,7 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
     };
     // Read before training starts, so that a wrong folder is said at once.
     let reference = match &cli.run.compare {
-        Some(dir) => reference_bands(dir)?,
+        Some(dir) => reference_bands(dir, env::make(&config.env).id())?,
         None => Vec::new(),
     };
     // The followed run and the DQN baseline train side by side.

@@ -391,3 +391,26 @@ fn compare_needs_a_results_folder_and_the_dashboard() {
         stderr(&output)
     );
 }
+
+/// `--compare` with another task's results drew CartPole's returns under MountainCar's:
+/// refused, naming both tasks, before the dashboard opens.
+#[test]
+fn compare_refuses_another_tasks_results() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("cartpole");
+    assert!(run_short(&out, "1").status.success());
+    let mountain_car = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/mountain_car.ron");
+    let output = sapnet(&[
+        "--config",
+        mountain_car.to_str().unwrap(),
+        "--compare",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output)
+            .contains("its results are on CartPole-v1, the dashboard trains on MountainCar-v0"),
+        "{}",
+        stderr(&output)
+    );
+}
