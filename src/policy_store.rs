@@ -390,6 +390,20 @@ fn check_name(name: &str) -> Result<(), StoreError> {
     }
 }
 
+/// Removes the hidden `*.tmp` files a save that never finished (a killed process) left in
+/// `dir`. For a folder no other process is writing to: a resumed run's, a library being
+/// trained again.
+pub fn remove_temporaries(dir: &Path) -> std::io::Result<()> {
+    for entry in fs::read_dir(dir)? {
+        let path = entry?.path();
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name.starts_with('.') && name.ends_with(".tmp") && path.is_file() {
+            fs::remove_file(&path)?;
+        }
+    }
+    Ok(())
+}
+
 /// A hidden sibling of `path`, unique to this process; `*.tmp` is ignored by git.
 fn temporary(path: &Path) -> PathBuf {
     let file = path

@@ -237,9 +237,18 @@ pub fn unfinished(config: &Config, finished: &[RunFolder]) -> Vec<RunKey> {
     keys
 }
 
-/// Removes what a resumed protocol runs again: partial records (a killed process's) and
-/// the records of stopped runs.
+/// Removes what a resumed protocol runs again: partial records and half-saved policies (a
+/// killed process's) and the records of stopped runs.
 pub fn clear_unfinished(out: &Path, finished: &[RunFolder]) -> Result<()> {
+    let policies = out.join("policies");
+    if policies.is_dir() {
+        crate::policy_store::remove_temporaries(&policies).with_context(|| {
+            format!(
+                "removing a killed save's leftovers from {}",
+                policies.display()
+            )
+        })?;
+    }
     let dir = out.join(RUNS);
     if let Ok(entries) = std::fs::read_dir(&dir) {
         for entry in entries.flatten() {
@@ -264,6 +273,26 @@ pub fn clear_unfinished(out: &Path, finished: &[RunFolder]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_resume_removes_a_killed_saves_leftovers_and_keeps_the_policies() {
+        let out = tempfile::tempdir().unwrap();
+        let policies = out.path().join("policies");
+        std::fs::create_dir(&policies).unwrap();
+        let leftovers = [
+            ".sapnet-run0.ron.4242.tmp",
+            ".sapnet-run0.safetensors.4242.tmp",
+        ];
+        for name in leftovers {
+            std::fs::write(policies.join(name), "half").unwrap();
+        }
+        std::fs::write(policies.join("dqn-16-run0.ron"), "kept").unwrap();
+        clear_unfinished(out.path(), &[]).unwrap();
+        for name in leftovers {
+            assert!(!policies.join(name).exists(), "{name}");
+        }
+        assert!(policies.join("dqn-16-run0.ron").exists());
+    }
 
     #[test]
     fn run_names_are_plain() {

@@ -36,7 +36,8 @@ pub fn train_library(
     let kept = resumable(&dir, &training, &plans, retrain)?;
     std::fs::create_dir_all(&dir)
         .with_context(|| format!("creating the library folder {}", dir.display()))?;
-    remove_temporaries(&dir)?;
+    crate::policy_store::remove_temporaries(&dir)
+        .with_context(|| format!("removing a killed save's leftovers from {}", dir.display()))?;
     let mut manifest = Manifest {
         complete: false,
         training,
@@ -244,19 +245,6 @@ fn resumable(
             Ok(adopted)
         }
     }
-}
-
-/// Removes the hidden `*.tmp` files an interrupted save leaves behind.
-fn remove_temporaries(dir: &Path) -> Result<()> {
-    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
-        let path = entry?.path();
-        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
-        if name.starts_with('.') && name.ends_with(".tmp") && path.is_file() {
-            std::fs::remove_file(&path)
-                .with_context(|| format!("removing the leftover {}", path.display()))?;
-        }
-    }
-    Ok(())
 }
 
 /// Progress of one source's training, and its outcome.
