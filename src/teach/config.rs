@@ -70,6 +70,11 @@ impl Default for TeachConfig {
     }
 }
 
+/// The most policies a lesson may have: a lesson is stepped by hand and drawn on one screen,
+/// and the bound is checked before the graph is allocated (100 million policies once took
+/// 7 GB and ran on without a word).
+pub const MAX_LESSON_POLICIES: usize = 1000;
+
 /// A teach file made ready: the SAP-Net and what to call its policies.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Lesson {
@@ -192,8 +197,14 @@ impl TeachConfig {
                 Some(_) => {}
             }
         }
-        n.map(|(_, count)| count)
-            .ok_or_else(|| "no policies: give `policies`, `names` or `descriptions`".into())
+        match n {
+            None => Err("no policies: give `policies`, `names` or `descriptions`".into()),
+            Some((field, count)) if count > MAX_LESSON_POLICIES => Err(format!(
+                "field `{field}` gives {count} policies: a lesson has at most \
+                 {MAX_LESSON_POLICIES} (it is stepped by hand and drawn on one screen)"
+            )),
+            Some((_, count)) => Ok(count),
+        }
     }
 }
 
@@ -262,6 +273,12 @@ mod tests {
             e.contains("`names` gives 2 policies but `policies` gives 3"),
             "{e}"
         );
+        let e = lesson("(policies: 100000000)").unwrap_err();
+        assert!(
+            e.contains("field `policies` gives 100000000 policies: a lesson has at most 1000"),
+            "{e}"
+        );
+        assert!(lesson("(policies: 1000)").is_ok());
         let e = lesson("(policies: 2, initial: Some([1.0]))").unwrap_err();
         assert!(e.contains("field `initial`"), "{e}");
         let e = lesson("(threshold: 1.0)").unwrap_err();
