@@ -17,6 +17,9 @@ use crate::tui::{self, teach::Teach};
 use crate::{assets, env, random_episodes, trainer};
 
 pub fn run(cli: Cli) -> Result<()> {
+    if let Some(command) = &cli.command {
+        refuse_unread_flags(&cli, command)?;
+    }
     match &cli.command {
         Some(Command::Env(args)) => run_env(&cli, args),
         Some(Command::Teach(args)) => run_teach(&cli, args),
@@ -32,6 +35,43 @@ pub fn run(cli: Cli) -> Result<()> {
         }
         None => run_experiment(&cli),
     }
+}
+
+/// A flag the subcommand would ignore is refused: `sapnet env --library DIR` reads no
+/// library, and saying nothing would let the user believe it did.
+fn refuse_unread_flags(cli: &Cli, command: &Command) -> Result<()> {
+    let (name, reads): (&str, &[&str]) = match command {
+        Command::Env(_) => ("env", &["--config", "--seed"]),
+        Command::Teach(_) => ("teach", &["--config"]),
+        Command::Sources(_) => ("sources", &["--config", "--seed", "--library"]),
+        Command::Plot(_) => ("plot", &[]),
+        Command::Sweep(args) => match args.command {
+            SweepCommand::Plan { .. } => ("sweep plan", &["--config", "--library"]),
+            SweepCommand::Run { .. } => ("sweep run", &["--jobs"]),
+            SweepCommand::Prepare { .. } => ("sweep prepare", &[]),
+            SweepCommand::Status { .. } => ("sweep status", &[]),
+            SweepCommand::Merge { .. } => ("sweep merge", &[]),
+        },
+    };
+    let unread: Vec<&str> = cli
+        .run
+        .given()
+        .into_iter()
+        .filter(|flag| !reads.contains(flag))
+        .collect();
+    if unread.is_empty() {
+        return Ok(());
+    }
+    let what = if reads.is_empty() {
+        "none of the run's flags".to_string()
+    } else {
+        reads.join(", ")
+    };
+    let them = if unread.len() == 1 { "it" } else { "them" };
+    anyhow::bail!(
+        "`sapnet {name}` does not read {}: leave {them} out (it reads {what})",
+        unread.join(", ")
+    )
 }
 
 /// The config the user named, or `embedded` (with `label` for messages), with `--quick`,

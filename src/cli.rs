@@ -92,7 +92,7 @@ pub struct RunArgs {
     pub trace: bool,
 
     /// Runs trained at the same time (`sweep run --all`: cells). Default: one per core.
-    #[arg(long, value_name = "N", global = true)]
+    #[arg(long, value_name = "N", global = true, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=4096))]
     pub jobs: Option<usize>,
 
     /// The policy library's root directory: SAP-Net reuses <LIBRARY>/<source task>/.
@@ -111,6 +111,31 @@ pub struct RunArgs {
 pub const DEFAULT_LIBRARY: &str = "saved_policies";
 
 impl RunArgs {
+    /// The flags given, as the user spelled them: a subcommand refuses those it does not
+    /// read rather than ignore them.
+    pub fn given(&self) -> Vec<&'static str> {
+        [
+            ("--config", self.config.is_some()),
+            ("--headless", self.headless),
+            ("--seed", self.seed.is_some()),
+            ("--out", self.out.is_some()),
+            ("--force", self.force),
+            ("--resume", self.resume),
+            ("--quick", self.quick),
+            ("--follow", self.follow.is_some()),
+            ("--follow-run", self.follow_run.is_some()),
+            ("--compare", self.compare.is_some()),
+            ("--episodes", self.episodes.is_some()),
+            ("--trace", self.trace),
+            ("--jobs", self.jobs.is_some()),
+            ("--library", self.library.is_some()),
+            ("--train-library", self.train_library),
+        ]
+        .into_iter()
+        .filter_map(|(flag, given)| given.then_some(flag))
+        .collect()
+    }
+
     /// `--library`, or the default.
     pub fn library_path(&self) -> PathBuf {
         self.library
@@ -231,11 +256,12 @@ pub struct TeachArgs {
     #[arg(long = "activate", value_name = "I")]
     pub activate: Vec<usize>,
 
-    /// With --activate: open with the last walk already run to its end.
-    #[arg(long)]
+    /// With --activate: open with the last walk already run to its end (--headless prints
+    /// every walk whole anyway).
+    #[arg(long, conflicts_with = "headless")]
     pub run: bool,
 
     /// With --headless: print one JSON object {activations, probabilities, trace}.
-    #[arg(long)]
+    #[arg(long, requires = "headless")]
     pub json: bool,
 }

@@ -414,3 +414,34 @@ fn compare_refuses_another_tasks_results() {
         stderr(&output)
     );
 }
+
+/// Flags a subcommand does not read were accepted and ignored (`sapnet env --library DIR`,
+/// `teach --json` opening the TUI, `--jobs 0`): each is refused, naming it.
+#[test]
+fn flags_a_subcommand_would_ignore_are_refused() {
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["env", "--library", "/nonexistent", "--jobs", "5"],
+            "`sapnet env` does not read --jobs, --library: leave them out (it reads --config, --seed)",
+        ),
+        (
+            &["plot", "--seed", "3", "/nonexistent"],
+            "`sapnet plot` does not read --seed: leave it out",
+        ),
+        (
+            &["--headless", "teach"],
+            "`sapnet teach` does not read --headless: leave it out (it reads --config)",
+        ),
+        (&["teach", "--json"], "--headless"),
+        (&["--headless", "--jobs", "0"], "invalid value '0' for '--jobs <N>'"),
+    ];
+    for (args, expected) in cases {
+        let output = sapnet(args);
+        assert_eq!(output.status.code(), Some(2), "{args:?}");
+        assert!(
+            stderr(&output).contains(expected),
+            "{args:?}: {}",
+            stderr(&output)
+        );
+    }
+}
