@@ -102,8 +102,9 @@ pub fn slurm_script(exe: &Path, sweep: &Path, cells: usize) -> String {
     format!(
         "#!/bin/bash\n\
          # The {cells} cells of {sweep} as a Slurm array job: `sbatch {sweep}/slurm.sbatch`.\n\
-         # Throttle with `sbatch --array=0-{last}%8 …`; rerun cells 3 and 7 only with\n\
-         # `sbatch --array=3,7 …` (`sapnet sweep status {sweep}` lists what failed).\n\
+         # Throttle with `sbatch --array=0-{last}%8 …`; rerun only some cells by their\n\
+         # numbers, e.g. `sbatch --array=0,{last} …` (`sapnet sweep status {sweep}` lists\n\
+         # what failed).\n\
          #SBATCH --job-name=sapnet-sweep\n\
          #SBATCH --array=0-{last}\n\
          #SBATCH --cpus-per-task=1\n\
