@@ -241,7 +241,7 @@ pub struct SourcesArgs {
 #[derive(Debug, Args)]
 pub struct EnvArgs {
     /// Number of episodes.
-    #[arg(long, value_name = "N", default_value_t = 10)]
+    #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
     pub episodes: u32,
 }
 

@@ -457,7 +457,20 @@ impl Config {
 
     /// Reads and validates a config from RON text; `origin` names it in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Self, ConfigError> {
-        let config: Config = parse_ron(text, origin)?;
+        let config: Config = parse_ron(text, origin).map_err(|e| {
+            // A lesson given where a training config is expected: say what each reads.
+            if parse_ron::<crate::teach::config::TeachConfig>(text, origin).is_ok() {
+                ConfigError::Invalid {
+                    origin: origin.to_string(),
+                    message: "this is a lesson, for `sapnet teach --config`; runs, `env` and \
+                              `sources` read a training config (e.g. assets/cartpole.ron, \
+                              assets/mountain_car.ron)"
+                        .to_string(),
+                }
+            } else {
+                e
+            }
+        })?;
         config.validate().map_err(|message| ConfigError::Invalid {
             origin: origin.to_string(),
             message,
@@ -812,6 +825,16 @@ fn check_exploration(exploration: &Exploration, field: &str) -> Result<(), Strin
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_lesson_given_as_a_training_config_is_named_as_such() {
+        let lesson = include_str!("../assets/teach_fig2.ron");
+        let err = Config::from_ron(lesson, "fig2.ron").unwrap_err().to_string();
+        assert!(
+            err.contains("fig2.ron: this is a lesson, for `sapnet teach --config`"),
+            "{err}"
+        );
+    }
 
     #[test]
     fn defaults_are_the_papers_tables() {
