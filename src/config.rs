@@ -441,7 +441,10 @@ pub fn parse_ron<T: serde::de::DeserializeOwned>(
         }))
     };
     let value = serde_path_to_error::deserialize(&mut de).map_err(|e| {
-        let field = e.path().to_string();
+        // A syntax error between fields ends the path in `?` (no field was being read):
+        // name the innermost field that was, and let the line and column say the rest.
+        let path = e.path().to_string();
+        let field = path.trim_end_matches(['?', '.']).to_string();
         located(&de, field, e.into_inner())
     })?;
     de.end().map_err(|e| located(&de, String::new(), e))?;
@@ -825,6 +828,18 @@ fn check_exploration(exploration: &Exploration, field: &str) -> Result<(), Strin
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_syntax_error_between_fields_names_the_field_around_it() {
+        let err = Config::from_ron("(\n    dqn: (batch_size: 32.5),\n)", "bad.ron")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("line 2, column 25, field `dqn`: "), "{err}");
+        let err = Config::from_ron("(\n    dqn: (batch_size: 32),\n", "bad.ron")
+            .unwrap_err()
+            .to_string();
+        assert!(!err.contains('?'), "{err}");
+    }
 
     #[test]
     fn a_lesson_given_as_a_training_config_is_named_as_such() {
