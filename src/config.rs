@@ -580,9 +580,15 @@ impl Config {
         if let Some(sources) = &self.sources.dqn {
             check_dqn(sources, "sources.dqn")?;
         }
-        self.sapnet
-            .validate()
-            .map_err(|e| format!("section `sapnet`: {e}"))?;
+        self.sapnet.validate().map_err(|e| match e {
+            // Worded as every other field of the config is.
+            crate::sapnet::SapNetError::BadParameter {
+                name,
+                value,
+                expected,
+            } => format!("field `sapnet.{name}`: expected {expected}, got {}", value.shown()),
+            e => format!("section `sapnet`: {e}"),
+        })?;
         // A negative transition activates with 0 (Algorithm 3): 𝒜 ≤ 0 would never credit a
         // good step, and no selection could follow learning.
         check(
@@ -839,6 +845,17 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(!err.contains('?'), "{err}");
+    }
+
+    #[test]
+    fn a_bad_sapnet_parameter_is_worded_as_every_field() {
+        let err = Config::from_ron("(sapnet: (temperature: -1.0))", "t.ron")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("field `sapnet.temperature`: expected a finite number > 0, got -1.0"),
+            "{err}"
+        );
     }
 
     #[test]
