@@ -441,7 +441,8 @@ fn run_sweep(cli: &Cli, command: &SweepCommand) -> Result<()> {
                 eprint!("{}", sweep::status::report(&states));
                 anyhow::ensure!(
                     failed == 0,
-                    "{failed} cells failed: `sapnet sweep status {}` says why",
+                    "{failed} {} failed: `sapnet sweep status {}` says why",
+                    if failed == 1 { "cell" } else { "cells" },
                     sweep.display()
                 );
                 return Ok(());
@@ -473,8 +474,13 @@ fn run_sweep(cli: &Cli, command: &SweepCommand) -> Result<()> {
                     .map(|&id| sweep::cell_name(id))
                     .collect();
                 eprintln!(
-                    "{} cells are not done and are left out: {}",
+                    "{} {} left out: {}",
                     names.len(),
+                    if names.len() == 1 {
+                        "cell is not done and is"
+                    } else {
+                        "cells are not done and are"
+                    },
                     names.join(", ")
                 );
             }

@@ -586,7 +586,10 @@ impl Config {
                 name,
                 value,
                 expected,
-            } => format!("field `sapnet.{name}`: expected {expected}, got {}", value.shown()),
+            } => format!(
+                "field `sapnet.{name}`: expected {expected}, got {}",
+                value.shown()
+            ),
             e => format!("section `sapnet`: {e}"),
         })?;
         // A negative transition activates with 0 (Algorithm 3): 𝒜 ≤ 0 would never credit a
@@ -861,7 +864,9 @@ mod tests {
     #[test]
     fn a_lesson_given_as_a_training_config_is_named_as_such() {
         let lesson = include_str!("../assets/teach_fig2.ron");
-        let err = Config::from_ron(lesson, "fig2.ron").unwrap_err().to_string();
+        let err = Config::from_ron(lesson, "fig2.ron")
+            .unwrap_err()
+            .to_string();
         assert!(
             err.contains("fig2.ron: this is a lesson, for `sapnet teach --config`"),
             "{err}"
