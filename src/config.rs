@@ -385,6 +385,8 @@ pub fn read_text(path: &Path) -> Result<String, ConfigError> {
 /// A located syntax or type error in a RON file.
 #[derive(Debug)]
 pub struct ParseError {
+    /// What the file is, as messages name it: `config`, `policy metadata`, ….
+    pub kind: &'static str,
     /// The file name, or a label for text that did not come from a file.
     pub origin: String,
     pub line: usize,
@@ -398,8 +400,8 @@ impl fmt::Display for ParseError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "config {}: line {}, column {}",
-            self.origin, self.line, self.column
+            "{} {}: line {}, column {}",
+            self.kind, self.origin, self.line, self.column
         )?;
         if !self.field.is_empty() && self.field != "." {
             write!(f, ", field `{}`", self.field)?;
@@ -415,14 +417,26 @@ pub fn ron_options() -> ron::Options {
         .with_default_extension(ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES)
 }
 
-/// Reads any RON document, with located errors. `origin` names the text in messages.
+/// Reads a config, lesson or grid from RON, with located errors. `origin` names the text
+/// in messages.
 pub fn parse_ron<T: serde::de::DeserializeOwned>(
     text: &str,
     origin: &str,
 ) -> Result<T, ConfigError> {
+    parse_ron_as(text, origin, "config")
+}
+
+/// Reads any RON document, with located errors naming it as `kind` (`policy metadata`,
+/// `library manifest`, …) and `origin`.
+pub fn parse_ron_as<T: serde::de::DeserializeOwned>(
+    text: &str,
+    origin: &str,
+    kind: &'static str,
+) -> Result<T, ConfigError> {
     let options = ron_options();
     let mut de = ron::Deserializer::from_str_with_options(text, &options).map_err(|e| {
         ConfigError::Parse(Box::new(ParseError {
+            kind,
             origin: origin.to_string(),
             line: e.span.start.line,
             column: e.span.start.col,
@@ -433,6 +447,7 @@ pub fn parse_ron<T: serde::de::DeserializeOwned>(
     let located = |de: &ron::Deserializer, field: String, code: ron::Error| {
         let spanned = de.span_error(code);
         ConfigError::Parse(Box::new(ParseError {
+            kind,
             origin: origin.to_string(),
             line: spanned.span.start.line,
             column: spanned.span.start.col,

@@ -20,7 +20,7 @@ use candle_core::{DType, Device};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::config::{parse_ron, ron_options, ConfigError};
+use crate::config::{parse_ron_as, ron_options, ConfigError};
 use crate::dqn::{Architecture, DqnError, QNet};
 use crate::env::EnvConfig;
 
@@ -100,7 +100,8 @@ pub enum StoreError {
     },
     #[error("policy name {name:?} is not a plain file name (nor {RESERVED_NAME:?})")]
     InvalidName { name: String },
-    #[error("policy metadata: {0}")]
+    /// Reading or parsing a RON file of the store (its message names the file and what it is).
+    #[error("{0}")]
     Metadata(ConfigError),
     #[error("policy file {}: {message}", path.display())]
     Invalid { path: PathBuf, message: String },
@@ -229,7 +230,11 @@ pub fn load(dir: &Path, name: &str) -> Result<StoredPolicy, StoreError> {
         });
     }
     let text = crate::config::read_text(&metadata_path)?;
-    let metadata: PolicyMetadata = parse_ron(&text, &metadata_path.display().to_string())?;
+    let metadata: PolicyMetadata = parse_ron_as(
+        &text,
+        &metadata_path.display().to_string(),
+        "policy metadata",
+    )?;
     if metadata.activation != ACTIVATION {
         return Err(StoreError::Invalid {
             path: metadata_path,

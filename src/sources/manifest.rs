@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::SourceTask;
-use crate::config::{parse_ron, ron_options, Config, DqnConfig};
+use crate::config::{parse_ron_as, ron_options, Config, DqnConfig};
 use crate::policy_store::{self, PolicyMetadata, StoreError};
 
 /// The manifest's file name inside `<library>/<task>/`.
@@ -211,7 +211,11 @@ pub fn read(dir: &Path) -> Result<Option<Manifest>, StoreError> {
         return Ok(None);
     }
     let text = crate::config::read_text(&path)?;
-    Ok(Some(parse_ron(&text, &path.display().to_string())?))
+    Ok(Some(parse_ron_as(
+        &text,
+        &path.display().to_string(),
+        "library manifest",
+    )?))
 }
 
 /// Replaces `dir`'s manifest in one rename, so a reader sees the old one or the new one.
@@ -249,6 +253,20 @@ mod tests {
         assert_eq!(read(tmp.path()).unwrap(), None);
         write(tmp.path(), &manifest).unwrap();
         assert_eq!(read(tmp.path()).unwrap(), Some(manifest));
+    }
+
+    #[test]
+    fn a_broken_manifest_is_named_as_one() {
+        let dir = tempfile::tempdir().unwrap();
+        fs::write(path(dir.path()), "(complete: tru").unwrap();
+        let err = read(dir.path()).unwrap_err().to_string();
+        assert!(
+            err.starts_with(&format!(
+                "library manifest {}: line 1",
+                path(dir.path()).display()
+            )),
+            "{err}"
+        );
     }
 
     #[test]

@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::config::{parse_ron, read_text, ron_options};
+use crate::config::{parse_ron_as, read_text, ron_options};
 
 /// `SWEEP/sweep.ron`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -59,7 +59,11 @@ impl Manifest {
         let path = sweep.join("sweep.ron");
         let text = read_text(&path)
             .with_context(|| format!("{} is not a sweep (sapnet sweep plan)", sweep.display()))?;
-        Ok(parse_ron(&text, &path.display().to_string())?)
+        Ok(parse_ron_as(
+            &text,
+            &path.display().to_string(),
+            "sweep manifest",
+        )?)
     }
 
     pub fn write(&self, sweep: &Path) -> Result<()> {
