@@ -398,3 +398,90 @@ fn a_run_other_than_the_first_is_named_in_the_status_line() {
     let line = status_line(&draw_dashboard(&d, (120, 40)));
     assert!(line.contains("sapnet run 3 ep 0/5000"), "{line}");
 }
+
+/// The screen's rows as text.
+fn screen_lines(terminal: &Terminal<TestBackend>) -> Vec<String> {
+    let buffer = terminal.backend().buffer();
+    (0..buffer.area.height)
+        .map(|y| {
+            (0..buffer.area.width)
+                .map(|x| buffer[(x, y)].symbol())
+                .collect()
+        })
+        .collect()
+}
+
+/// The cell `(column, row)` where `needle` first starts on the screen, at or right of
+/// `from_column`.
+fn cell_of(terminal: &Terminal<TestBackend>, needle: &str, from_column: u16) -> Option<(u16, u16)> {
+    let buffer = terminal.backend().buffer();
+    (0..buffer.area.height).find_map(|y| {
+        (from_column..buffer.area.width)
+            .find(|&x| {
+                let rest: String = (x..buffer.area.width)
+                    .map(|c| buffer[(c, y)].symbol())
+                    .collect();
+                rest.starts_with(needle)
+            })
+            .map(|x| (x, y))
+    })
+}
+
+/// At 80×24 the policy table has nine rows for ten sources: it scrolls to the picked one,
+/// says how many rows it hides, and a click picks the row it lands on.
+#[test]
+fn the_policy_table_scrolls_to_the_picked_row_at_the_smallest_size() {
+    let mut d = dashboard();
+    let terminal = draw_dashboard(&d, (80, 24));
+    let text = screen_lines(&terminal).join("\n");
+    assert!(!text.contains("source-9"), "{text}");
+    assert!(
+        text.contains("▼ 1 more"),
+        "the hidden row is counted: {text}"
+    );
+    // Up from the first row: the last, scrolled into view.
+    d.on_key(KeyEvent::new(KeyCode::Up, KeyModifiers::NONE));
+    assert_eq!(d.cursor, 9);
+    let terminal = draw_dashboard(&d, (80, 24));
+    let text = screen_lines(&terminal).join("\n");
+    assert!(text.contains("source-9"), "{text}");
+    assert!(text.contains("▲ 1 more"), "{text}");
+    assert!(!text.contains("source-0 "), "{text}");
+    insta::assert_snapshot!("dashboard_scrolled_80x24", terminal.backend());
+    // A click on the row that reads source-1 picks source-1.
+    let (column, row) = cell_of(&terminal, "source-1 ", 31).expect("source-1's row");
+    d.on_click(column, row, ratatui::layout::Rect::new(0, 0, 80, 24));
+    assert_eq!(d.cursor, 1);
+}
+
+/// Teach mode on the live graph at 80×24: the activations table has room for four of ten
+/// rows; it shows the picked and activated source-9, and the trace's names fit.
+#[test]
+fn live_teach_keeps_the_picked_policy_in_view_at_the_smallest_size() {
+    let mut d = dashboard();
+    d.on_key(key(' '));
+    d.on_key(KeyEvent::new(KeyCode::Up, KeyModifiers::NONE));
+    d.on_key(key('t'));
+    d.on_key(key('a'));
+    d.on_key(key('s'));
+    let terminal = draw_dashboard(&d, (80, 24));
+    let lines = screen_lines(&terminal);
+    let text = lines.join("\n");
+    assert!(text.contains("source-9 "), "{text}");
+    assert!(text.contains("▲ 6 more"), "{text}");
+    // The trace row of the call made: from source-9 to its first neighbour, by label.
+    let trace: String = lines
+        .iter()
+        .find(|l| l.contains("│1    "))
+        .expect("the trace's first row")
+        .chars()
+        .skip(36) // the right-hand panels
+        .collect();
+    assert!(!trace.contains("sour"), "{trace}");
+    assert!(trace.contains("│1    9    "), "{trace}");
+    insta::assert_snapshot!("live_teach_source_9_80x24", terminal.backend());
+    // A click on the row that reads source-7 picks it.
+    let (column, row) = cell_of(&terminal, "source-7 ", 37).expect("source-7's row");
+    d.on_click(column, row, ratatui::layout::Rect::new(0, 0, 80, 24));
+    assert_eq!(d.teach.as_ref().unwrap().cursor(), 7);
+}

@@ -609,12 +609,13 @@ impl Dashboard {
         let layout = super::view::training_layout(area, self.zoomed());
         let inside = |r: Rect| r.contains(Position::new(column, row));
         if inside(layout.table) {
-            // Below the border and the header row.
-            let first = layout.table.y + 2;
-            if let Some(i) = row.checked_sub(first).map(usize::from) {
-                if i < view.policies.len() && row < layout.table.bottom() - 1 {
-                    self.cursor = i;
-                }
+            // The rows as drawn, below the border and the header row.
+            let window = super::view::policy_rows(layout.table, self);
+            if let Some(i) = row
+                .checked_sub(layout.table.y + 2)
+                .and_then(|line| window.row_at(usize::from(line)))
+            {
+                self.cursor = i;
             }
             self.focus = Focus::Table;
         } else if inside(layout.graph) {

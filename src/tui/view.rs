@@ -13,6 +13,7 @@ use ratatui::Frame;
 use super::dashboard::{Dashboard, Focus, Mode, RunView, SapNetView, HISTORY, SPEEDS};
 use super::graph_view::{self, node_style, Scene};
 use super::reference::Band;
+use super::row_window::RowWindow;
 use super::step_line::step_line;
 use super::theme::Theme;
 
@@ -179,8 +180,7 @@ fn draw_training(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
                         dashboard.focus == Focus::Table,
                     ),
                     view,
-                    dashboard.cursor,
-                    dashboard.relative,
+                    dashboard,
                     theme,
                 );
             }
@@ -268,15 +268,31 @@ fn thousands(n: u64) -> String {
     out
 }
 
+/// The rows of the policy table that a panel of `area` shows: the cursor's row always,
+/// and while paused the acting policy's too. Running, the acting policy changes from frame
+/// to frame: a window that followed it would jitter, and a click could land on another row
+/// than the one seen, so the bottom border names it when it is hidden instead.
+pub fn policy_rows(area: Rect, dashboard: &Dashboard) -> RowWindow {
+    let (total, acting) = dashboard
+        .sapnet
+        .as_ref()
+        .map_or((0, None), |v| (v.policies.len(), v.acting));
+    // Below the top border and the header, above the bottom border.
+    let room = usize::from(area.height.saturating_sub(3));
+    let acting = acting.filter(|_| dashboard.mode == Mode::Paused);
+    RowWindow::new(total, room, std::iter::once(dashboard.cursor).chain(acting))
+}
+
 fn draw_policy_table(
     frame: &mut Frame,
     area: Rect,
     block: Block,
     view: &SapNetView,
-    cursor: usize,
-    relative: bool,
+    dashboard: &Dashboard,
     theme: Theme,
 ) {
+    let (cursor, relative) = (dashboard.cursor, dashboard.relative);
+    let window = policy_rows(area, dashboard);
     // `v`: each score less the highest, so that saturated activations (2.360e5 beside
     // 2.359e5) still read apart.
     let highest = view
@@ -305,49 +321,52 @@ fn draw_policy_table(
     // window), where the panel is wide enough: zoomed (`z`) or on a wide terminal.
     let history = area.width >= 90;
     let history_top = graph_view::highest(view.history.iter().flatten().copied());
-    let rows = view.policies.iter().enumerate().map(|(i, p)| {
-        let a = view.net.activations()[i];
-        let probability = view.probabilities.get(i).copied().unwrap_or(0.0);
-        let mut name = Span::styled(p.name.clone(), node_style(theme, a, top));
-        if view.acting == Some(i) {
-            name = name.patch_style(theme.active());
-        }
-        let mut cells = vec![Cell::from(name)];
-        if full {
-            cells.push(Cell::from(format!("{:?}", p.description.hidden)));
-            cells.push(Cell::from(if tasks {
-                graph_view::short_task(&p.description.source_task).to_string()
+    let rows = view.policies[window.rows()]
+        .iter()
+        .zip(window.rows())
+        .map(|(p, i)| {
+            let a = view.net.activations()[i];
+            let probability = view.probabilities.get(i).copied().unwrap_or(0.0);
+            let mut name = Span::styled(p.name.clone(), node_style(theme, a, top));
+            if view.acting == Some(i) {
+                name = name.patch_style(theme.active());
+            }
+            let mut cells = vec![Cell::from(name)];
+            if full {
+                cells.push(Cell::from(format!("{:?}", p.description.hidden)));
+                cells.push(Cell::from(if tasks {
+                    graph_view::short_task(&p.description.source_task).to_string()
+                } else {
+                    p.description.hidden.len().to_string()
+                }));
+            }
+            cells.push(Cell::from(format_activation(if relative {
+                a - highest
             } else {
-                p.description.hidden.len().to_string()
-            }));
-        }
-        cells.push(Cell::from(format_activation(if relative {
-            a - highest
-        } else {
-            a
-        })));
-        cells.push(Cell::from(probability_bar(probability, bar_width)));
-        cells.push(Cell::from(count(view.selections[i])));
-        if full {
-            cells.push(Cell::from(format!(
-                "{}/{}",
-                count(view.positive[i]),
-                count(view.negative[i])
-            )));
-        }
-        if history {
-            cells.push(Cell::from(sparkline(
-                view.history.iter().map(|scores| scores[i]),
-                history_top,
-            )));
-        }
-        let row = Row::new(cells);
-        if i == cursor {
-            row.style(theme.cursor())
-        } else {
-            row
-        }
-    });
+                a
+            })));
+            cells.push(Cell::from(probability_bar(probability, bar_width)));
+            cells.push(Cell::from(count(view.selections[i])));
+            if full {
+                cells.push(Cell::from(format!(
+                    "{}/{}",
+                    count(view.positive[i]),
+                    count(view.negative[i])
+                )));
+            }
+            if history {
+                cells.push(Cell::from(sparkline(
+                    view.history.iter().map(|scores| scores[i]),
+                    history_top,
+                )));
+            }
+            let row = Row::new(cells);
+            if i == cursor {
+                row.style(theme.cursor())
+            } else {
+                row
+            }
+        });
     let (mut header, mut widths) = if full {
         (
             vec![
@@ -384,6 +403,11 @@ fn draw_policy_table(
         header.push("A per episode");
         widths.push(Constraint::Length(HISTORY as u16));
     }
+    let mut marker = window.marker().unwrap_or_default();
+    if let Some(acting) = view.acting.filter(|i| !window.rows().contains(i)) {
+        marker.push_str(&format!("· {} acts ", view.policies[acting].name));
+    }
+    let block = block.title_bottom(Line::styled(marker, theme.title()).right_aligned());
     let table = Table::new(rows, widths)
         .header(Row::new(header).style(theme.title()))
         .block(block);
