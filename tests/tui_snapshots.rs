@@ -485,3 +485,31 @@ fn live_teach_keeps_the_picked_policy_in_view_at_the_smallest_size() {
     d.on_click(column, row, ratatui::layout::Rect::new(0, 0, 80, 24));
     assert_eq!(d.teach.as_ref().unwrap().cursor(), 7);
 }
+
+/// Table II's lesson names its policies by their layers: `1×100`, `2×100`, `3×100` and
+/// `3×50-150-100` would all read `100` on the graph. The nodes read π0…π9 instead, and
+/// the table gives each π its name, whole where there is room.
+#[test]
+fn a_lesson_whose_names_end_alike_is_labelled_by_index() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/teach_table2.ron");
+    let lesson = TeachConfig::load(Some(&path)).unwrap();
+    let mut teach = Teach::new(lesson.names, lesson.net);
+    teach.move_cursor(8);
+    for (w, h) in SIZES {
+        let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
+        terminal
+            .draw(|f| teach_view::draw(f, &teach, false, Theme::plain()))
+            .unwrap();
+        let text = screen_lines(&terminal).join("\n");
+        for node in ["○100", "●100", "◐100"] {
+            assert!(!text.contains(node), "{node} at {w}×{h}: {text}");
+        }
+        for i in 0..10 {
+            assert!(text.contains(&format!("○π{i}")), "π{i} at {w}×{h}: {text}");
+        }
+        // The picked policy's name, whole: in its column, or in the title where the
+        // column has no room.
+        assert!(text.contains("3×50-150-100"), "{w}×{h}: {text}");
+        insta::assert_snapshot!(format!("teach_table2_{w}x{h}"), terminal.backend());
+    }
+}

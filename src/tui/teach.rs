@@ -7,6 +7,7 @@
 //! [`Teach::advance`], so a walk of millions of calls leaves the screen and the keys
 //! responsive.
 
+use super::graph_view;
 use super::knobs::{walk_end, EditReport, Knob};
 use crate::sapnet::{Call, SapNet, SpreadState, Spreader, TraceStep};
 
@@ -17,6 +18,10 @@ pub const CALLS_PER_FRAME: usize = 50_000;
 #[derive(Debug, Clone)]
 pub struct Teach {
     names: Vec<String>,
+    /// The names the lesson gave, where they could not tell the policies apart on the
+    /// graph (`1×100`, `2×100` both read `100`): the policies are then called π0…, and the
+    /// activations table gives these beside.
+    descriptions: Option<Vec<String>>,
     /// The names as the paper numbers policies, π1…πN, where the given ones are π0…πN−1.
     paper_names: Option<Vec<String>>,
     /// Show `paper_names` (`p`).
@@ -77,6 +82,13 @@ pub struct WalkView<'a> {
 impl Teach {
     pub fn new(names: Vec<String>, net: SapNet) -> Self {
         let initial = net.activations().to_vec();
+        let (names, descriptions) = match graph_view::distinct_labels(&names) {
+            Some(_) => (names, None),
+            None => (
+                (0..names.len()).map(|i| format!("π{i}")).collect(),
+                Some(names),
+            ),
+        };
         let zero_based = names
             .iter()
             .enumerate()
@@ -86,6 +98,7 @@ impl Teach {
             paper_names,
             paper_numbering: false,
             names,
+            descriptions,
             net,
             initial,
             cursor: 0,
@@ -115,6 +128,12 @@ impl Teach {
             (Some(paper), true) => paper,
             _ => &self.names,
         }
+    }
+
+    /// What the lesson called each policy, where the screen calls them π0… instead (see
+    /// [`new`](Self::new)).
+    pub fn descriptions(&self) -> Option<&[String]> {
+        self.descriptions.as_deref()
     }
 
     /// `p`: the paper's numbering π1…πN, or back to π0…; `false` when the lesson names

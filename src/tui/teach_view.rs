@@ -336,7 +336,7 @@ fn draw_trace(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     let names = if name_width(names, 4, usize::MAX) <= room {
         names
     } else {
-        short = names.iter().map(|n| graph_view::short_label(n)).collect();
+        short = graph_view::labels(names);
         short.as_slice()
     };
     let name_width = name_width(names, 4, usize::MAX);
@@ -401,18 +401,54 @@ fn draw_values(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         .last_edit()
         .filter(|_| area.width >= 60)
         .map(|r| (r.activation_change(), r.probability_change()));
+    // The figures' columns, then the names in the room left (the names are cut only
+    // where there is none), then the lesson's descriptions where they fit whole; where
+    // they do not, the title gives the picked policy's.
+    let mut widths = vec![
+        Constraint::Length(VALUE_WIDTH as u16),
+        Constraint::Length(VALUE_WIDTH as u16),
+        Constraint::Length(11),
+    ];
+    let mut header = vec!["A (eq. 8)", "ΣΔA eq.11", "P (eq. 6)"];
+    if edit.is_some() {
+        widths.extend([Constraint::Length(9), Constraint::Min(6)]);
+        header.extend(["edit: ΔA", "ΔP"]);
+    }
+    let figures: u16 = widths.iter().map(|w| constraint_width(*w) + 1).sum();
+    let room = area.width.saturating_sub(2 + figures);
+    let name_width = name_width(names, 6, usize::from(room));
+    let descriptions = teach.descriptions();
+    let description_width = descriptions.map_or(0, name_width_of);
+    let beside = descriptions.filter(|_| description_width < room.saturating_sub(name_width));
+    if beside.is_some() {
+        widths.insert(0, Constraint::Length(description_width));
+        header.insert(0, "name");
+    }
+    widths.insert(0, Constraint::Length(name_width));
+    header.insert(0, "policy");
+    let mut title = " activations ".to_string();
+    if let (Some(descriptions), None) = (descriptions, beside) {
+        let i = teach.cursor();
+        title = format!(" activations · {} = {} ", names[i], descriptions[i]);
+    }
     let window = values_rows(area, teach);
     let rows = names[window.rows()]
         .iter()
         .zip(window.rows())
         .map(|(name, i)| {
             let a = net.activations()[i];
-            let mut cells = vec![
-                Cell::from(Span::styled(name.clone(), node_style(theme, a, top))),
+            let mut cells = vec![Cell::from(Span::styled(
+                name.clone(),
+                node_style(theme, a, top),
+            ))];
+            if let Some(descriptions) = beside {
+                cells.push(Cell::from(descriptions[i].clone()));
+            }
+            cells.extend([
                 Cell::from(fit(a, VALUE_WIDTH)),
                 Cell::from(deposited.map_or(String::new(), |d| fit(d[i], VALUE_WIDTH))),
                 Cell::from(probability_bar(probabilities[i], 6)),
-            ];
+            ]);
             if let Some((da, dp)) = &edit {
                 cells.push(Cell::from(signed(da[i], 4)));
                 cells.push(Cell::from(signed(dp[i], 3)));
@@ -424,24 +460,12 @@ fn draw_values(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
                 row
             }
         });
-    let name_width = name_width(names, 6, 10);
-    let mut widths = vec![
-        Constraint::Length(name_width),
-        Constraint::Length(VALUE_WIDTH as u16),
-        Constraint::Length(VALUE_WIDTH as u16),
-        Constraint::Length(11),
-    ];
-    let mut header = vec!["policy", "A (eq. 8)", "ΣΔA eq.11", "P (eq. 6)"];
-    if edit.is_some() {
-        widths.extend([Constraint::Length(9), Constraint::Min(6)]);
-        header.extend(["edit: ΔA", "ΔP"]);
-    }
     frame.render_widget(
         Table::new(rows, widths)
             .header(Row::new(header).style(theme.title()))
             .block(
                 Block::bordered()
-                    .title(Span::styled(" activations ", theme.title()))
+                    .title(Span::styled(title, theme.title()))
                     .title_bottom(
                         Line::styled(window.marker().unwrap_or_default(), theme.title())
                             .right_aligned(),
@@ -451,10 +475,23 @@ fn draw_values(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     );
 }
 
-/// A column for the longest of `names`, within `least..=most` characters.
+/// The cells a fixed column takes (a `Min` column its minimum).
+fn constraint_width(constraint: Constraint) -> u16 {
+    match constraint {
+        Constraint::Length(n) | Constraint::Min(n) => n,
+        _ => 0,
+    }
+}
+
+/// The characters of the longest of `names`.
+fn name_width_of(names: &[String]) -> u16 {
+    names.iter().map(|n| n.chars().count()).max().unwrap_or(0) as u16
+}
+
+/// A column for the longest of `names`, within `least..=most` characters (`least` where
+/// `most` is smaller).
 fn name_width(names: &[String], least: usize, most: usize) -> u16 {
-    let longest = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
-    longest.clamp(least, most) as u16
+    usize::from(name_width_of(names)).min(most).max(least) as u16
 }
 
 /// Characters of an activation in the table.
