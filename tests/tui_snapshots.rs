@@ -513,3 +513,30 @@ fn a_lesson_whose_names_end_alike_is_labelled_by_index() {
         insta::assert_snapshot!(format!("teach_table2_{w}x{h}"), terminal.backend());
     }
 }
+
+/// `?` in teach mode on the live graph: Esc goes back there, so the help says so and
+/// lists q and Ctrl-C alone for quitting; `p` renumbers π-named policies only, so it is
+/// left out for source-0…; a line too long for the box wraps instead of being cut.
+#[test]
+fn live_teach_help_tells_the_keys_as_they_are() {
+    let mut d = dashboard();
+    d.on_key(key(' '));
+    d.on_key(key('t'));
+    d.on_key(key('?'));
+    let terminal = draw_dashboard(&d, (80, 24));
+    let lines = screen_lines(&terminal);
+    let text = lines.join("\n");
+    assert!(
+        text.contains("t / Esc  back to the paused dashboard"),
+        "{text}"
+    );
+    assert!(text.contains("q / Ctrl-C  quit"), "{text}");
+    assert!(!text.contains("q / Esc"), "{text}");
+    assert!(!text.contains("number the policies"), "{text}");
+    let wrapped = lines
+        .iter()
+        .position(|l| l.contains("the weight M of an"))
+        .expect("the edit line");
+    assert!(lines[wrapped + 1].contains("edge"), "{text}");
+    insta::assert_snapshot!("live_teach_help_80x24", terminal.backend());
+}

@@ -40,31 +40,49 @@ pub fn draw(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {
     let line = Line::from(spans);
     frame.render_widget(Paragraph::new(line), status);
     if help {
-        draw_help(frame, area, TEACH_HELP, theme);
+        draw_help(frame, area, &teach_help(teach, false), theme);
     }
 }
 
-/// Teach mode's own keys, for its `?`.
-pub(super) const TEACH_HELP: &[(&str, &str)] = &[
-    ("↑↓←→ hjkl, click", "pick a policy (its node or its row)"),
-    ("a", "activate the picked policy (A += 𝒜, eq. 8)"),
-    ("s", "make the next spread call (eq. 9–11)"),
-    ("r", "run the spreading to its end (s, u, c stop it)"),
-    ("u", "undo the last call, then the activation"),
-    ("c", "back to the starting activations"),
-    ("p", "number the policies π1…πN as the paper does, or π0…"),
-    (
-        "1 … 5",
-        "edit T_ω, 𝒜, τ, the path mode or the weight M of an edge",
-    ),
-    (
-        "+ / −",
-        "turn it a step: the walk restarts, the change is shown",
-    ),
-    ("e", "the picked policy's next edge (for 5)"),
-    ("?", "this help (any key closes it)"),
-    ("q / Esc / Ctrl-C", "quit"),
-];
+/// Teach mode's own keys, for its `?`. `p` is listed where it renumbers the policies (they
+/// are called π0…); Esc quits stand-alone teach mode, and on the dashboard goes back to it.
+pub(super) fn teach_help(
+    teach: &Teach,
+    on_the_dashboard: bool,
+) -> Vec<(&'static str, &'static str)> {
+    let mut keys = vec![
+        ("↑↓←→ hjkl, click", "pick a policy (its node or its row)"),
+        ("a", "activate the picked policy (A += 𝒜, eq. 8)"),
+        ("s", "make the next spread call (eq. 9–11)"),
+        ("r", "run the spreading to its end (s, u, c stop it)"),
+        ("u", "undo the last call, then the activation"),
+        ("c", "back to the starting activations"),
+    ];
+    if teach.numbering().is_some() {
+        keys.push(("p", "number the policies π1…πN as the paper does, or π0…"));
+    }
+    keys.extend([
+        (
+            "1 … 5",
+            "edit T_ω, 𝒜, τ, the path mode or the weight M of an edge",
+        ),
+        (
+            "+ / −",
+            "turn it a step: the walk restarts, the change is shown",
+        ),
+        ("e", "the picked policy's next edge (for 5)"),
+        ("?", "this help (any key closes it)"),
+    ]);
+    if on_the_dashboard {
+        keys.extend([
+            ("t / Esc", "back to the paused dashboard"),
+            ("q / Ctrl-C", "quit"),
+        ]);
+    } else {
+        keys.push(("q / Esc / Ctrl-C", "quit"));
+    }
+    keys
+}
 
 const TEACH_HINTS: &str =
     "↑↓ pick · a activate · s step · r run · u undo · c reset · 1–5 +/− edit · ? help · q quit";

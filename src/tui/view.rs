@@ -34,10 +34,13 @@ pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
     }
     draw_status(frame, status, dashboard, theme);
     if dashboard.help {
-        if dashboard.mode == Mode::Teach {
-            let mut keys = super::teach_view::TEACH_HELP.to_vec();
-            keys.insert(keys.len() - 2, ("t / Esc", "back to the paused dashboard"));
-            draw_help(frame, area, &keys, theme);
+        if let (Some(teach), Mode::Teach) = (&dashboard.teach, dashboard.mode) {
+            draw_help(
+                frame,
+                area,
+                &super::teach_view::teach_help(teach, true),
+                theme,
+            );
         } else {
             draw_help(frame, area, HELP, theme);
         }
@@ -767,24 +770,30 @@ const HELP: &[(&str, &str)] = &[
     ("+/−", "its positive / negative transitions so far (eq. 7)"),
 ];
 
+/// The width of the help's key column, with the two spaces after it.
+const HELP_KEYS: usize = 20;
+
 pub(super) fn draw_help(frame: &mut Frame, area: Rect, keys: &[(&str, &str)], theme: Theme) {
     let width = 76.min(area.width);
-    let height = (keys.len() as u16 + 4).min(area.height);
+    // What a key does wraps under itself, beside the keys' column.
+    let room = usize::from(width.saturating_sub(2)).saturating_sub(HELP_KEYS);
+    let mut lines: Vec<Line> = Vec::new();
+    for (key, what) in keys {
+        for (k, part) in wrap_words(what, room).into_iter().enumerate() {
+            let key = if k == 0 { *key } else { "" };
+            lines.push(Line::from(vec![
+                Span::styled(format!("{key:>w$}  ", w = HELP_KEYS - 2), theme.title()),
+                Span::raw(part),
+            ]));
+        }
+    }
+    let height = (lines.len() as u16 + 4).min(area.height);
     let [row] = Layout::vertical([Constraint::Length(height)])
         .flex(ratatui::layout::Flex::Center)
         .areas(area);
     let [popup] = Layout::horizontal([Constraint::Length(width)])
         .flex(ratatui::layout::Flex::Center)
         .areas(row);
-    let lines: Vec<Line> = keys
-        .iter()
-        .map(|(key, what)| {
-            Line::from(vec![
-                Span::styled(format!("{key:>18}  "), theme.title()),
-                Span::raw(*what),
-            ])
-        })
-        .collect();
     frame.render_widget(Clear, popup);
     frame.render_widget(
         Paragraph::new(lines).block(
@@ -796,9 +805,38 @@ pub(super) fn draw_help(frame: &mut Frame, area: Rect, keys: &[(&str, &str)], th
     );
 }
 
+/// `text` in lines of at most `width` columns, broken between words (a word longer than
+/// the width has a line of its own).
+fn wrap_words(text: &str, width: usize) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    for word in text.split(' ') {
+        let line = lines.last_mut().expect("one line at least");
+        let wanted = Line::from(line.as_str()).width() + 1 + Line::from(word).width();
+        if line.is_empty() {
+            line.push_str(word);
+        } else if wanted <= width {
+            line.push(' ');
+            line.push_str(word);
+        } else {
+            lines.push(word.to_string());
+        }
+    }
+    lines
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{count, sparkline};
+    use super::{count, sparkline, wrap_words};
+
+    #[test]
+    fn help_lines_wrap_between_words() {
+        assert_eq!(
+            wrap_words("the weight M of an edge", 14),
+            ["the weight M", "of an edge"]
+        );
+        assert_eq!(wrap_words("quit", 14), ["quit"]);
+        assert_eq!(wrap_words("", 14), [""]);
+    }
 
     #[test]
     fn sparklines_share_one_scale() {
