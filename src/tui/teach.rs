@@ -8,7 +8,7 @@
 //! responsive.
 
 use super::graph_view;
-use super::knobs::{walk_end, EditReport, Knob};
+use super::knobs::{refusal, walk_end, EditReport, Knob};
 use crate::sapnet::{Call, SapNet, SpreadState, Spreader, TraceStep};
 
 /// Calls `r` makes between two frames: a few milliseconds' worth.
@@ -244,7 +244,20 @@ impl Teach {
         let turned = match self.knob.turn(&start, self.selected_edge(), up) {
             Ok(net) => net,
             Err(refused) => {
-                self.notice = Some(format!("{} stays {from}: {refused}", self.knob.symbol()));
+                // In the screen's names: the net's message numbers the policies from 0.
+                let names = self.names();
+                let (what, why) = match (self.knob, self.selected_edge()) {
+                    (Knob::EdgeWeight, Some((i, j))) => (
+                        format!("M({},{})", names[i], names[j]),
+                        refusal(&refused, names),
+                    ),
+                    (Knob::EdgeWeight, None) => (
+                        "M".to_string(),
+                        format!("{} has no edge to change", names[self.cursor]),
+                    ),
+                    (knob, _) => (knob.symbol().to_string(), refusal(&refused, names)),
+                };
+                self.notice = Some(format!("{what} stays {from}: {why}"));
                 return;
             }
         };
@@ -566,6 +579,23 @@ mod tests {
             notice.starts_with("T_ω stays 0.1: parameter `threshold`"),
             "{notice}"
         );
+    }
+
+    /// With `p` the screen calls Fig. 2's policies π1…π4: a refused weight names its edge
+    /// so, not by the net's indices from 0.
+    #[test]
+    fn a_refused_weight_names_its_edge_as_the_screen_does() {
+        let mut teach = fig2();
+        assert!(teach.toggle_numbering());
+        let (i, j) = teach.selected_edge().expect("π1 has edges");
+        teach.choose_knob(Knob::EdgeWeight);
+        for _ in 0..20 {
+            teach.edit(false);
+        }
+        let notice = teach.notice().expect("refused");
+        let edge = format!("M({},{})", teach.names()[i], teach.names()[j]);
+        assert!(notice.contains(&edge), "{edge}: {notice}");
+        assert!(!notice.contains(&format!("({i}, {j})")), "{notice}");
     }
 
     /// The graph of issue 13: 300 policies, every pair joined with weight 0.6. One
