@@ -540,3 +540,20 @@ fn live_teach_help_tells_the_keys_as_they_are() {
     assert!(lines[wrapped + 1].contains("edge"), "{text}");
     insta::assert_snapshot!("live_teach_help_80x24", terminal.backend());
 }
+
+/// Paused for teaching, training makes no steps: the status shows no rate, not the last
+/// one measured.
+#[test]
+fn the_status_shows_no_rate_while_training_is_paused() {
+    let mut d = dashboard();
+    d.steps_per_second = Some(15_001.0);
+    assert!(status_line(&draw_dashboard(&d, (120, 40))).contains("15001 steps/s"));
+    d.on_key(key(' '));
+    d.on_key(key('t'));
+    let line = status_line(&draw_dashboard(&d, (120, 40)));
+    assert!(!line.contains("steps/s"), "{line}");
+    assert!(line.contains(" · paused"), "{line}");
+    d.on_key(key('t'));
+    let line = status_line(&draw_dashboard(&d, (120, 40)));
+    assert!(!line.contains("steps/s"), "{line}");
+}

@@ -676,9 +676,12 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
             r.method, r.episode, r.planned_episodes
         )
     });
-    let speed = match dashboard.steps_per_second {
-        Some(s) => format!("{s:.0} steps/s"),
-        None => "- steps/s".to_string(),
+    // Paused, training makes no steps: the last rate measured would be stale.
+    let speed = match (dashboard.mode, dashboard.steps_per_second) {
+        (Mode::Teach, _) => Some("paused".to_string()),
+        _ if finished || dashboard.mode == Mode::Paused => None,
+        (_, Some(s)) => Some(format!("{s:.0} steps/s")),
+        (_, None) => Some("- steps/s".to_string()),
     };
     let throttle = match SPEEDS[dashboard.speed] {
         d if d.is_zero() => "full speed".to_string(),
@@ -710,15 +713,15 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
                 .saturating_sub(hints.chars().count() + 1)
                 .saturating_sub(spans.iter().map(|s| s.content.chars().count()).sum());
             let figures = [
-                throttle,
-                episode,
-                format!("step {}", thousands(dashboard.step)),
+                Some(throttle),
+                Some(episode),
+                Some(format!("step {}", thousands(dashboard.step))),
                 speed,
-                format!("ε {epsilon:.2}"),
-                dashboard.task.clone(),
+                Some(format!("ε {epsilon:.2}")),
+                Some(dashboard.task.clone()),
             ];
             let mut text = String::new();
-            for figure in figures {
+            for figure in figures.into_iter().flatten() {
                 let next = if text.is_empty() {
                     format!(" {figure}")
                 } else {
