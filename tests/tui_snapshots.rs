@@ -557,3 +557,22 @@ fn the_status_shows_no_rate_while_training_is_paused() {
     let line = status_line(&draw_dashboard(&d, (120, 40)));
     assert!(!line.contains("steps/s"), "{line}");
 }
+
+/// The first step of episode 61 came: the step line and the status both say episode 61,
+/// the one being played.
+#[test]
+fn the_step_line_and_the_status_count_episodes_alike() {
+    let mut d = dashboard();
+    let Some(mut step) = d.last_step else {
+        panic!("the script's steps")
+    };
+    step.episode = 61;
+    step.step += 1;
+    d.on_event(Event::Step(step));
+    let terminal = draw_dashboard(&d, (120, 40));
+    let lines = screen_lines(&terminal);
+    let step_line = &lines[lines.len() - 2];
+    assert!(step_line.contains("· ep 61 return"), "{step_line}");
+    let status = status_line(&terminal);
+    assert!(status.contains("ep 61/5000"), "{status}");
+}

@@ -671,9 +671,14 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
             0 => String::new(),
             run => format!(" run {}", run + 1),
         };
+        // The episode being played, as the step line counts it: the next one once its
+        // first step came (the run counts the episodes that ended).
+        let playing = dashboard.last_step.as_ref().map_or(0, |s| s.episode);
         format!(
             "{}{which} ep {}/{}",
-            r.method, r.episode, r.planned_episodes
+            r.method,
+            r.episode.max(playing),
+            r.planned_episodes
         )
     });
     // Paused, training makes no steps: the last rate measured would be stale.
