@@ -576,3 +576,24 @@ fn the_step_line_and_the_status_count_episodes_alike() {
     let status = status_line(&terminal);
     assert!(status.contains("ep 61/5000"), "{status}");
 }
+
+/// However long the figures, at least two spaces part them from the keys: "paused ? keys"
+/// read as one phrase.
+#[test]
+fn the_status_figures_keep_apart_from_the_keys() {
+    let mut d = dashboard();
+    d.on_key(key(' '));
+    d.on_key(key('t'));
+    for step in [6_450, 241_747, 12_345_678] {
+        d.step = step;
+        for size in SIZES {
+            let line = status_line(&draw_dashboard(&d, size));
+            // The teach keys on a wide terminal, else only ? and q.
+            let keys = line
+                .find("a · s")
+                .or_else(|| line.find("? keys"))
+                .expect("the keys");
+            assert!(line[..keys].ends_with("  "), "{line}");
+        }
+    }
+}

@@ -713,9 +713,10 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
                 spans.push(Span::styled(format!(" {method} FAILED ·"), theme.stopped()));
             }
             // The state first: how fast training is let run, where the run is. What does
-            // not fit before the keys is dropped from the end, never cut mid-word.
+            // not fit before the keys is dropped from the end, never cut mid-word; two
+            // spaces at least keep the last figure from reading into the keys.
             let room = usize::from(area.width)
-                .saturating_sub(hints.chars().count() + 1)
+                .saturating_sub(hints.chars().count() + 2)
                 .saturating_sub(spans.iter().map(|s| s.content.chars().count()).sum());
             let figures = [
                 Some(throttle),
