@@ -398,3 +398,202 @@ fn a_run_other_than_the_first_is_named_in_the_status_line() {
     let line = status_line(&draw_dashboard(&d, (120, 40)));
     assert!(line.contains("sapnet run 2 ep 0/5000"), "{line}");
 }
+
+/// The screen's rows as text.
+fn screen_lines(terminal: &Terminal<TestBackend>) -> Vec<String> {
+    let buffer = terminal.backend().buffer();
+    (0..buffer.area.height)
+        .map(|y| {
+            (0..buffer.area.width)
+                .map(|x| buffer[(x, y)].symbol())
+                .collect()
+        })
+        .collect()
+}
+
+/// The cell `(column, row)` where `needle` first starts on the screen, at or right of
+/// `from_column`.
+fn cell_of(terminal: &Terminal<TestBackend>, needle: &str, from_column: u16) -> Option<(u16, u16)> {
+    let buffer = terminal.backend().buffer();
+    (0..buffer.area.height).find_map(|y| {
+        (from_column..buffer.area.width)
+            .find(|&x| {
+                let rest: String = (x..buffer.area.width)
+                    .map(|c| buffer[(c, y)].symbol())
+                    .collect();
+                rest.starts_with(needle)
+            })
+            .map(|x| (x, y))
+    })
+}
+
+/// At 80×24 the policy table has nine rows for ten sources: it scrolls to the picked one,
+/// says how many rows it hides, and a click picks the row it lands on.
+#[test]
+fn the_policy_table_scrolls_to_the_picked_row_at_the_smallest_size() {
+    let mut d = dashboard();
+    let terminal = draw_dashboard(&d, (80, 24));
+    let text = screen_lines(&terminal).join("\n");
+    assert!(!text.contains("source-9"), "{text}");
+    assert!(
+        text.contains("▼ 1 more"),
+        "the hidden row is counted: {text}"
+    );
+    // Up from the first row: the last, scrolled into view.
+    d.on_key(KeyEvent::new(KeyCode::Up, KeyModifiers::NONE));
+    assert_eq!(d.cursor, 9);
+    let terminal = draw_dashboard(&d, (80, 24));
+    let text = screen_lines(&terminal).join("\n");
+    assert!(text.contains("source-9"), "{text}");
+    assert!(text.contains("▲ 1 more"), "{text}");
+    assert!(!text.contains("source-0 "), "{text}");
+    insta::assert_snapshot!("dashboard_scrolled_80x24", terminal.backend());
+    // A click on the row that reads source-1 picks source-1.
+    let (column, row) = cell_of(&terminal, "source-1 ", 31).expect("source-1's row");
+    d.on_click(column, row, ratatui::layout::Rect::new(0, 0, 80, 24));
+    assert_eq!(d.cursor, 1);
+}
+
+/// Teach mode on the live graph at 80×24: the activations table has room for four of ten
+/// rows; it shows the picked and activated source-9, and the trace's names fit.
+#[test]
+fn live_teach_keeps_the_picked_policy_in_view_at_the_smallest_size() {
+    let mut d = dashboard();
+    d.on_key(key(' '));
+    d.on_key(KeyEvent::new(KeyCode::Up, KeyModifiers::NONE));
+    d.on_key(key('t'));
+    d.on_key(key('a'));
+    d.on_key(key('s'));
+    let terminal = draw_dashboard(&d, (80, 24));
+    let lines = screen_lines(&terminal);
+    let text = lines.join("\n");
+    assert!(text.contains("source-9 "), "{text}");
+    assert!(text.contains("▲ 6 more"), "{text}");
+    // The trace row of the call made: from source-9 to its first neighbour, by label.
+    let trace: String = lines
+        .iter()
+        .find(|l| l.contains("│1    "))
+        .expect("the trace's first row")
+        .chars()
+        .skip(36) // the right-hand panels
+        .collect();
+    assert!(!trace.contains("sour"), "{trace}");
+    assert!(trace.contains("│1    9    "), "{trace}");
+    insta::assert_snapshot!("live_teach_source_9_80x24", terminal.backend());
+    // A click on the row that reads source-7 picks it.
+    let (column, row) = cell_of(&terminal, "source-7 ", 37).expect("source-7's row");
+    d.on_click(column, row, ratatui::layout::Rect::new(0, 0, 80, 24));
+    assert_eq!(d.teach.as_ref().unwrap().cursor(), 7);
+}
+
+/// Table II's lesson names its policies by their layers: `1×100`, `2×100`, `3×100` and
+/// `3×50-150-100` would all read `100` on the graph. The nodes read π0…π9 instead, and
+/// the table gives each π its name, whole where there is room.
+#[test]
+fn a_lesson_whose_names_end_alike_is_labelled_by_index() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/teach_table2.ron");
+    let lesson = TeachConfig::load(Some(&path)).unwrap();
+    let mut teach = Teach::new(lesson.names, lesson.net);
+    teach.move_cursor(8);
+    for (w, h) in SIZES {
+        let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
+        terminal
+            .draw(|f| teach_view::draw(f, &teach, false, Theme::plain()))
+            .unwrap();
+        let text = screen_lines(&terminal).join("\n");
+        for node in ["○100", "●100", "◐100"] {
+            assert!(!text.contains(node), "{node} at {w}×{h}: {text}");
+        }
+        for i in 0..10 {
+            assert!(text.contains(&format!("○π{i}")), "π{i} at {w}×{h}: {text}");
+        }
+        // The picked policy's name, whole: in its column, or in the title where the
+        // column has no room.
+        assert!(text.contains("3×50-150-100"), "{w}×{h}: {text}");
+        insta::assert_snapshot!(format!("teach_table2_{w}x{h}"), terminal.backend());
+    }
+}
+
+/// `?` in teach mode on the live graph: Esc goes back there, so the help says so and
+/// lists q and Ctrl-C alone for quitting; `p` renumbers π-named policies only, so it is
+/// left out for source-0…; a line too long for the box wraps instead of being cut.
+#[test]
+fn live_teach_help_tells_the_keys_as_they_are() {
+    let mut d = dashboard();
+    d.on_key(key(' '));
+    d.on_key(key('t'));
+    d.on_key(key('?'));
+    let terminal = draw_dashboard(&d, (80, 24));
+    let lines = screen_lines(&terminal);
+    let text = lines.join("\n");
+    assert!(
+        text.contains("t / Esc  back to the paused dashboard"),
+        "{text}"
+    );
+    assert!(text.contains("q / Ctrl-C  quit"), "{text}");
+    assert!(!text.contains("q / Esc"), "{text}");
+    assert!(!text.contains("number the policies"), "{text}");
+    let wrapped = lines
+        .iter()
+        .position(|l| l.contains("the weight M of an"))
+        .expect("the edit line");
+    assert!(lines[wrapped + 1].contains("edge"), "{text}");
+    insta::assert_snapshot!("live_teach_help_80x24", terminal.backend());
+}
+
+/// Paused for teaching, training makes no steps: the status shows no rate, not the last
+/// one measured.
+#[test]
+fn the_status_shows_no_rate_while_training_is_paused() {
+    let mut d = dashboard();
+    d.steps_per_second = Some(15_001.0);
+    assert!(status_line(&draw_dashboard(&d, (120, 40))).contains("15001 steps/s"));
+    d.on_key(key(' '));
+    d.on_key(key('t'));
+    let line = status_line(&draw_dashboard(&d, (120, 40)));
+    assert!(!line.contains("steps/s"), "{line}");
+    assert!(line.contains(" · paused"), "{line}");
+    d.on_key(key('t'));
+    let line = status_line(&draw_dashboard(&d, (120, 40)));
+    assert!(!line.contains("steps/s"), "{line}");
+}
+
+/// The first step of episode 61 came: the step line and the status both say episode 61,
+/// the one being played.
+#[test]
+fn the_step_line_and_the_status_count_episodes_alike() {
+    let mut d = dashboard();
+    let Some(mut step) = d.last_step else {
+        panic!("the script's steps")
+    };
+    step.episode = 61;
+    step.step += 1;
+    d.on_event(Event::Step(step));
+    let terminal = draw_dashboard(&d, (120, 40));
+    let lines = screen_lines(&terminal);
+    let step_line = &lines[lines.len() - 2];
+    assert!(step_line.contains("· ep 61 return"), "{step_line}");
+    let status = status_line(&terminal);
+    assert!(status.contains("ep 61/5000"), "{status}");
+}
+
+/// However long the figures, at least two spaces part them from the keys: "paused ? keys"
+/// read as one phrase.
+#[test]
+fn the_status_figures_keep_apart_from_the_keys() {
+    let mut d = dashboard();
+    d.on_key(key(' '));
+    d.on_key(key('t'));
+    for step in [6_450, 241_747, 12_345_678] {
+        d.step = step;
+        for size in SIZES {
+            let line = status_line(&draw_dashboard(&d, size));
+            // The teach keys on a wide terminal, else only ? and q.
+            let keys = line
+                .find("a · s")
+                .or_else(|| line.find("? keys"))
+                .expect("the keys");
+            assert!(line[..keys].ends_with("  "), "{line}");
+        }
+    }
+}

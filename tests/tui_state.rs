@@ -346,3 +346,36 @@ fn lock_in_is_dated_from_the_first_snapshot_above_the_threshold() {
     d.on_event(snapshot(40, 2, 0.9999));
     assert_eq!(locked(&d), Some((2, 40)));
 }
+
+/// UCB1 picks by rule: its view gives the next pick probability 1, which is no collapsed
+/// softmax. The headless comparison measures no lock-in for it ("-"), and neither does the
+/// dashboard.
+#[test]
+fn a_method_that_picks_by_rule_never_shows_a_lock_in() {
+    let ucb1 = sapnet::trainer::MethodId::new(7, &sapnet::config::Method::Ucb1);
+    let mut start = tui_script::sapnet_start();
+    if let sapnet::trainer::Event::RunStarted { method, sapnet, .. } = &mut start {
+        *method = ucb1.clone();
+        sapnet.as_mut().unwrap().score_name = "mean";
+    }
+    let mut d = Dashboard::new("CartPole-v1");
+    d.on_event(start);
+    let n = tui_script::HIDDEN.len();
+    let mut probabilities = vec![0.0; n];
+    probabilities[2] = 1.0;
+    d.on_event(sapnet::trainer::Event::Activations(
+        sapnet::trainer::ActivationSnapshot {
+            run: 0,
+            method: ucb1,
+            step: 102_244,
+            episode: 400,
+            score_name: "mean",
+            activations: vec![0.5; n],
+            probabilities,
+            selections: vec![0; n],
+            positive: vec![0; n],
+            negative: vec![0; n],
+        },
+    ));
+    assert_eq!(d.sapnet.as_ref().unwrap().locked, None);
+}

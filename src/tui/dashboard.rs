@@ -152,7 +152,8 @@ pub struct SapNetView {
     /// The last policy that activated and spread, and the step it did.
     pub spread: Option<(usize, u64)>,
     /// The policy that has held P > [`LOCK_IN`] since the step given, while it does: the
-    /// softmax has collapsed onto it.
+    /// softmax has collapsed onto it. Never for a method that picks by rule (as in the
+    /// headless comparison, [`MethodKind::picks_by_probability`]).
     pub locked: Option<(usize, u64)>,
     /// The scores at the end of each of the last [`HISTORY`] episodes, oldest first: the
     /// table's sparklines.
@@ -464,7 +465,14 @@ impl Dashboard {
             view.selections = snapshot.selections;
             view.positive = snapshot.positive;
             view.negative = snapshot.negative;
-            let top = view.probabilities.iter().position(|&p| p > LOCK_IN);
+            // Lock-in as the headless comparison measures it: only for a method that
+            // picks by probabilities. UCB1's view gives its next pick probability 1, which
+            // is a rule, not a softmax that collapsed.
+            let top = view
+                .probabilities
+                .iter()
+                .position(|&p| p > LOCK_IN)
+                .filter(|_| snapshot.method.kind.picks_by_probability());
             view.locked = match (top, view.locked) {
                 (Some(i), Some((held, since))) if i == held => Some((held, since)),
                 (Some(i), _) => Some((i, snapshot.step)),
@@ -609,12 +617,13 @@ impl Dashboard {
         let layout = super::view::training_layout(area, self.zoomed());
         let inside = |r: Rect| r.contains(Position::new(column, row));
         if inside(layout.table) {
-            // Below the border and the header row.
-            let first = layout.table.y + 2;
-            if let Some(i) = row.checked_sub(first).map(usize::from) {
-                if i < view.policies.len() && row < layout.table.bottom() - 1 {
-                    self.cursor = i;
-                }
+            // The rows as drawn, below the border and the header row.
+            let window = super::view::policy_rows(layout.table, self);
+            if let Some(i) = row
+                .checked_sub(layout.table.y + 2)
+                .and_then(|line| window.row_at(usize::from(line)))
+            {
+                self.cursor = i;
             }
             self.focus = Focus::Table;
         } else if inside(layout.graph) {

@@ -118,6 +118,23 @@ impl Knob {
     }
 }
 
+/// Why the net refused a turn, with its policies called as the screen calls them (`names`):
+/// the net's own message numbers them from 0.
+pub fn refusal(refused: &SapNetError, names: &[String]) -> String {
+    match *refused {
+        SapNetError::BadWeight { i, j, weight } => format!(
+            "M({},{}) would weigh {weight}: every edge weight must be a finite number > 0, \
+             or spreading would never end",
+            names[i], names[j]
+        ),
+        SapNetError::NoEdge { i, j } => format!(
+            "{} and {} are not joined: there is no edge to change",
+            names[i], names[j]
+        ),
+        ref other => other.to_string(),
+    }
+}
+
 pub fn paths_name(paths: Paths) -> &'static str {
     match paths {
         Paths::Literal => "literal",

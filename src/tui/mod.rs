@@ -9,6 +9,7 @@
 //! - [`teach`]: one activation's spreading, a call at a time, with undo.
 //! - [`knobs`]: teach mode's live edits (T_ω, 𝒜, τ, paths, an edge's weight).
 //! - [`reference`]: a finished protocol's bands beside the live run (`--compare`).
+//! - [`row_window`]: which rows a table too long for its panel shows.
 //! - [`view`], [`step_line`], [`teach_view`], [`graph_view`]: drawing, as pure functions
 //!   of that state.
 
@@ -16,6 +17,7 @@ pub mod dashboard;
 pub mod graph_view;
 pub mod knobs;
 pub mod reference;
+pub mod row_window;
 pub mod step_line;
 pub mod teach;
 pub mod teach_view;

@@ -7,7 +7,8 @@
 //! [`Teach::advance`], so a walk of millions of calls leaves the screen and the keys
 //! responsive.
 
-use super::knobs::{walk_end, EditReport, Knob};
+use super::graph_view;
+use super::knobs::{refusal, walk_end, EditReport, Knob};
 use crate::sapnet::{Call, SapNet, SpreadState, Spreader, TraceStep};
 
 /// Calls `r` makes between two frames: a few milliseconds' worth.
@@ -17,6 +18,10 @@ pub const CALLS_PER_FRAME: usize = 50_000;
 #[derive(Debug, Clone)]
 pub struct Teach {
     names: Vec<String>,
+    /// The names the lesson gave, where they could not tell the policies apart on the
+    /// graph (`1×100`, `2×100` both read `100`): the policies are then called π0…, and the
+    /// activations table gives these beside.
+    descriptions: Option<Vec<String>>,
     /// The names as the paper numbers policies, π1…πN, where the given ones are π0…πN−1.
     paper_names: Option<Vec<String>>,
     /// Show `paper_names` (`p`).
@@ -77,6 +82,13 @@ pub struct WalkView<'a> {
 impl Teach {
     pub fn new(names: Vec<String>, net: SapNet) -> Self {
         let initial = net.activations().to_vec();
+        let (names, descriptions) = match graph_view::distinct_labels(&names) {
+            Some(_) => (names, None),
+            None => (
+                (0..names.len()).map(|i| format!("π{i}")).collect(),
+                Some(names),
+            ),
+        };
         let zero_based = names
             .iter()
             .enumerate()
@@ -86,6 +98,7 @@ impl Teach {
             paper_names,
             paper_numbering: false,
             names,
+            descriptions,
             net,
             initial,
             cursor: 0,
@@ -115,6 +128,12 @@ impl Teach {
             (Some(paper), true) => paper,
             _ => &self.names,
         }
+    }
+
+    /// What the lesson called each policy, where the screen calls them π0… instead (see
+    /// [`new`](Self::new)).
+    pub fn descriptions(&self) -> Option<&[String]> {
+        self.descriptions.as_deref()
     }
 
     /// `p`: the paper's numbering π1…πN, or back to π0…; `false` when the lesson names
@@ -225,7 +244,20 @@ impl Teach {
         let turned = match self.knob.turn(&start, self.selected_edge(), up) {
             Ok(net) => net,
             Err(refused) => {
-                self.notice = Some(format!("{} stays {from}: {refused}", self.knob.symbol()));
+                // In the screen's names: the net's message numbers the policies from 0.
+                let names = self.names();
+                let (what, why) = match (self.knob, self.selected_edge()) {
+                    (Knob::EdgeWeight, Some((i, j))) => (
+                        format!("M({},{})", names[i], names[j]),
+                        refusal(&refused, names),
+                    ),
+                    (Knob::EdgeWeight, None) => (
+                        "M".to_string(),
+                        format!("{} has no edge to change", names[self.cursor]),
+                    ),
+                    (knob, _) => (knob.symbol().to_string(), refusal(&refused, names)),
+                };
+                self.notice = Some(format!("{what} stays {from}: {why}"));
                 return;
             }
         };
@@ -547,6 +579,23 @@ mod tests {
             notice.starts_with("T_ω stays 0.1: parameter `threshold`"),
             "{notice}"
         );
+    }
+
+    /// With `p` the screen calls Fig. 2's policies π1…π4: a refused weight names its edge
+    /// so, not by the net's indices from 0.
+    #[test]
+    fn a_refused_weight_names_its_edge_as_the_screen_does() {
+        let mut teach = fig2();
+        assert!(teach.toggle_numbering());
+        let (i, j) = teach.selected_edge().expect("π1 has edges");
+        teach.choose_knob(Knob::EdgeWeight);
+        for _ in 0..20 {
+            teach.edit(false);
+        }
+        let notice = teach.notice().expect("refused");
+        let edge = format!("M({},{})", teach.names()[i], teach.names()[j]);
+        assert!(notice.contains(&edge), "{edge}: {notice}");
+        assert!(!notice.contains(&format!("({i}, {j})")), "{notice}");
     }
 
     /// The graph of issue 13: 300 policies, every pair joined with weight 0.6. One

@@ -9,6 +9,7 @@ use ratatui::Frame;
 
 use super::graph_view::{self, node_style, Scene};
 use super::knobs::{EditReport, Knob};
+use super::row_window::RowWindow;
 use super::teach::Teach;
 use super::theme::Theme;
 use super::view::{draw_help, probability_bar, too_small, MIN_HEIGHT, MIN_WIDTH};
@@ -39,31 +40,49 @@ pub fn draw(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {
     let line = Line::from(spans);
     frame.render_widget(Paragraph::new(line), status);
     if help {
-        draw_help(frame, area, TEACH_HELP, theme);
+        draw_help(frame, area, &teach_help(teach, false), theme);
     }
 }
 
-/// Teach mode's own keys, for its `?`.
-pub(super) const TEACH_HELP: &[(&str, &str)] = &[
-    ("↑↓←→ hjkl, click", "pick a policy (its node or its row)"),
-    ("a", "activate the picked policy (A += 𝒜, eq. 8)"),
-    ("s", "make the next spread call (eq. 9–11)"),
-    ("r", "run the spreading to its end (s, u, c stop it)"),
-    ("u", "undo the last call, then the activation"),
-    ("c", "back to the starting activations"),
-    ("p", "number the policies π1…πN as the paper does, or π0…"),
-    (
-        "1 … 5",
-        "edit T_ω, 𝒜, τ, the path mode or the weight M of an edge",
-    ),
-    (
-        "+ / −",
-        "turn it a step: the walk restarts, the change is shown",
-    ),
-    ("e", "the picked policy's next edge (for 5)"),
-    ("?", "this help (any key closes it)"),
-    ("q / Esc / Ctrl-C", "quit"),
-];
+/// Teach mode's own keys, for its `?`. `p` is listed where it renumbers the policies (they
+/// are called π0…); Esc quits stand-alone teach mode, and on the dashboard goes back to it.
+pub(super) fn teach_help(
+    teach: &Teach,
+    on_the_dashboard: bool,
+) -> Vec<(&'static str, &'static str)> {
+    let mut keys = vec![
+        ("↑↓←→ hjkl, click", "pick a policy (its node or its row)"),
+        ("a", "activate the picked policy (A += 𝒜, eq. 8)"),
+        ("s", "make the next spread call (eq. 9–11)"),
+        ("r", "run the spreading to its end (s, u, c stop it)"),
+        ("u", "undo the last call, then the activation"),
+        ("c", "back to the starting activations"),
+    ];
+    if teach.numbering().is_some() {
+        keys.push(("p", "number the policies π1…πN as the paper does, or π0…"));
+    }
+    keys.extend([
+        (
+            "1 … 5",
+            "edit T_ω, 𝒜, τ, the path mode or the weight M of an edge",
+        ),
+        (
+            "+ / −",
+            "turn it a step: the walk restarts, the change is shown",
+        ),
+        ("e", "the picked policy's next edge (for 5)"),
+        ("?", "this help (any key closes it)"),
+    ]);
+    if on_the_dashboard {
+        keys.extend([
+            ("t / Esc", "back to the paused dashboard"),
+            ("q / Ctrl-C", "quit"),
+        ]);
+    } else {
+        keys.push(("q / Esc / Ctrl-C", "quit"));
+    }
+    keys
+}
 
 const TEACH_HINTS: &str =
     "↑↓ pick · a activate · s step · r run · u undo · c reset · 1–5 +/− edit · ? help · q quit";
@@ -117,11 +136,23 @@ pub fn policy_at(area: Rect, teach: &Teach, column: u16, row: u16) -> Option<usi
             .and_then(|point| graph_view::node_at(&positions, point, graph_view::CLICK_REACH));
     }
     if panels.values.contains(at) && row < panels.values.bottom() - 1 {
-        // Below the border and the header row.
-        let i = usize::from(row.checked_sub(panels.values.y + 2)?);
-        return (i < n).then_some(i);
+        // The rows as drawn, below the border and the header row.
+        let line = usize::from(row.checked_sub(panels.values.y + 2)?);
+        return values_rows(panels.values, teach).row_at(line);
     }
     None
+}
+
+/// The rows of the activations table that a panel of `area` shows: the picked policy's
+/// always, and the activated one's beside it if they fit.
+fn values_rows(area: Rect, teach: &Teach) -> RowWindow {
+    let room = usize::from(area.height.saturating_sub(3));
+    let activated = teach.walk().map(|w| w.policy);
+    RowWindow::new(
+        teach.net().len(),
+        room,
+        std::iter::once(teach.cursor()).chain(activated),
+    )
 }
 
 /// A left click at `(column, row)` of a `screen` showing teach mode (its panels above the
@@ -266,12 +297,16 @@ fn draw_call(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
 fn draw_stack(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     let walk = teach.walk();
     let names = teach.names();
+    let pending = walk.as_ref().map_or(0, |w| w.pending.len());
+    // The next calls, on top; the marker counts those below.
+    let window = RowWindow::new(pending, usize::from(area.height.saturating_sub(2)), [0]);
     let stack_lines: Vec<Line> = walk
         .as_ref()
         .map(|w| {
             w.pending
                 .iter()
                 .rev()
+                .take(window.shown)
                 .enumerate()
                 .map(|(k, c)| {
                     let text = format!(
@@ -287,13 +322,15 @@ fn draw_stack(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
                 .collect()
         })
         .unwrap_or_default();
-    frame.render_widget(
-        Paragraph::new(stack_lines).block(Block::bordered().title(Span::styled(
+    let block = Block::bordered()
+        .title(Span::styled(
             " pending spread calls (next on top) ",
             theme.title(),
-        ))),
-        area,
-    );
+        ))
+        .title_bottom(
+            Line::styled(window.marker().unwrap_or_default(), theme.title()).right_aligned(),
+        );
+    frame.render_widget(Paragraph::new(stack_lines).block(block), area);
 }
 
 /// The trace: the calls made so far, the latest last.
@@ -301,16 +338,30 @@ fn draw_trace(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     let walk = teach.walk();
     let names = teach.names();
     let trace_steps = walk.as_ref().map_or(&[][..], |w| w.trace);
-    let visible = area.height.saturating_sub(3) as usize;
-    let skip = trace_steps.len().saturating_sub(visible);
-    let rows = trace_steps
-        .iter()
-        .enumerate()
-        .skip(skip)
-        .map(|(k, s)| trace_row(k + 1, s, names, theme));
-    let name_width = name_width(names, 4, 9);
+    // The latest calls; the marker counts the earlier ones.
+    let window = RowWindow::new(
+        trace_steps.len(),
+        usize::from(area.height.saturating_sub(3)),
+        trace_steps.len().checked_sub(1),
+    );
     // Wide enough for the last call's number: long walks make hundreds of thousands.
     let number_width = trace_steps.len().max(1).to_string().len().max(4) as u16;
+    // #, h, Ω, η, ΔA ("0.526316") and the six gaps between the seven columns.
+    let fixed = number_width + 2 + 5 + 7 + 8 + 6;
+    let room = area.width.saturating_sub(2 + fixed) / 2;
+    // The names where both columns have room for them, else the graph's labels.
+    let short: Vec<String>;
+    let names = if name_width(names, 4, usize::MAX) <= room {
+        names
+    } else {
+        short = graph_view::labels(names);
+        short.as_slice()
+    };
+    let name_width = name_width(names, 4, usize::MAX);
+    let rows = trace_steps[window.rows()]
+        .iter()
+        .zip(window.rows())
+        .map(|(s, k)| trace_row(k + 1, s, names, theme));
     frame.render_widget(
         Table::new(
             rows,
@@ -321,11 +372,18 @@ fn draw_trace(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
                 Constraint::Length(2),
                 Constraint::Length(5),
                 Constraint::Length(7),
-                Constraint::Min(10),
+                Constraint::Min(8),
             ],
         )
         .header(Row::new(["#", "from", "to", "h", "Ω", "η", "ΔA"]).style(theme.title()))
-        .block(Block::bordered().title(Span::styled(" trace ", theme.title()))),
+        .block(
+            Block::bordered()
+                .title(Span::styled(" trace ", theme.title()))
+                .title_bottom(
+                    Line::styled(window.marker().unwrap_or_default(), theme.title())
+                        .right_aligned(),
+                ),
+        ),
         area,
     );
 }
@@ -361,49 +419,97 @@ fn draw_values(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         .last_edit()
         .filter(|_| area.width >= 60)
         .map(|r| (r.activation_change(), r.probability_change()));
-    let rows = names.iter().enumerate().map(|(i, name)| {
-        let a = net.activations()[i];
-        let mut cells = vec![
-            Cell::from(Span::styled(name.clone(), node_style(theme, a, top))),
-            Cell::from(fit(a, VALUE_WIDTH)),
-            Cell::from(deposited.map_or(String::new(), |d| fit(d[i], VALUE_WIDTH))),
-            Cell::from(probability_bar(probabilities[i], 6)),
-        ];
-        if let Some((da, dp)) = &edit {
-            cells.push(Cell::from(signed(da[i], 4)));
-            cells.push(Cell::from(signed(dp[i], 3)));
-        }
-        let row = Row::new(cells);
-        if i == teach.cursor() {
-            row.style(theme.cursor())
-        } else {
-            row
-        }
-    });
-    let name_width = name_width(names, 6, 10);
+    // The figures' columns, then the names in the room left (the names are cut only
+    // where there is none), then the lesson's descriptions where they fit whole; where
+    // they do not, the title gives the picked policy's.
     let mut widths = vec![
-        Constraint::Length(name_width),
         Constraint::Length(VALUE_WIDTH as u16),
         Constraint::Length(VALUE_WIDTH as u16),
         Constraint::Length(11),
     ];
-    let mut header = vec!["policy", "A (eq. 8)", "ΣΔA eq.11", "P (eq. 6)"];
+    let mut header = vec!["A (eq. 8)", "ΣΔA eq.11", "P (eq. 6)"];
     if edit.is_some() {
         widths.extend([Constraint::Length(9), Constraint::Min(6)]);
         header.extend(["edit: ΔA", "ΔP"]);
     }
+    let figures: u16 = widths.iter().map(|w| constraint_width(*w) + 1).sum();
+    let room = area.width.saturating_sub(2 + figures);
+    let name_width = name_width(names, 6, usize::from(room));
+    let descriptions = teach.descriptions();
+    let description_width = descriptions.map_or(0, name_width_of);
+    let beside = descriptions.filter(|_| description_width < room.saturating_sub(name_width));
+    if beside.is_some() {
+        widths.insert(0, Constraint::Length(description_width));
+        header.insert(0, "name");
+    }
+    widths.insert(0, Constraint::Length(name_width));
+    header.insert(0, "policy");
+    let mut title = " activations ".to_string();
+    if let (Some(descriptions), None) = (descriptions, beside) {
+        let i = teach.cursor();
+        title = format!(" activations · {} = {} ", names[i], descriptions[i]);
+    }
+    let window = values_rows(area, teach);
+    let rows = names[window.rows()]
+        .iter()
+        .zip(window.rows())
+        .map(|(name, i)| {
+            let a = net.activations()[i];
+            let mut cells = vec![Cell::from(Span::styled(
+                name.clone(),
+                node_style(theme, a, top),
+            ))];
+            if let Some(descriptions) = beside {
+                cells.push(Cell::from(descriptions[i].clone()));
+            }
+            cells.extend([
+                Cell::from(fit(a, VALUE_WIDTH)),
+                Cell::from(deposited.map_or(String::new(), |d| fit(d[i], VALUE_WIDTH))),
+                Cell::from(probability_bar(probabilities[i], 6)),
+            ]);
+            if let Some((da, dp)) = &edit {
+                cells.push(Cell::from(signed(da[i], 4)));
+                cells.push(Cell::from(signed(dp[i], 3)));
+            }
+            let row = Row::new(cells);
+            if i == teach.cursor() {
+                row.style(theme.cursor())
+            } else {
+                row
+            }
+        });
     frame.render_widget(
         Table::new(rows, widths)
             .header(Row::new(header).style(theme.title()))
-            .block(Block::bordered().title(Span::styled(" activations ", theme.title()))),
+            .block(
+                Block::bordered()
+                    .title(Span::styled(title, theme.title()))
+                    .title_bottom(
+                        Line::styled(window.marker().unwrap_or_default(), theme.title())
+                            .right_aligned(),
+                    ),
+            ),
         area,
     );
 }
 
-/// A column for the longest of `names`, within `least..=most` characters.
+/// The cells a fixed column takes (a `Min` column its minimum).
+fn constraint_width(constraint: Constraint) -> u16 {
+    match constraint {
+        Constraint::Length(n) | Constraint::Min(n) => n,
+        _ => 0,
+    }
+}
+
+/// The characters of the longest of `names`.
+fn name_width_of(names: &[String]) -> u16 {
+    names.iter().map(|n| n.chars().count()).max().unwrap_or(0) as u16
+}
+
+/// A column for the longest of `names`, within `least..=most` characters (`least` where
+/// `most` is smaller).
 fn name_width(names: &[String], least: usize, most: usize) -> u16 {
-    let longest = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
-    longest.clamp(least, most) as u16
+    usize::from(name_width_of(names)).min(most).max(least) as u16
 }
 
 /// Characters of an activation in the table.

@@ -13,6 +13,7 @@ use ratatui::Frame;
 use super::dashboard::{Dashboard, Focus, Mode, RunView, SapNetView, HISTORY, SPEEDS};
 use super::graph_view::{self, node_style, Scene};
 use super::reference::Band;
+use super::row_window::RowWindow;
 use super::step_line::step_line;
 use super::theme::Theme;
 
@@ -33,10 +34,13 @@ pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
     }
     draw_status(frame, status, dashboard, theme);
     if dashboard.help {
-        if dashboard.mode == Mode::Teach {
-            let mut keys = super::teach_view::TEACH_HELP.to_vec();
-            keys.insert(keys.len() - 2, ("t / Esc", "back to the paused dashboard"));
-            draw_help(frame, area, &keys, theme);
+        if let (Some(teach), Mode::Teach) = (&dashboard.teach, dashboard.mode) {
+            draw_help(
+                frame,
+                area,
+                &super::teach_view::teach_help(teach, true),
+                theme,
+            );
         } else {
             draw_help(frame, area, HELP, theme);
         }
@@ -179,8 +183,7 @@ fn draw_training(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
                         dashboard.focus == Focus::Table,
                     ),
                     view,
-                    dashboard.cursor,
-                    dashboard.relative,
+                    dashboard,
                     theme,
                 );
             }
@@ -268,15 +271,31 @@ fn thousands(n: u64) -> String {
     out
 }
 
+/// The rows of the policy table that a panel of `area` shows: the cursor's row always,
+/// and while paused the acting policy's too. Running, the acting policy changes from frame
+/// to frame: a window that followed it would jitter, and a click could land on another row
+/// than the one seen, so the bottom border names it when it is hidden instead.
+pub fn policy_rows(area: Rect, dashboard: &Dashboard) -> RowWindow {
+    let (total, acting) = dashboard
+        .sapnet
+        .as_ref()
+        .map_or((0, None), |v| (v.policies.len(), v.acting));
+    // Below the top border and the header, above the bottom border.
+    let room = usize::from(area.height.saturating_sub(3));
+    let acting = acting.filter(|_| dashboard.mode == Mode::Paused);
+    RowWindow::new(total, room, std::iter::once(dashboard.cursor).chain(acting))
+}
+
 fn draw_policy_table(
     frame: &mut Frame,
     area: Rect,
     block: Block,
     view: &SapNetView,
-    cursor: usize,
-    relative: bool,
+    dashboard: &Dashboard,
     theme: Theme,
 ) {
+    let (cursor, relative) = (dashboard.cursor, dashboard.relative);
+    let window = policy_rows(area, dashboard);
     // `v`: each score less the highest, so that saturated activations (2.360e5 beside
     // 2.359e5) still read apart.
     let highest = view
@@ -305,49 +324,52 @@ fn draw_policy_table(
     // window), where the panel is wide enough: zoomed (`z`) or on a wide terminal.
     let history = area.width >= 90;
     let history_top = graph_view::highest(view.history.iter().flatten().copied());
-    let rows = view.policies.iter().enumerate().map(|(i, p)| {
-        let a = view.net.activations()[i];
-        let probability = view.probabilities.get(i).copied().unwrap_or(0.0);
-        let mut name = Span::styled(p.name.clone(), node_style(theme, a, top));
-        if view.acting == Some(i) {
-            name = name.patch_style(theme.active());
-        }
-        let mut cells = vec![Cell::from(name)];
-        if full {
-            cells.push(Cell::from(format!("{:?}", p.description.hidden)));
-            cells.push(Cell::from(if tasks {
-                graph_view::short_task(&p.description.source_task).to_string()
+    let rows = view.policies[window.rows()]
+        .iter()
+        .zip(window.rows())
+        .map(|(p, i)| {
+            let a = view.net.activations()[i];
+            let probability = view.probabilities.get(i).copied().unwrap_or(0.0);
+            let mut name = Span::styled(p.name.clone(), node_style(theme, a, top));
+            if view.acting == Some(i) {
+                name = name.patch_style(theme.active());
+            }
+            let mut cells = vec![Cell::from(name)];
+            if full {
+                cells.push(Cell::from(format!("{:?}", p.description.hidden)));
+                cells.push(Cell::from(if tasks {
+                    graph_view::short_task(&p.description.source_task).to_string()
+                } else {
+                    p.description.hidden.len().to_string()
+                }));
+            }
+            cells.push(Cell::from(format_activation(if relative {
+                a - highest
             } else {
-                p.description.hidden.len().to_string()
-            }));
-        }
-        cells.push(Cell::from(format_activation(if relative {
-            a - highest
-        } else {
-            a
-        })));
-        cells.push(Cell::from(probability_bar(probability, bar_width)));
-        cells.push(Cell::from(count(view.selections[i])));
-        if full {
-            cells.push(Cell::from(format!(
-                "{}/{}",
-                count(view.positive[i]),
-                count(view.negative[i])
-            )));
-        }
-        if history {
-            cells.push(Cell::from(sparkline(
-                view.history.iter().map(|scores| scores[i]),
-                history_top,
-            )));
-        }
-        let row = Row::new(cells);
-        if i == cursor {
-            row.style(theme.cursor())
-        } else {
-            row
-        }
-    });
+                a
+            })));
+            cells.push(Cell::from(probability_bar(probability, bar_width)));
+            cells.push(Cell::from(count(view.selections[i])));
+            if full {
+                cells.push(Cell::from(format!(
+                    "{}/{}",
+                    count(view.positive[i]),
+                    count(view.negative[i])
+                )));
+            }
+            if history {
+                cells.push(Cell::from(sparkline(
+                    view.history.iter().map(|scores| scores[i]),
+                    history_top,
+                )));
+            }
+            let row = Row::new(cells);
+            if i == cursor {
+                row.style(theme.cursor())
+            } else {
+                row
+            }
+        });
     let (mut header, mut widths) = if full {
         (
             vec![
@@ -384,6 +406,11 @@ fn draw_policy_table(
         header.push("A per episode");
         widths.push(Constraint::Length(HISTORY as u16));
     }
+    let mut marker = window.marker().unwrap_or_default();
+    if let Some(acting) = view.acting.filter(|i| !window.rows().contains(i)) {
+        marker.push_str(&format!("· {} acts ", view.policies[acting].name));
+    }
+    let block = block.title_bottom(Line::styled(marker, theme.title()).right_aligned());
     let table = Table::new(rows, widths)
         .header(Row::new(header).style(theme.title()))
         .block(block);
@@ -645,14 +672,22 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
             0 => String::new(),
             run => format!(" run {run}"),
         };
+        // The episode being played, as the step line counts it: the next one once its
+        // first step came (the run counts the episodes that ended).
+        let playing = dashboard.last_step.as_ref().map_or(0, |s| s.episode);
         format!(
             "{}{which} ep {}/{}",
-            r.method, r.episode, r.planned_episodes
+            r.method,
+            r.episode.max(playing),
+            r.planned_episodes
         )
     });
-    let speed = match dashboard.steps_per_second {
-        Some(s) => format!("{s:.0} steps/s"),
-        None => "- steps/s".to_string(),
+    // Paused, training makes no steps: the last rate measured would be stale.
+    let speed = match (dashboard.mode, dashboard.steps_per_second) {
+        (Mode::Teach, _) => Some("paused".to_string()),
+        _ if finished || dashboard.mode == Mode::Paused => None,
+        (_, Some(s)) => Some(format!("{s:.0} steps/s")),
+        (_, None) => Some("- steps/s".to_string()),
     };
     let throttle = match SPEEDS[dashboard.speed] {
         d if d.is_zero() => "full speed".to_string(),
@@ -679,20 +714,21 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
                 spans.push(Span::styled(format!(" {method} FAILED ·"), theme.stopped()));
             }
             // The state first: how fast training is let run, where the run is. What does
-            // not fit before the keys is dropped from the end, never cut mid-word.
+            // not fit before the keys is dropped from the end, never cut mid-word; two
+            // spaces at least keep the last figure from reading into the keys.
             let room = usize::from(area.width)
-                .saturating_sub(hints.chars().count() + 1)
+                .saturating_sub(hints.chars().count() + 2)
                 .saturating_sub(spans.iter().map(|s| s.content.chars().count()).sum());
             let figures = [
-                throttle,
-                episode,
-                format!("step {}", thousands(dashboard.step)),
+                Some(throttle),
+                Some(episode),
+                Some(format!("step {}", thousands(dashboard.step))),
                 speed,
-                format!("ε {epsilon:.2}"),
-                dashboard.task.clone(),
+                Some(format!("ε {epsilon:.2}")),
+                Some(dashboard.task.clone()),
             ];
             let mut text = String::new();
-            for figure in figures {
+            for figure in figures.into_iter().flatten() {
                 let next = if text.is_empty() {
                     format!(" {figure}")
                 } else {
@@ -744,24 +780,30 @@ const HELP: &[(&str, &str)] = &[
     ("+/−", "its positive / negative transitions so far (eq. 7)"),
 ];
 
+/// The width of the help's key column, with the two spaces after it.
+const HELP_KEYS: usize = 20;
+
 pub(super) fn draw_help(frame: &mut Frame, area: Rect, keys: &[(&str, &str)], theme: Theme) {
     let width = 76.min(area.width);
-    let height = (keys.len() as u16 + 4).min(area.height);
+    // What a key does wraps under itself, beside the keys' column.
+    let room = usize::from(width.saturating_sub(2)).saturating_sub(HELP_KEYS);
+    let mut lines: Vec<Line> = Vec::new();
+    for (key, what) in keys {
+        for (k, part) in wrap_words(what, room).into_iter().enumerate() {
+            let key = if k == 0 { *key } else { "" };
+            lines.push(Line::from(vec![
+                Span::styled(format!("{key:>w$}  ", w = HELP_KEYS - 2), theme.title()),
+                Span::raw(part),
+            ]));
+        }
+    }
+    let height = (lines.len() as u16 + 4).min(area.height);
     let [row] = Layout::vertical([Constraint::Length(height)])
         .flex(ratatui::layout::Flex::Center)
         .areas(area);
     let [popup] = Layout::horizontal([Constraint::Length(width)])
         .flex(ratatui::layout::Flex::Center)
         .areas(row);
-    let lines: Vec<Line> = keys
-        .iter()
-        .map(|(key, what)| {
-            Line::from(vec![
-                Span::styled(format!("{key:>18}  "), theme.title()),
-                Span::raw(*what),
-            ])
-        })
-        .collect();
     frame.render_widget(Clear, popup);
     frame.render_widget(
         Paragraph::new(lines).block(
@@ -773,9 +815,38 @@ pub(super) fn draw_help(frame: &mut Frame, area: Rect, keys: &[(&str, &str)], th
     );
 }
 
+/// `text` in lines of at most `width` columns, broken between words (a word longer than
+/// the width has a line of its own).
+fn wrap_words(text: &str, width: usize) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    for word in text.split(' ') {
+        let line = lines.last_mut().expect("one line at least");
+        let wanted = Line::from(line.as_str()).width() + 1 + Line::from(word).width();
+        if line.is_empty() {
+            line.push_str(word);
+        } else if wanted <= width {
+            line.push(' ');
+            line.push_str(word);
+        } else {
+            lines.push(word.to_string());
+        }
+    }
+    lines
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{count, sparkline};
+    use super::{count, sparkline, wrap_words};
+
+    #[test]
+    fn help_lines_wrap_between_words() {
+        assert_eq!(
+            wrap_words("the weight M of an edge", 14),
+            ["the weight M", "of an edge"]
+        );
+        assert_eq!(wrap_words("quit", 14), ["quit"]);
+        assert_eq!(wrap_words("", 14), [""]);
+    }
 
     #[test]
     fn sparklines_share_one_scale() {
