@@ -120,6 +120,9 @@ fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
         // SIGTERM or SIGHUP end teach mode as `q` does, the terminal restored.
         let _stop = crate::signals::stop_on_signals()?;
         let mut teach = Teach::new(lesson.names, lesson.net);
+        if let Some(groups) = lesson.groups {
+            teach = teach.with_groups(groups);
+        }
         // Each activation finishes the walk before it; the last is left to step, unless
         // --run.
         for &i in &args.activate {

@@ -33,6 +33,25 @@ impl Prototype {
         }
     }
 
+    /// The category of each of `policies`, numbered in order of appearance: what the
+    /// screens group the graph's nodes by.
+    pub fn group_indices<'a>(
+        &self,
+        policies: impl IntoIterator<Item = &'a PolicyDescription>,
+    ) -> Vec<usize> {
+        let mut keys = Vec::new();
+        policies
+            .into_iter()
+            .map(|p| {
+                let key = self.category(p);
+                keys.iter().position(|k| *k == key).unwrap_or_else(|| {
+                    keys.push(key);
+                    keys.len() - 1
+                })
+            })
+            .collect()
+    }
+
     /// Whether two policies share a category under this prototype.
     pub fn relates(&self, a: &PolicyDescription, b: &PolicyDescription) -> bool {
         self.category(a) == self.category(b)

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::config::{parse_ron, ConfigError};
 use crate::sapnet::{
-    BaseGraph, Graph, Paths, PolicyDescription, SapNet, SapNetError, SapNetParams,
+    BaseGraph, Graph, Paths, PolicyDescription, Prototype, SapNet, SapNetError, SapNetParams,
     WeightedPrototype,
 };
 
@@ -80,6 +80,9 @@ pub const MAX_LESSON_POLICIES: usize = 1000;
 pub struct Lesson {
     pub names: Vec<String>,
     pub net: SapNet,
+    /// Each policy's category under the first prototype, where the lesson gives
+    /// `descriptions`: the screen draws a category's policies together.
+    pub groups: Option<Vec<usize>>,
 }
 
 impl TeachConfig {
@@ -157,7 +160,14 @@ impl TeachConfig {
         } else {
             self.names.clone()
         };
-        Ok(Lesson { names, net })
+        let groups = (!self.descriptions.is_empty()).then(|| {
+            let prototype = self
+                .prototypes
+                .first()
+                .map_or(Prototype::HiddenLayers, |p| p.prototype.clone());
+            prototype.group_indices(&self.descriptions)
+        });
+        Ok(Lesson { names, net, groups })
     }
 
     /// With the graph given by its `edges`, the fields that build M from categories would
@@ -218,6 +228,14 @@ mod tests {
 
     fn lesson(text: &str) -> Result<Lesson, String> {
         TeachConfig::lesson_from_ron(text, "test.ron").map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn a_lesson_of_descriptions_groups_its_policies_by_category() {
+        let table2 = lesson(include_str!("../../assets/teach_table2.ron")).unwrap();
+        assert_eq!(table2.groups, Some(vec![0, 0, 0, 1, 1, 1, 1, 2, 2, 2]));
+        // Edges given by hand have no categories to group by.
+        assert_eq!(lesson(FIG2).unwrap().groups, None);
     }
 
     #[test]

@@ -21,7 +21,7 @@ struct Report<'a> {
 /// Loads the teach file (the embedded Fig. 2 without one), activates `args.activate` in
 /// order as positive transitions, and writes the trace and the final state to `out`.
 pub fn run(config: Option<&Path>, args: &TeachArgs, out: &mut impl Write) -> Result<()> {
-    let Lesson { names, mut net } = TeachConfig::load(config)?;
+    let Lesson { names, mut net, .. } = TeachConfig::load(config)?;
     let origin = config.map_or("the embedded Fig. 2".to_string(), |p| {
         p.display().to_string()
     });

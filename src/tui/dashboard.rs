@@ -170,17 +170,7 @@ impl SapNetView {
             .prototypes
             .first()
             .map_or(Prototype::HiddenLayers, |p| p.prototype.clone());
-        let mut keys = Vec::new();
-        self.policies
-            .iter()
-            .map(|p| {
-                let key = prototype.category(&p.description);
-                keys.iter().position(|k| *k == key).unwrap_or_else(|| {
-                    keys.push(key);
-                    keys.len() - 1
-                })
-            })
-            .collect()
+        prototype.group_indices(self.policies.iter().map(|p| &p.description))
     }
 
     /// The name of each group of [`categories`](Self::categories) when the graph groups
