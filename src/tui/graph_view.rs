@@ -46,12 +46,26 @@ pub fn draw(frame: &mut Frame, area: Rect, block: Block, scene: Scene, theme: Th
     let show_weights = scene.net.len() <= 6;
     // The canvas's x units per terminal cell.
     let cell = 2.7 / f64::from(area.width.saturating_sub(2).max(1));
+    let weight_labels = if show_weights {
+        let row = (Y_BOUNDS[1] - Y_BOUNDS[0]) / f64::from(area.height.saturating_sub(2).max(1));
+        weight_label_points(
+            scene
+                .net
+                .graph()
+                .edges()
+                .map(|(i, j, _)| (positions[i], positions[j])),
+            (cell, row),
+            4,
+        )
+    } else {
+        Vec::new()
+    };
     let canvas = Canvas::default()
         .block(block)
         .x_bounds(X_BOUNDS)
         .y_bounds(Y_BOUNDS)
         .paint(|ctx| {
-            for (i, j, w) in scene.net.graph().edges() {
+            for (k, (i, j, w)) in scene.net.graph().edges().enumerate() {
                 let (a, b) = (positions[i], positions[j]);
                 let lit = scene.lit.iter().any(|&e| e == (i, j) || e == (j, i));
                 let walking = scene.walking.is_some_and(|e| e == (i, j) || e == (j, i));
@@ -62,8 +76,7 @@ pub fn draw(frame: &mut Frame, area: Rect, block: Block, scene: Scene, theme: Th
                 } else {
                     dotted(ctx, a, b, w, color(theme, Color::DarkGray));
                 }
-                if show_weights {
-                    let (x, y) = ((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0);
+                if let Some(&(x, y)) = weight_labels.get(k) {
                     ctx.print(x, y, Span::styled(format!("{w:.2}"), theme.dim()));
                 }
             }
@@ -252,6 +265,40 @@ pub fn distinct_labels(names: &[String]) -> Option<Vec<String>> {
     (sorted.len() == labels.len()).then_some(labels)
 }
 
+/// Where each edge's weight is printed: its middle, unless an earlier label is already
+/// there (the two diagonals of a square cross at their middles); then a row above or below
+/// it, or a third of the way along the edge. `cell` is a terminal cell's size in canvas
+/// units (x, y), `width` a label's characters.
+pub fn weight_label_points(
+    edges: impl IntoIterator<Item = ((f64, f64), (f64, f64))>,
+    cell: (f64, f64),
+    width: usize,
+) -> Vec<(f64, f64)> {
+    let mut points: Vec<(f64, f64)> = Vec::new();
+    for (a, b) in edges {
+        let along = |t: f64| (a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t);
+        let middle = along(0.5);
+        let taken = |p: (f64, f64)| {
+            points.iter().any(|q| {
+                (p.0 - q.0).abs() < (width + 1) as f64 * cell.0 && (p.1 - q.1).abs() < cell.1
+            })
+        };
+        let candidates = [
+            middle,
+            (middle.0, middle.1 + cell.1),
+            (middle.0, middle.1 - cell.1),
+            along(1.0 / 3.0),
+            along(2.0 / 3.0),
+        ];
+        let point = candidates
+            .into_iter()
+            .find(|&p| !taken(p))
+            .unwrap_or(middle);
+        points.push(point);
+    }
+    points
+}
+
 /// `source-12` → `12`; short names stay as they are.
 pub fn short_label(name: &str) -> String {
     let digits = name.len() - name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
@@ -331,6 +378,16 @@ mod tests {
         assert_eq!(short_label("source-12"), "12");
         assert_eq!(short_label("π3"), "π3");
         assert_eq!(short_label("cartpole"), "cartpole");
+    }
+
+    #[test]
+    fn crossing_edges_print_their_weights_apart() {
+        let (n, e, s, w) = ((0.0, 1.0), (1.0, 0.0), (0.0, -1.0), (-1.0, 0.0));
+        let cell = (0.1, 0.2);
+        let points = weight_label_points([(n, e), (n, s), (e, w)], cell, 4);
+        assert_eq!(points[0], (0.5, 0.5));
+        assert_eq!(points[1], (0.0, 0.0), "the first diagonal at its middle");
+        assert_eq!(points[2], (0.0, 0.2), "the second a row above it");
     }
 
     #[test]
