@@ -348,8 +348,8 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
     Ok(())
 }
 
-/// Run `run` (from 0, as in the results' files; `--follow-run`) of every reusing method, streaming every step, and of
-/// the first DQN baseline: what the dashboard can train.
+/// Run `run` (`--follow-run`, from 0 as in the results' files) of every reusing method,
+/// streaming every step, and of the first DQN baseline: what the dashboard can train.
 fn dashboard_specs(specs: &[RunSpec], run: u32) -> Result<(Vec<RunSpec>, Option<RunSpec>)> {
     let runs = specs.iter().map(|s| s.run + 1).max().unwrap_or(0);
     anyhow::ensure!(
@@ -358,10 +358,9 @@ fn dashboard_specs(specs: &[RunSpec], run: u32) -> Result<(Vec<RunSpec>, Option<
          numbered from 0 as in the results' files)",
         runs.saturating_sub(1)
     );
-    let index = run;
     let followable = specs
         .iter()
-        .filter(|s| s.run == index && s.method.kind.reuses())
+        .filter(|s| s.run == run && s.method.kind.reuses())
         .map(|s| {
             let mut spec = s.clone();
             spec.stream = StreamOptions::live();
@@ -370,7 +369,7 @@ fn dashboard_specs(specs: &[RunSpec], run: u32) -> Result<(Vec<RunSpec>, Option<
         .collect();
     let baseline = specs
         .iter()
-        .find(|s| s.run == index && s.method.kind == MethodKind::Dqn)
+        .find(|s| s.run == run && s.method.kind == MethodKind::Dqn)
         .cloned();
     Ok((followable, baseline))
 }
