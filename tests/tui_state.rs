@@ -322,18 +322,7 @@ fn lock_in_is_dated_from_the_first_snapshot_above_the_threshold() {
         let n = tui_script::HIDDEN.len();
         let mut probabilities = vec![(1.0 - p) / (n - 1) as f64; n];
         probabilities[top] = p;
-        sapnet::trainer::Event::Activations(sapnet::trainer::ActivationSnapshot {
-            run: 0,
-            method: tui_script::method("sapnet"),
-            step,
-            episode: 1,
-            score_name: "A",
-            activations: vec![0.0; n],
-            probabilities,
-            selections: vec![0; n],
-            positive: vec![0; n],
-            negative: vec![0; n],
-        })
+        tui_script::probabilities_at(tui_script::method("sapnet"), step, probabilities)
     };
     let locked = |d: &Dashboard| d.sapnet.as_ref().unwrap().locked;
     d.on_event(snapshot(5, 6, 0.9));
@@ -363,19 +352,6 @@ fn a_method_that_picks_by_rule_never_shows_a_lock_in() {
     let n = tui_script::HIDDEN.len();
     let mut probabilities = vec![0.0; n];
     probabilities[2] = 1.0;
-    d.on_event(sapnet::trainer::Event::Activations(
-        sapnet::trainer::ActivationSnapshot {
-            run: 0,
-            method: ucb1,
-            step: 102_244,
-            episode: 400,
-            score_name: "mean",
-            activations: vec![0.5; n],
-            probabilities,
-            selections: vec![0; n],
-            positive: vec![0; n],
-            negative: vec![0; n],
-        },
-    ));
+    d.on_event(tui_script::probabilities_at(ucb1, 102_244, probabilities));
     assert_eq!(d.sapnet.as_ref().unwrap().locked, None);
 }

@@ -176,3 +176,21 @@ pub fn sapnet_end(episodes: u32) -> Event {
         wall_s: 12.5,
     })
 }
+
+/// A selector's snapshot of `method` at `step` with these probabilities, and nothing else
+/// to show: for tests of what the probabilities alone decide (the lock-in).
+pub fn probabilities_at(method: MethodId, step: u64, probabilities: Vec<f64>) -> Event {
+    let n = probabilities.len();
+    Event::Activations(ActivationSnapshot {
+        run: 0,
+        method,
+        step,
+        episode: 1,
+        score_name: "A",
+        activations: vec![0.0; n],
+        probabilities,
+        selections: vec![0; n],
+        positive: vec![0; n],
+        negative: vec![0; n],
+    })
+}
