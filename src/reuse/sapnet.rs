@@ -93,6 +93,20 @@ impl SapNetKnobs {
                 "field `{field}.judgment`: expected KSteps(k) with k ≥ 1, got KSteps(0)"
             ));
         }
+        if let Some(label) = &self.label {
+            // The label names the run's files and its chosen policy in the library: a
+            // label that cannot be a file name would fail the protocol after training.
+            let plain = !label.is_empty()
+                && !label.starts_with('.')
+                && !label.contains(['/', '\\'])
+                && label.chars().all(|c| !c.is_control());
+            if !plain {
+                return Err(format!(
+                    "field `{field}.label`: expected a plain name (it names the run's files: \
+                     no '/', '\\', leading '.' or control characters), got {label:?}"
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -399,6 +413,26 @@ mod tests {
             label: None,
         };
         assert_eq!(knobs.label(), "sapnet-tau-exp4-0.5-episode-decay0.999");
+    }
+
+    #[test]
+    fn a_label_that_cannot_name_a_file_is_refused() {
+        for label in ["my/slash", "", ".hidden", "back\\slash"] {
+            let knobs = SapNetKnobs {
+                label: Some(label.to_string()),
+                ..SapNetKnobs::default()
+            };
+            let err = knobs.validate("protocol.methods[1]").unwrap_err();
+            assert!(
+                err.starts_with("field `protocol.methods[1].label`: expected a plain name"),
+                "{label}: {err}"
+            );
+        }
+        let fine = SapNetKnobs {
+            label: Some("sapnet-mine".to_string()),
+            ..SapNetKnobs::default()
+        };
+        assert!(fine.validate("protocol.methods[1]").is_ok());
     }
 
     #[test]
