@@ -130,10 +130,13 @@ fn a_sweep_through_gnu_parallel_survives_a_killed_cell() {
     let status = String::from_utf8(sweep(&["status"], &a).stdout).unwrap();
     assert!(status.contains("0002 running"), "{status}");
 
-    // Merging what there is names what is missing.
+    // Nothing finished: nothing to merge. Then merging what there is names what is missing.
+    let nothing = sweep(&["merge"], &a);
+    assert_eq!(nothing.status.code(), Some(2));
+    ok(sweep(&["run", "--cell", "0", "--jobs", "1"], &a));
     let partly = ok(sweep(&["merge"], &a));
     assert!(
-        stderr(&partly).contains("6 cells are not done"),
+        stderr(&partly).contains("5 cells are not done"),
         "{}",
         stderr(&partly)
     );
@@ -210,4 +213,46 @@ fn a_scheduler_names_the_cell_through_its_environment() {
         "{}",
         stderr(&output)
     );
+}
+
+/// A merge before any cell finished wrote empty files and said "merged 0 cells": it is
+/// refused, pointing at `sweep status`.
+#[test]
+fn a_merge_with_no_finished_cell_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("sweep");
+    ok(plan(&grid(tmp.path()), &dir, &tmp.path().join("lib")));
+    let output = sweep(&["merge"], &dir);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output).contains("has finished: nothing to merge"),
+        "{}",
+        stderr(&output)
+    );
+    assert!(!dir.join("merged").exists());
+}
+
+/// A cell file edited after planning is refused by `sweep run`, whose message says to plan
+/// again; planning the same sweep again writes the file back (it once left it edited).
+#[test]
+fn planning_again_restores_an_edited_cell() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (dir, grid, library) = (
+        tmp.path().join("sweep"),
+        grid(tmp.path()),
+        tmp.path().join("lib"),
+    );
+    ok(plan(&grid, &dir, &library));
+    let cell = dir.join("cells/0001.ron");
+    let planned = std::fs::read_to_string(&cell).unwrap();
+    std::fs::write(&cell, planned.replace("temperature", "temperature ")).unwrap();
+    let output = sweep(&["run", "--cell", "1"], &dir);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output).contains("`sapnet sweep plan` with the same grid and --out writes it back"),
+        "{}",
+        stderr(&output)
+    );
+    ok(plan(&grid, &dir, &library));
+    assert_eq!(std::fs::read_to_string(&cell).unwrap(), planned);
 }

@@ -44,6 +44,13 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
             missing.push(cell.id);
         }
     }
+    anyhow::ensure!(
+        !done.is_empty(),
+        "no cell of {} has finished: nothing to merge (`sapnet sweep status {}` says where \
+         they are)",
+        sweep.display(),
+        sweep.display()
+    );
     let out = sweep.join("merged");
     if out.exists() {
         std::fs::remove_dir_all(&out).with_context(|| format!("replacing {}", out.display()))?;

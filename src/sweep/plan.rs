@@ -72,6 +72,15 @@ pub fn plan(options: &PlanOptions) -> Result<Manifest> {
                 sweep.display()
             );
         }
+        // The same sweep planned again: a cell file edited since is written back as planned
+        // (a cell runs only the config its manifest hashes).
+        for (entry, text) in found.cells.iter().zip(&texts) {
+            let path = cell_config(&sweep, entry.id);
+            let now = std::fs::read(&path).ok().map(|bytes| sha256_hex(&bytes));
+            if now.as_deref() != Some(entry.config_sha256.as_str()) {
+                write_atomically(&path, text.as_bytes())?;
+            }
+        }
         return Ok(found);
     }
     for dir in ["cells", "results", "failed", "logs"] {

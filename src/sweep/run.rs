@@ -93,8 +93,9 @@ fn attempt(
     let text = crate::config::read_text(&path)?;
     if sha256_hex(text.as_bytes()) != entry.config_sha256 {
         bail!(
-            "{} changed after the sweep was planned (its SHA-256 differs from sweep.ron): plan \
-             the sweep again",
+            "{} changed after the sweep was planned (its SHA-256 differs from sweep.ron): \
+             `sapnet sweep plan` with the same grid and --out writes it back as planned; to run \
+             other settings, change the grid and plan into another --out",
             path.display()
         );
     }
