@@ -201,8 +201,10 @@ pub enum SweepCommand {
     Run {
         #[arg(value_name = "SWEEP")]
         sweep: PathBuf,
+        /// The cell to run (its number, as in SWEEP/cells/NNNN.ron).
         #[arg(long, value_name = "K", conflicts_with = "all")]
         cell: Option<usize>,
+        /// Every cell not done yet, --jobs at a time, on this machine.
         #[arg(long)]
         all: bool,
     },
