@@ -56,9 +56,10 @@ pub struct RunArgs {
     )]
     pub resume: bool,
 
-    /// A smoke run (seconds for the paper's protocol, about a minute for the comparison of
-    /// assets/reuse_cartpole.ron): the protocol cut to 1/20 of its episodes and at most
-    /// 2 runs per method (on the same source library). With --episodes, its N episodes.
+    /// A smoke run (seconds for the paper's protocol, about ten for the comparison of
+    /// assets/reuse_cartpole.ron, on 2 cores): the protocol cut to 1/20 of its episodes and
+    /// at most 2 runs per method (on the same source library). With --episodes, its N
+    /// episodes.
     #[arg(long)]
     pub quick: bool,
 
