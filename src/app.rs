@@ -382,18 +382,24 @@ fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
         let mut out = std::io::stdout().lock();
         writeln!(
             out,
-            "{:<10} {:<28} {:<16} {:>10} {:>12}",
-            "source", "task", "hidden", "own task", target
+            "{:<10} {:<28} {:<16} {:>10} {:>width$}",
+            "source",
+            "task",
+            "hidden",
+            "own task",
+            target,
+            width = target.len().max(12)
         )?;
         for e in &evaluations {
             writeln!(
                 out,
-                "{:<10} {:<28} {:<16} {:>10} {:>12.1}",
+                "{:<10} {:<28} {:<16} {:>10} {:>width$.1}",
                 e.name,
                 e.task,
                 format!("{:?}", e.hidden),
                 e.own_score.map_or("-".into(), |s| format!("{s:.1}")),
-                e.target_score
+                e.target_score,
+                width = target.len().max(12)
             )?;
         }
         return Ok(());
