@@ -256,3 +256,15 @@ fn planning_again_restores_an_edited_cell() {
     ok(plan(&grid, &dir, &library));
     assert_eq!(std::fs::read_to_string(&cell).unwrap(), planned);
 }
+
+/// Cells that differ only by seed reuse one library: `sweep prepare` readies it once (it
+/// said "ready" once per seed).
+#[test]
+fn prepare_readies_a_library_once_for_every_seed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("sweep");
+    ok(plan(&grid(tmp.path()), &dir, &tmp.path().join("lib")));
+    let prepared = ok(sweep(&["prepare"], &dir));
+    let said = stderr(&prepared);
+    assert_eq!(said.matches(" ready").count(), 1, "{said}");
+}

@@ -3,7 +3,7 @@
 //! reuse, trained once before the array starts.
 
 use std::io::IsTerminal;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc::Receiver;
 use std::time::Duration;
@@ -150,7 +150,13 @@ pub fn prepare(sweep: &Path, stop: &Receiver<TrainerCommand>) -> Result<()> {
         }
         let training = sources::LibraryTraining::of(&config);
         let dir = sources::library_dir(&manifest.library, &config);
-        if seen.contains(&(dir.clone(), training.clone())) {
+        // Cells that differ by seed (or test episodes) reuse one library: it is readied once.
+        if seen
+            .iter()
+            .any(|(d, t): &(PathBuf, sources::LibraryTraining)| {
+                *d == dir && t.differences(&training).is_empty()
+            })
+        {
             continue;
         }
         seen.push((dir.clone(), training));
