@@ -177,18 +177,32 @@ fn pool(group: &[&Results]) -> Results {
     let mut runs = Vec::new();
     let mut rewards: BTreeMap<(MethodId, u32), Vec<f64>> = BTreeMap::new();
     let mut offset = 0;
+    // A method the other axes do not touch (DQN in a sweep over `sapnet.temperature`) runs
+    // the same in every cell of one seed: one run, counted once, or the pooled runs would
+    // be inflated and their spread too small.
+    let mut seen: Vec<(String, u64, Option<&Vec<f64>>, &Vec<f64>)> = Vec::new();
     for results in group {
         for summary in &results.runs {
             let Some(id) = id_of(summary.record.method.label()) else {
                 continue;
             };
+            let returns = results
+                .rewards
+                .get(&(summary.record.method.clone(), summary.record.run));
+            let key = (
+                id.label().to_string(),
+                summary.record.seed,
+                returns,
+                &summary.record.test_returns,
+            );
+            if seen.contains(&key) {
+                continue;
+            }
+            seen.push(key);
             let mut pooled: RunSummary = summary.clone();
             pooled.record.method = id.clone();
             pooled.record.run += offset;
-            if let Some(returns) = results
-                .rewards
-                .get(&(summary.record.method.clone(), summary.record.run))
-            {
+            if let Some(returns) = returns {
                 rewards.insert((id, pooled.record.run), returns.clone());
             }
             runs.push(pooled);
