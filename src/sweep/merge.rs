@@ -159,6 +159,10 @@ fn folder_name(axis: &str, value: &str) -> String {
         .collect()
 }
 
+/// What makes two pooled runs one: the method's label, the run's seed, its training
+/// returns and its test returns.
+type SameRun<'a> = (String, u64, Option<&'a Vec<f64>>, &'a Vec<f64>);
+
 /// The runs of several cells as one protocol: the methods of all (matched by label, in the
 /// order first met), the runs numbered on from cell to cell.
 fn pool(group: &[&Results]) -> Results {
@@ -180,7 +184,7 @@ fn pool(group: &[&Results]) -> Results {
     // A method the other axes do not touch (DQN in a sweep over `sapnet.temperature`) runs
     // the same in every cell of one seed: one run, counted once, or the pooled runs would
     // be inflated and their spread too small.
-    let mut seen: Vec<(String, u64, Option<&Vec<f64>>, &Vec<f64>)> = Vec::new();
+    let mut seen: Vec<SameRun> = Vec::new();
     for results in group {
         for summary in &results.runs {
             let Some(id) = id_of(summary.record.method.label()) else {
