@@ -699,7 +699,7 @@ impl Config {
         {
             return Err(format!(
                 "field `protocol.methods[{i}]`: lists {twice} a second time; each method runs \
-                 once per run (give a SapNetWith its own `label`)"
+                 once per run (give a SapNetWith or Prql its own `label`)"
             ));
         }
         Ok(())
@@ -940,8 +940,8 @@ mod tests {
         let c = Config::from_ron(
             "(protocol: (methods: [SapNet, SapNetWith(judgment: Episode, decay: 0.999), \
              SapNetWith(judgment: KSteps(10), temperature: Some(Linear(from: 4.0, to: 0.5, \
-             steps: 1000))), Random, RandomPerEpisode, Ucb1, Prql(), BestSource, \
-             Dqn(hidden: [100])]))",
+             steps: 1000))), Random, RandomPerEpisode, Ucb1, Prql(), Prql(psi: 0.5), \
+             BestSource, Dqn(hidden: [100])]))",
             "test",
         )
         .unwrap();
@@ -956,6 +956,7 @@ mod tests {
                 "random-episode",
                 "ucb1",
                 "prql",
+                "prql-psi0.5",
                 "best-source",
                 "dqn[100]"
             ]

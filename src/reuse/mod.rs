@@ -216,3 +216,21 @@ pub(crate) fn argmax(values: &[f64]) -> usize {
     }
     best
 }
+
+/// A method's own `label` names its run's files and its chosen policy in the library: one
+/// that cannot be a file name would fail the protocol after training, so it is refused
+/// with its field first.
+pub fn check_label(field: &str, label: &str) -> Result<(), String> {
+    let plain = !label.is_empty()
+        && !label.starts_with('.')
+        && !label.contains(['/', '\\'])
+        && label.chars().all(|c| !c.is_control());
+    if plain {
+        Ok(())
+    } else {
+        Err(format!(
+            "field `{field}.label`: expected a plain name (it names the run's files: no '/', \
+             '\\', leading '.' or control characters), got {label:?}"
+        ))
+    }
+}

@@ -31,6 +31,8 @@ pub struct PrqlKnobs {
     pub tau0: f64,
     /// Δτ ≥ 0: τ's growth per episode.
     pub delta_tau: f64,
+    /// The label of results; default: built from the knobs that differ from the paper's.
+    pub label: Option<String>,
 }
 
 impl Default for PrqlKnobs {
@@ -41,19 +43,35 @@ impl Default for PrqlKnobs {
             upsilon: 0.95,
             tau0: 0.0,
             delta_tau: 0.05,
+            label: None,
         }
     }
 }
 
 impl PrqlKnobs {
-    /// `prql`, or `prql[64,64]` for another learner.
+    /// The given label, else `prql` with what differs from the paper's knobs:
+    /// `prql[64,64]` for another learner, `-psi0.5`, `-upsilon0.9`, `-tau0.5`, `-dtau0.1`.
     pub fn label(&self) -> String {
-        if self.hidden == Self::default().hidden {
-            "prql".into()
-        } else {
-            let layers: Vec<String> = self.hidden.iter().map(ToString::to_string).collect();
-            format!("prql[{}]", layers.join(","))
+        if let Some(label) = &self.label {
+            return label.clone();
         }
+        let paper = Self::default();
+        let mut label = String::from("prql");
+        if self.hidden != paper.hidden {
+            let layers: Vec<String> = self.hidden.iter().map(ToString::to_string).collect();
+            label.push_str(&format!("[{}]", layers.join(",")));
+        }
+        for (name, value, default) in [
+            ("psi", self.psi, paper.psi),
+            ("upsilon", self.upsilon, paper.upsilon),
+            ("tau", self.tau0, paper.tau0),
+            ("dtau", self.delta_tau, paper.delta_tau),
+        ] {
+            if value != default {
+                label.push_str(&format!("-{name}{value}"));
+            }
+        }
+        label
     }
 
     /// The ranges serde cannot check; `field` is where the knobs sit in the config.
@@ -82,6 +100,9 @@ impl PrqlKnobs {
         }
         if !(self.delta_tau >= 0.0 && self.delta_tau.is_finite()) {
             return fail("delta_tau", "a finite Δτ ≥ 0", &self.delta_tau);
+        }
+        if let Some(label) = &self.label {
+            super::check_label(field, label)?;
         }
         Ok(())
     }
@@ -293,6 +314,30 @@ mod tests {
         prql.psi = 0.0;
         prql.knobs.psi = 0.0;
         assert!((0..100).all(|_| prql.act(&mut rng) == Actor::Learner));
+    }
+
+    #[test]
+    fn labels_name_what_differs_from_the_paper_or_are_given() {
+        assert_eq!(PrqlKnobs::default().label(), "prql");
+        let knobs = PrqlKnobs {
+            hidden: vec![64, 64],
+            psi: 0.5,
+            ..PrqlKnobs::default()
+        };
+        assert_eq!(knobs.label(), "prql[64,64]-psi0.5");
+        let named = PrqlKnobs {
+            label: Some("prql-mine".into()),
+            ..knobs
+        };
+        assert_eq!(named.label(), "prql-mine");
+        let slash = PrqlKnobs {
+            label: Some("a/b".into()),
+            ..PrqlKnobs::default()
+        };
+        assert!(slash
+            .validate("protocol.methods[4]")
+            .unwrap_err()
+            .starts_with("field `protocol.methods[4].label`: expected a plain name"));
     }
 
     #[test]

@@ -94,18 +94,7 @@ impl SapNetKnobs {
             ));
         }
         if let Some(label) = &self.label {
-            // The label names the run's files and its chosen policy in the library: a
-            // label that cannot be a file name would fail the protocol after training.
-            let plain = !label.is_empty()
-                && !label.starts_with('.')
-                && !label.contains(['/', '\\'])
-                && label.chars().all(|c| !c.is_control());
-            if !plain {
-                return Err(format!(
-                    "field `{field}.label`: expected a plain name (it names the run's files: \
-                     no '/', '\\', leading '.' or control characters), got {label:?}"
-                ));
-            }
+            super::check_label(field, label)?;
         }
         Ok(())
     }
