@@ -501,12 +501,8 @@ impl Config {
     fn check_source_tasks(&self) -> Result<(), String> {
         let s = &self.sources;
         if let Some(name) = &s.name {
-            let plain = !name.is_empty()
-                && !name.starts_with('.')
-                && !name.contains(['/', '\\'])
-                && name != "chosen";
             check(
-                plain,
+                crate::policy_store::is_plain_name(name) && name != "chosen",
                 "sources.name",
                 "a plain folder name (not `chosen`, no `/`, not starting with `.`)",
                 format!("{name:?}"),

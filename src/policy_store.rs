@@ -380,13 +380,17 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
         .collect()
 }
 
-fn check_name(name: &str) -> Result<(), StoreError> {
-    let plain = !name.is_empty()
-        && name != RESERVED_NAME
+/// Whether `name` can be a file of its own in a folder: not empty, not hidden, no path
+/// separators. What names policies, libraries and methods' labels are checked against.
+pub fn is_plain_name(name: &str) -> bool {
+    !name.is_empty()
         && !name.starts_with('.')
         && !name.contains(['/', '\\'])
-        && Path::new(name).file_name() == Some(name.as_ref());
-    if plain {
+        && Path::new(name).file_name() == Some(name.as_ref())
+}
+
+fn check_name(name: &str) -> Result<(), StoreError> {
+    if is_plain_name(name) && name != RESERVED_NAME {
         Ok(())
     } else {
         Err(StoreError::InvalidName {

@@ -221,16 +221,12 @@ pub(crate) fn argmax(values: &[f64]) -> usize {
 /// that cannot be a file name would fail the protocol after training, so it is refused
 /// with its field first.
 pub fn check_label(field: &str, label: &str) -> Result<(), String> {
-    let plain = !label.is_empty()
-        && !label.starts_with('.')
-        && !label.contains(['/', '\\'])
-        && label.chars().all(|c| !c.is_control());
-    if plain {
+    if crate::policy_store::is_plain_name(label) {
         Ok(())
     } else {
         Err(format!(
-            "field `{field}.label`: expected a plain name (it names the run's files: no '/', \
-             '\\', leading '.' or control characters), got {label:?}"
+            "field `{field}.label`: expected a plain name (it names the run's files: not \
+             empty, no '/' or '\\', not starting with '.'), got {label:?}"
         ))
     }
 }
