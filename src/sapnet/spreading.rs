@@ -152,6 +152,15 @@ fn deposits_stop_at_neighbours(graph: &Graph, spreading: Spreading, i: usize) ->
     })
 }
 
+/// Eq. 8: the activated policy gains 𝒜, before any spreading; every entry point begins so.
+///
+/// # Panics
+/// If `activations` does not hold one value per policy of `graph`.
+fn activate_own(graph: &Graph, i: usize, coefficient: f64, activations: &mut [f64]) {
+    assert_eq!(activations.len(), graph.len(), "one activation per policy");
+    activations[i] += coefficient;
+}
+
 /// `activate` when [`deposits_stop_at_neighbours`]: eq. 8, then eq. 10's deposit on each
 /// neighbour the threshold lets through, in the walk's order and with its arithmetic
 /// (`h = 1`, so `η / (h·Ω)` is `η / Ω` exactly), without the walk's stack: training
@@ -165,8 +174,7 @@ fn activate_neighbours<S: TraceSink>(
     activations: &mut [f64],
     sink: &mut S,
 ) {
-    assert_eq!(activations.len(), graph.len(), "one activation per policy");
-    activations[i] += coefficient;
+    activate_own(graph, i, coefficient, activations);
     let eta = coefficient / graph.degree(i) as f64;
     for (j, w) in graph.neighbours(i) {
         let omega = 0.0 + w;
@@ -201,8 +209,7 @@ pub fn activate_recursive<S: TraceSink>(
     activations: &mut [f64],
     sink: &mut S,
 ) {
-    assert_eq!(activations.len(), graph.len(), "one activation per policy");
-    activations[i] += coefficient;
+    activate_own(graph, i, coefficient, activations);
     let k = graph.degree(i) as f64;
     let mut path = vec![i];
     for (j, w) in graph.neighbours(i) {
@@ -350,8 +357,7 @@ impl<'g> Spreader<'g> {
         activations: &mut [f64],
         skip_stopped: bool,
     ) -> Self {
-        assert_eq!(activations.len(), graph.len(), "one activation per policy");
-        activations[i] += coefficient;
+        activate_own(graph, i, coefficient, activations);
         let mut spreader = Spreader {
             graph,
             spreading,
