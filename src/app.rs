@@ -75,8 +75,8 @@ fn refuse_unread_flags(cli: &Cli, command: &Command) -> Result<()> {
 }
 
 /// The config the user named, or `embedded` (with `label` for messages), with `--quick`,
-/// then `--seed` and `--episodes` applied (an explicit `--episodes` wins over `--quick`'s
-/// 1/20).
+/// then `--seed`, `--episodes` and `--runs` applied (an explicit `--episodes` or `--runs`
+/// wins over `--quick`'s).
 fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
     let mut config = match &cli.run.config {
         Some(path) => Config::from_file(path)?,
@@ -93,6 +93,9 @@ fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
     }
     if let Some(episodes) = cli.run.episodes {
         config.protocol.episodes = episodes;
+    }
+    if let Some(runs) = cli.run.runs {
+        config.protocol.runs = runs;
     }
     Ok(config)
 }
@@ -205,7 +208,7 @@ fn resume_experiment(cli: &Cli) -> Result<()> {
         .out
         .as_deref()
         .context("--resume needs --out DIR, the results to continue")?;
-    let summary = headless::resume(dir, &run_options(cli), &on_interrupt()?)?;
+    let summary = headless::resume(dir, cli.run.runs, &run_options(cli), &on_interrupt()?)?;
     report(&summary, dir)
 }
 

@@ -86,6 +86,12 @@ pub struct RunArgs {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub episodes: Option<u32>,
 
+    /// Runs per method, overriding the config's `protocol.runs`. Run r's seeds do not
+    /// depend on how many runs there are, so the first N runs of a longer protocol are
+    /// exactly these. With --resume: extend a finished protocol to N runs (its runs kept).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=crate::config::MAX_RUNS as i64))]
+    pub runs: Option<u32>,
+
     /// With --headless: also write trace.csv, every spread call (eq. 9-11) of every
     /// positive activation of SAP-Net's runs, as teach mode shows them. One row per call:
     /// millions over a full protocol, so best with --quick or a small config.
@@ -127,6 +133,7 @@ impl RunArgs {
             ("--follow-run", self.follow_run.is_some()),
             ("--compare", self.compare.is_some()),
             ("--episodes", self.episodes.is_some()),
+            ("--runs", self.runs.is_some()),
             ("--trace", self.trace),
             ("--jobs", self.jobs.is_some()),
             ("--library", self.library.is_some()),

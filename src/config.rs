@@ -231,6 +231,49 @@ impl MethodKind {
             Self::SapNet | Self::Random | Self::Prql | Self::BestSource
         )
     }
+
+    /// What the method hands over to be tested greedily and written as the run's result:
+    /// one rule per method, fixed before the run, as `comparison.csv`'s `tested` column
+    /// names it.
+    pub fn tested(self) -> Tested {
+        match self {
+            Self::SapNet => Tested::HighestActivation,
+            Self::Random | Self::RandomPerEpisode => Tested::DrawnAtStart,
+            Self::Ucb1 => Tested::MostPlayed,
+            Self::BestSource => Tested::BestRecorded,
+            Self::Prql | Self::Dqn => Tested::Learner,
+        }
+    }
+}
+
+/// What a method's run hands over for its greedy tests.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tested {
+    /// The source with the highest activation when the run ends (Algorithm 3).
+    HighestActivation,
+    /// A source drawn uniformly when the run starts, whatever the run then does: a random
+    /// selector has no preference to hand over. (Handing over the source that acted most
+    /// would select by return: the longest episodes are the best source's.)
+    DrawnAtStart,
+    /// The source played in most episodes: a bandit's recommendation.
+    MostPlayed,
+    /// The source with the best recorded score: the oracle's pick, made before training.
+    BestRecorded,
+    /// The method's own learner, not a source.
+    Learner,
+}
+
+impl Tested {
+    /// The rule's name in `comparison.csv`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::HighestActivation => "highest-activation",
+            Self::DrawnAtStart => "drawn-at-start",
+            Self::MostPlayed => "most-played",
+            Self::BestRecorded => "best-recorded",
+            Self::Learner => "learner",
+        }
+    }
 }
 
 impl Method {
@@ -272,6 +315,10 @@ impl Method {
         }
     }
 }
+
+/// The most runs per method a protocol may ask for: far beyond what a comparison needs
+/// (hundreds separate the closest methods), and refused before anything is planned.
+pub const MAX_RUNS: u32 = 10_000;
 
 /// What an experiment runs and how often (paper III-B).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -638,7 +685,12 @@ impl Config {
             format!("{:?}", src.units),
         )?;
         let p = &self.protocol;
-        check(p.runs > 0, "protocol.runs", "at least 1", p.runs)?;
+        check(
+            (1..=MAX_RUNS).contains(&p.runs),
+            "protocol.runs",
+            &format!("1 to {MAX_RUNS}"),
+            p.runs,
+        )?;
         check(
             p.episodes > 0,
             "protocol.episodes",

@@ -22,8 +22,8 @@ pub struct EpisodeSummary {
 /// resets draw from two streams derived from `seed`; resets after the first continue the
 /// environment's generator.
 pub fn run(env: &mut dyn Environment, episodes: u32, seed: u64) -> Vec<EpisodeSummary> {
-    let mut rng = StdRng::seed_from_u64(seeds::derive(seed, &[0]));
-    let env_seed = seeds::derive(seed, &[1]);
+    let mut rng = StdRng::seed_from_u64(seeds::derive(seed, &[seeds::Part::Name("actions")]));
+    let env_seed = seeds::derive(seed, &[seeds::Part::Name("env")]);
     (0..episodes)
         .map(|episode| {
             env.reset((episode == 0).then_some(env_seed));

@@ -33,6 +33,20 @@ impl EnvConfig {
         }
     }
 
+    /// The lowest and highest discounted return `Σ_{t<T} γ^t r_t` an episode can have: each
+    /// step's reward lies in `return_range / T` (the rewards here are constant per step), so
+    /// the bounds are those times `Σ_{t<T} γ^t = (1 − γ^T)/(1 − γ)`.
+    pub fn discounted_return_range(&self, gamma: f64) -> (f64, f64) {
+        let steps = f64::from(self.max_episode_steps());
+        let horizon = if gamma == 1.0 {
+            steps
+        } else {
+            (1.0 - gamma.powf(steps)) / (1.0 - gamma)
+        };
+        let (low, high) = self.return_range();
+        (low / steps * horizon, high / steps * horizon)
+    }
+
     /// Moving averages of returns a comparison reports reaching: Gymnasium's "solved"
     /// levels (CartPole-v1 475, v0 195; MountainCar −110; Acrobot −100) and an easier one.
     pub fn return_thresholds(&self) -> [f64; 2] {

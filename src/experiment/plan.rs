@@ -96,7 +96,7 @@ impl std::fmt::Display for ConfigField {
 }
 
 /// One spec per (method, run), each with its own seed derived from the run seed, the
-/// method's place in the protocol and the run's index.
+/// method's label and the run's index ([`seeds::run_seed`]).
 pub fn run_specs(config: &Config, sources: Option<&Arc<Vec<SourcePolicy>>>) -> Vec<RunSpec> {
     let ids = method_ids(config);
     let none = Arc::new(Vec::new());
@@ -118,7 +118,7 @@ pub fn run_specs(config: &Config, sources: Option<&Arc<Vec<SourcePolicy>>>) -> V
                 episodes: config.protocol.episodes,
                 max_steps: config.protocol.max_steps,
                 test_episodes: config.protocol.test_episodes,
-                seed: seeds::derive(config.seed, &[m as u64, u64::from(run)]),
+                seed: seeds::run_seed(config.seed, ids[m].label(), run),
                 stream: StreamOptions::episodes(),
             });
         }

@@ -122,9 +122,32 @@ pub fn run(
 
 /// Continues the protocol whose results are in `dir` (a stopped, failed or killed one):
 /// with the config and `--trace` it began with, its finished runs kept, the others run
-/// again from their seeds. `options.trace` is ignored.
-pub fn resume(dir: &Path, options: &RunOptions, commands: &Receiver<Command>) -> Result<Summary> {
-    let header = replot::read_header(dir)?;
+/// again from their seeds. `options.trace` is ignored. With `runs`, the protocol is
+/// extended to that many runs per method, finished or not: run r's seeds do not depend
+/// on the number of runs, so the result is the protocol that had `runs` from the start.
+pub fn resume(
+    dir: &Path,
+    runs: Option<u32>,
+    options: &RunOptions,
+    commands: &Receiver<Command>,
+) -> Result<Summary> {
+    let mut header = replot::read_header(dir)?;
+    if let Some(runs) = runs {
+        let had = header.config.protocol.runs;
+        if runs < had {
+            bail!(
+                "{} holds a protocol of {had} runs per method: --runs {runs} would drop runs                  (--resume --runs can only extend it)",
+                dir.display()
+            );
+        }
+        if runs > had {
+            header.config.protocol.runs = runs;
+            header.config.validate().map_err(|e| {
+                anyhow::anyhow!("{}: --runs {runs}: {e}", dir.join("summary.json").display())
+            })?;
+            header.status = Some(Status::Stopped);
+        }
+    }
     match header.status {
         None | Some(Status::Complete) => bail!(
             "{} holds a finished protocol (summary.json: status {}): nothing to resume",

@@ -139,7 +139,7 @@ pub trait Selector: Send + fmt::Debug {
     }
 
     /// The source the run ends with (tested and written to the library), or `None` when
-    /// the run's result is its learner.
+    /// the run's result is its learner: the method's [`crate::config::Tested`] rule.
     fn chosen(&self) -> Option<usize>;
 
     /// The SAP-Net behind the selector, if it is one: its graph, for drawing and teaching.
@@ -164,6 +164,8 @@ pub struct Library<'a> {
     pub scores: &'a [Option<f64>],
     /// The target task's possible returns per episode, (lowest, highest).
     pub return_range: (f64, f64),
+    /// The same for discounted returns, with the DQN's γ.
+    pub discounted_return_range: (f64, f64),
 }
 
 /// Why a selector could not be built.
@@ -200,7 +202,11 @@ pub fn build(
             library.descriptions.len(),
             library.return_range,
         )),
-        Method::Prql(knobs) => Box::new(prql::Prql::new(library.descriptions.len(), knobs)),
+        Method::Prql(knobs) => Box::new(prql::Prql::new(
+            library.descriptions.len(),
+            knobs,
+            library.discounted_return_range,
+        )),
         Method::BestSource => Box::new(best_source::BestSource::new(library.scores)?),
         Method::Dqn { .. } => Box::new(scratch::Scratch),
     })

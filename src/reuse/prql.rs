@@ -8,7 +8,13 @@
 //!   learner's ε-greedy action, with `ψ_{h+1} = ψ_h·υ` (ψ_0 = ψ each episode).
 //!
 //! After the episode, `W_k ← (W_k·U_k + R)/(U_k + 1)`, `U_k ← U_k + 1`, where R is the
-//! episode's discounted return, and `τ ← τ + Δτ`. The result of a run is the learner.
+//! episode's discounted return scaled to [0, 1] by the task's range of discounted returns,
+//! and `τ ← τ + Δτ`. The result of a run is the learner.
+//!
+//! The scaling is this project's: the paper's tasks pay 1 at the goal and nothing else, so
+//! its W lie in [0, 1] and Δτ = 0.05 was chosen for that scale. On CartPole's raw
+//! discounted returns (up to ≈ 99) the same Δτ made one source hold P > 0.99 within a few
+//! episodes of every run; UCB1 scales its rewards the same way.
 
 use crate::config::Shown;
 use rand::rngs::StdRng;
@@ -128,10 +134,13 @@ pub struct Prql {
     /// The largest `P(Π_k)` of a source, kept because W and τ change only between episodes
     /// while the run asks for it at every step.
     top_source: f64,
+    /// The task's (lowest, highest) discounted return, which W's returns are scaled by.
+    range: (f64, f64),
 }
 
 impl Prql {
-    pub fn new(n: usize, knobs: &PrqlKnobs) -> Self {
+    /// PRQ-learning over `n` sources, on a task whose discounted returns lie in `range`.
+    pub fn new(n: usize, knobs: &PrqlKnobs, range: (f64, f64)) -> Self {
         let mut prql = Self {
             knobs: knobs.clone(),
             w: vec![0.0; n + 1],
@@ -140,6 +149,7 @@ impl Prql {
             current: None,
             psi: knobs.psi,
             top_source: 0.0,
+            range,
         };
         prql.top_source = prql.top_source_probability();
         prql
@@ -219,13 +229,15 @@ impl Selector for Prql {
             Pick::Learner => 0,
             Pick::Source(k) => k + 1,
         };
-        self.w[j] = (self.w[j] * self.u[j] as f64 + end.discounted_return) / (self.u[j] + 1) as f64;
+        let (low, high) = self.range;
+        let reward = ((end.discounted_return - low) / (high - low)).clamp(0.0, 1.0);
+        self.w[j] = (self.w[j] * self.u[j] as f64 + reward) / (self.u[j] + 1) as f64;
         self.u[j] += 1;
         self.tau += self.knobs.delta_tau;
         self.top_source = self.top_source_probability();
     }
 
-    /// Scores: W of each source (the learner's is not a source's).
+    /// Scores: W of each source, in [0, 1] (the learner's is not a source's).
     fn view(&self) -> SelectorView {
         let n = self.w.len() - 1;
         SelectorView {
@@ -253,6 +265,8 @@ mod tests {
 
     use super::*;
 
+    const UNIT: (f64, f64) = (0.0, 1.0);
+
     fn end(discounted_return: f64) -> EpisodeEnd {
         EpisodeEnd {
             episode_return: 0.0,
@@ -267,7 +281,7 @@ mod tests {
             upsilon: 0.5,
             ..PrqlKnobs::default()
         };
-        let mut prql = Prql::new(2, &knobs);
+        let mut prql = Prql::new(2, &knobs, UNIT);
         let mut rng = StdRng::seed_from_u64(1);
         prql.current = Some(Pick::Source(1));
         prql.psi = 0.8;
@@ -283,19 +297,24 @@ mod tests {
 
     #[test]
     fn w_is_the_running_mean_of_discounted_returns_and_tau_grows() {
-        let mut prql = Prql::new(2, &PrqlKnobs::default());
+        let mut prql = Prql::new(2, &PrqlKnobs::default(), (-8.0, 8.0));
+        // Discounted returns in [−8, 8]: 3 and 6 scale to 11/16 and 14/16, −1 to 7/16, and
+        // 30 (beyond the range) to 1.
         for r in [3.0, 6.0] {
             prql.current = Some(Pick::Source(0));
             prql.on_episode_end(&end(r));
         }
         prql.current = Some(Pick::Learner);
         prql.on_episode_end(&end(-1.0));
-        assert_eq!(prql.w, [-1.0, 4.5, 0.0]);
-        assert_eq!(prql.u, [1, 2, 0]);
-        assert!((prql.tau - 0.15).abs() < 1e-15);
+        assert_eq!(prql.w, [7.0 / 16.0, 12.5 / 16.0, 0.0]);
+        prql.current = Some(Pick::Source(1));
+        prql.on_episode_end(&end(30.0));
+        assert_eq!(prql.w[2], 1.0);
+        assert_eq!(prql.u, [1, 2, 1]);
+        assert!((prql.tau - 0.2).abs() < 1e-15);
         // τ₀ = 0: the first choice is uniform over the learner and the sources.
         assert_eq!(
-            Prql::new(3, &PrqlKnobs::default()).probabilities(),
+            Prql::new(3, &PrqlKnobs::default(), UNIT).probabilities(),
             [0.25; 4]
         );
     }
@@ -307,7 +326,7 @@ mod tests {
             upsilon: 1.0,
             ..PrqlKnobs::default()
         };
-        let mut prql = Prql::new(1, &knobs);
+        let mut prql = Prql::new(1, &knobs, UNIT);
         let mut rng = StdRng::seed_from_u64(3);
         prql.current = Some(Pick::Source(0));
         assert!((0..100).all(|_| prql.act(&mut rng) == Actor::SourceGreedy(0)));

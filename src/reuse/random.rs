@@ -1,5 +1,7 @@
 //! The chance baselines: a uniformly random source, drawn every step or once per episode.
-//! The acting source fine-tunes as in SAP-Net; only the choice differs.
+//! The acting source fine-tunes as in SAP-Net; only the choice differs. What a run hands
+//! over for testing is drawn uniformly too, at its first choice
+//! ([`crate::config::Tested::DrawnAtStart`]), so that nothing the run saw selects it.
 
 use rand::rngs::StdRng;
 use rand::Rng;
@@ -14,6 +16,8 @@ pub struct Random {
     /// The source of the episode in progress (per episode only).
     current: Option<usize>,
     acted: Vec<u64>,
+    /// The source handed over for testing, drawn before the first choice.
+    handover: Option<usize>,
 }
 
 impl Random {
@@ -33,6 +37,7 @@ impl Random {
             per_episode,
             current: None,
             acted: vec![0; n],
+            handover: None,
         }
     }
 }
@@ -43,6 +48,9 @@ impl Selector for Random {
     }
 
     fn act(&mut self, rng: &mut StdRng) -> Actor {
+        if self.handover.is_none() {
+            self.handover = Some(rng.random_range(0..self.n));
+        }
         let i = match self.current {
             Some(i) if self.per_episode => i,
             _ => rng.random_range(0..self.n),
@@ -72,10 +80,10 @@ impl Selector for Random {
         }
     }
 
-    /// The source that acted most.
+    /// The source drawn at the first choice (source 0 for a run that never chose, which
+    /// a run with a library always does after its warm-up).
     fn chosen(&self) -> Option<usize> {
-        let acted: Vec<f64> = self.acted.iter().map(|&n| n as f64).collect();
-        Some(super::argmax(&acted))
+        Some(self.handover.unwrap_or(0))
     }
 }
 
@@ -110,5 +118,27 @@ mod tests {
             per_episode.on_episode_end(&end);
         }
         assert!(picks.iter().any(|&p| p != picks[0]), "{picks:?}");
+    }
+
+    #[test]
+    fn the_tested_source_is_drawn_before_the_run_not_picked_by_it() {
+        // Over many seeds, the handed-over source is uniform however the acting goes; and
+        // it does not follow which source acted most.
+        let mut handed = [0u32; 4];
+        let mut differs_from_most_acted = 0;
+        for seed in 0..400 {
+            let mut rng = StdRng::seed_from_u64(seed);
+            let mut random = Random::per_step(4);
+            for _ in 0..30 {
+                random.act(&mut rng);
+            }
+            let chosen = random.chosen().unwrap();
+            handed[chosen] += 1;
+            let most = super::super::argmax(&random.view().scores);
+            differs_from_most_acted += u32::from(chosen != most);
+        }
+        // Binomial(400, 1/4) each: mean 100, sd 8.7.
+        assert!(handed.iter().all(|&n| (60..140).contains(&n)), "{handed:?}");
+        assert!(differs_from_most_acted > 200, "{differs_from_most_acted}");
     }
 }

@@ -7,7 +7,7 @@ use std::sync::mpsc::Receiver;
 use anyhow::{bail, Context, Result};
 
 use super::manifest::{self, LibraryTraining};
-use super::{library_dir, plan, policy_files, train_library, SourceTask, SOURCES_STREAM};
+use super::{library_dir, plan, policy_files, train_library, SourceTask};
 use crate::config::Config;
 use crate::policy_store;
 use crate::sapnet::PolicyDescription;
@@ -33,7 +33,7 @@ pub struct Evaluation {
 pub fn evaluate(config: &Config, library: &Path) -> Result<Vec<Evaluation>> {
     let sources = load_library(config, library)?;
     let episodes = config.protocol.test_episodes.max(1);
-    let seed = seeds::derive(config.seed, &[SOURCES_STREAM, u64::MAX]);
+    let seed = seeds::derive(config.seed, &[seeds::Part::Name("evaluate sources")]);
     sources
         .iter()
         .map(|source| {

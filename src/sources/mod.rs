@@ -27,7 +27,7 @@ pub use load::{ensure_library, evaluate, load_library, needs_training, Evaluatio
 pub use manifest::{LibraryTraining, Manifest, ManifestEntry};
 pub use train::train_library;
 
-/// Stream key of the source library's seeds, apart from the experiments' `[method, run]`.
+/// Stream key of the source library's plan ([`seeds::library_v1`]), which no experiment uses.
 pub(crate) const SOURCES_STREAM: u64 = u64::MAX;
 
 /// One source policy to train.
@@ -105,7 +105,7 @@ pub fn plan(config: &Config) -> Vec<SourcePlan> {
         .enumerate()
         .flat_map(|(t, task)| std::iter::repeat_n(t, task.count))
         .collect();
-    let mut rng = StdRng::seed_from_u64(seeds::derive(config.seed, &[SOURCES_STREAM]));
+    let mut rng = StdRng::seed_from_u64(seeds::library_v1(config.seed, &[SOURCES_STREAM]));
     (0..s.count)
         .map(|i| {
             let layers = rng.random_range(s.hidden_layers.0..=s.hidden_layers.1);
@@ -115,7 +115,7 @@ pub fn plan(config: &Config) -> Vec<SourcePlan> {
             SourcePlan {
                 name: format!("source-{i}"),
                 hidden,
-                seed: seeds::derive(config.seed, &[SOURCES_STREAM, i as u64]),
+                seed: seeds::library_v1(config.seed, &[SOURCES_STREAM, i as u64]),
                 task: task_of.get(i).copied().unwrap_or(0),
             }
         })

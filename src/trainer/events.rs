@@ -104,7 +104,7 @@ pub struct RunRecord<M = MethodId> {
     pub run: u32,
     pub method: M,
     /// The seed of this run's random streams, derived from the config's run seed, the
-    /// method's index and the run's index (`seeds::derive(seed, &[method, run])`).
+    /// method's label and the run's index ([`crate::seeds::run_seed`]).
     pub seed: u64,
     /// Training episodes completed (a step budget may cut a last, partial episode, which is
     /// not counted; `steps` counts its steps).

@@ -124,12 +124,13 @@ pub(super) struct Streams {
 
 impl Streams {
     pub fn new(seed: u64) -> Self {
+        use seeds::Part::Name;
         Self {
-            weights: seeds::derive(seed, &[0]),
-            agent: seeds::derive(seed, &[1]),
-            env: seeds::derive(seed, &[2]),
-            test_env: seeds::derive(seed, &[3]),
-            selection: seeds::derive(seed, &[4]),
+            weights: seeds::derive(seed, &[Name("weights")]),
+            agent: seeds::derive(seed, &[Name("agent")]),
+            env: seeds::derive(seed, &[Name("env")]),
+            test_env: seeds::derive(seed, &[Name("test env")]),
+            selection: seeds::derive(seed, &[Name("selection")]),
         }
     }
 }
@@ -232,6 +233,7 @@ pub fn selector(spec: &RunSpec) -> Result<Box<dyn reuse::Selector>, TrainerError
         descriptions: &descriptions,
         scores: &scores,
         return_range: spec.env.return_range(),
+        discounted_return_range: spec.env.discounted_return_range(spec.dqn.gamma),
     };
     Ok(reuse::build(&spec.reuse, library, &spec.sapnet)?)
 }
@@ -569,5 +571,32 @@ mod tests {
         assert_eq!(tally.this_episode, vec![0, 0, 0]);
         // An episode spent in the warm-up selected nobody.
         assert_eq!(tally.end_episode(), None);
+    }
+
+    /// Every stream of every run of a protocol, and of a sweep over its `seed`, is its own:
+    /// no run's seed or stream equals another's (the derivation before 2026-12 gave
+    /// `seed 1, method 0` the streams of `seed 0, method 1`).
+    #[test]
+    fn every_stream_of_a_sweep_over_seeds_is_distinct() {
+        let mut config = crate::config::Config::from_ron(
+            include_str!("../../assets/reuse_cartpole.ron"),
+            "reuse_cartpole.ron",
+        )
+        .unwrap();
+        config.protocol.runs = 20;
+        let mut seen = std::collections::HashSet::new();
+        let mut count = 0;
+        for seed in 0..10 {
+            config.seed = seed;
+            for spec in crate::experiment::run_specs(&config, None) {
+                let s = Streams::new(spec.seed);
+                for stream in [spec.seed, s.weights, s.agent, s.env, s.test_env, s.selection] {
+                    seen.insert(stream);
+                    count += 1;
+                }
+            }
+        }
+        assert_eq!(count, 10 * 20 * 11 * 6);
+        assert_eq!(seen.len(), count);
     }
 }
