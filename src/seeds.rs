@@ -82,15 +82,24 @@ mod tests {
     #[test]
     fn derivation_is_stable_and_separates_streams() {
         use Part::{Index, Name};
-        assert_eq!(derive(7, &[Index(1), Index(2)]), derive(7, &[Index(1), Index(2)]));
-        assert_ne!(derive(7, &[Index(1), Index(2)]), derive(7, &[Index(2), Index(1)]));
+        assert_eq!(
+            derive(7, &[Index(1), Index(2)]),
+            derive(7, &[Index(1), Index(2)])
+        );
+        assert_ne!(
+            derive(7, &[Index(1), Index(2)]),
+            derive(7, &[Index(2), Index(1)])
+        );
         assert_ne!(derive(7, &[Index(0)]), derive(8, &[Index(0)]));
         assert_ne!(derive(7, &[]), derive(7, &[Index(0)]));
         // The old derivation's flaw: base and part swapped gave the same stream.
         assert_eq!(library_v1(3, &[5]), library_v1(5, &[3]));
         assert_ne!(derive(3, &[Index(5)]), derive(5, &[Index(3)]));
         // Names are length-prefixed and kind-tagged: no two spellings of one path.
-        assert_ne!(derive(0, &[Name("ab"), Name("c")]), derive(0, &[Name("a"), Name("bc")]));
+        assert_ne!(
+            derive(0, &[Name("ab"), Name("c")]),
+            derive(0, &[Name("a"), Name("bc")])
+        );
         assert_ne!(derive(0, &[Name("")]), derive(0, &[Index(0)]));
     }
 

@@ -248,11 +248,14 @@ fn trace_csv_holds_every_spread_call_and_adds_up_to_the_activations() {
     let tmp = tempfile::tempdir().unwrap();
     let library = tmp.path().join("lib");
     train_library(&library);
-    // SAP-Net alone, long enough for positive transitions (12 episodes have none).
+    // SAP-Net alone, long enough for positive transitions (12 episodes have none), on the
+    // complete graph: the library's lone two-layer source, which may lock in, has
+    // neighbours to spread to there.
     let text = std::fs::read_to_string(config("tiny_transfer.ron"))
         .unwrap()
         .replace("episodes: 12,", "episodes: 80,")
         .replace("runs: 2,", "runs: 1,")
+        .replace("seed: 5,", "sapnet: (base_graph: Complete),\n    seed: 5,")
         .replace("methods: [SapNet, Dqn(hidden: [8])]", "methods: [SapNet]");
     let longer = tmp.path().join("longer.ron");
     std::fs::write(&longer, text).unwrap();

@@ -106,9 +106,13 @@ fn the_warm_up_acts_in_turn_then_sap_net_selects_learns_and_activates() {
         // One update per step (update_interval 1), judged by its T_a (eq. 7).
         let update = step.update.expect("an update every step");
         assert_eq!(step.judgment, Some(update.transition() <= 0.0));
-        // A positive judgment deposited 𝒜 = 1 on the acting policy, at least (eq. 8).
+        // A positive judgment deposited 𝒜 = 1 on the acting policy, at least (eq. 8), up to
+        // the rounding of A_after − A_before (activations reach thousands: ulp ~1e-13).
         match step.deposit {
-            Some(deposit) => assert!(step.judgment == Some(true) && deposit.own >= 1.0),
+            Some(deposit) => assert!(
+                step.judgment == Some(true) && deposit.own >= 1.0 - 1e-9,
+                "{step:?}"
+            ),
             None => assert_eq!(step.judgment, Some(false)),
         }
     }

@@ -147,7 +147,8 @@ fn sigterm_leaves_the_dashboard_with_the_terminal_restored() {
         .status()
         .expect("running pkill");
     assert!(killed.success(), "no dashboard process found");
-    let screen = session.wait_for(&["SAPNET-EXITED 143"]);
+    // stty prints a moment after the exit line: wait for both.
+    let screen = session.wait_for(&["SAPNET-EXITED 143", "icanon"]);
     assert!(
         !screen.contains("SAP-Net graph"),
         "the alternate screen was left:\n{screen}"

@@ -590,7 +590,14 @@ mod tests {
             config.seed = seed;
             for spec in crate::experiment::run_specs(&config, None) {
                 let s = Streams::new(spec.seed);
-                for stream in [spec.seed, s.weights, s.agent, s.env, s.test_env, s.selection] {
+                for stream in [
+                    spec.seed,
+                    s.weights,
+                    s.agent,
+                    s.env,
+                    s.test_env,
+                    s.selection,
+                ] {
                     seen.insert(stream);
                     count += 1;
                 }
