@@ -15,6 +15,7 @@ use crate::teach::config::TeachConfig;
 use crate::trainer::{RunSpec, StreamOptions};
 use crate::tui::{self, teach::Teach};
 use crate::{assets, env, random_episodes, trainer};
+use crate::{report, results};
 
 pub fn run(cli: Cli) -> Result<()> {
     if let Some(command) = &cli.command {
@@ -26,7 +27,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Sources(args)) => run_sources(&cli, args),
         Some(Command::Sweep(args)) => run_sweep(&cli, &args.command),
         Some(Command::Plot(args)) => {
-            headless::replot(&args.dir)?;
+            results::replot(&args.dir)?;
             eprintln!(
                 "plots in {}: learning_curve.png, learning_curve.svg, tests.png, activations.png, selections.png",
                 args.dir.display()
@@ -225,7 +226,7 @@ fn run_options(cli: &Cli) -> RunOptions {
 
 /// What a headless protocol did: where its files are, each run on stderr, the comparison
 /// on stdout.
-fn report(summary: &headless::Summary, dir: &Path) -> Result<()> {
+fn report(summary: &results::Summary, dir: &Path) -> Result<()> {
     let config = &summary.config;
     let dir = dir.display();
     if summary.stopped() {
@@ -262,7 +263,7 @@ fn report(summary: &headless::Summary, dir: &Path) -> Result<()> {
     }
     if !summary.comparison.is_empty() {
         let mut out = std::io::stdout().lock();
-        write!(out, "{}", headless::comparison::table(&summary.comparison))
+        write!(out, "{}", report::comparison::table(&summary.comparison))
             .and_then(|()| out.flush())
             .context("writing to stdout")?;
     }
@@ -273,7 +274,7 @@ fn report(summary: &headless::Summary, dir: &Path) -> Result<()> {
 /// refused when that protocol trained on another task than `task`, the dashboard's (its
 /// returns would be drawn on the wrong scale).
 fn reference_bands(dir: &Path, task: &str) -> Result<Vec<tui::reference::Band>> {
-    let data = headless::read_plot_data(dir).with_context(|| {
+    let data = results::read_plot_data(dir).with_context(|| {
         format!(
             "--compare {}: expected the output folder of a `sapnet --headless` run",
             dir.display()

@@ -8,7 +8,10 @@
 //!   to the bit.
 //! - [`dqn`]: the DQN on candle; [`policy_store`]: policies on disk.
 //! - [`trainer`]: training runs on their own thread, reporting through events;
-//!   [`headless`]: the scripted front end over those events.
+//!   [`experiment`]: planning and scheduling a protocol's runs.
+//! - [`stats`]: interval estimates over runs' scores; [`report`]: the methods side by side
+//!   and the plots; [`results`]: a results directory on disk. Below both front ends.
+//! - [`headless`]: the scripted front end over the trainer's events.
 //! - [`teach`]: stepping activation and spreading by hand on a small graph.
 //! - [`tui`]: the terminal dashboard over the trainer's events, and interactive teach mode.
 //! - [`config`]: the RON run configuration, with the paper's values as defaults.
@@ -22,7 +25,10 @@ pub mod env;
 pub mod experiment;
 pub mod headless;
 pub mod policy_store;
+pub mod progress;
 pub mod random_episodes;
+pub mod report;
+pub mod results;
 pub mod reuse;
 pub mod sapnet;
 pub mod seeds;

@@ -3,8 +3,8 @@
 //!
 //! Runs are spread over `jobs` threads (one per core by default). Each run writes its own
 //! record as it trains and renames it into `runs/<method>-run<r>/` when it ends
-//! ([`records`]); the files below are put together from those records in a fixed order
-//! when the protocol ends, is stopped, or is found killed ([`assemble`]):
+//! ([`results::records`]); the files below are put together from those records in a fixed order
+//! when the protocol ends, is stopped, or is found killed ([`results::assemble`]):
 //! - `episodes.csv`: one row per training episode (`run, method, episode, reward, steps,
 //!   loss, statistic_loss, epsilon, policy, wall_s`; `policy` names the source that
 //!   acted most in the episode, for methods that reuse the library);
@@ -12,7 +12,7 @@
 //! - `activations.csv`: per episode of every run that reuses the library, each source's
 //!   score (SAP-Net: its activation), probability of being picked and steps acted;
 //! - `trace.csv` (with `--trace`): every `spread` call of SAP-Net's activations;
-//! - `comparison.csv`: one row per method, the measures of [`comparison`];
+//! - `comparison.csv`: one row per method, the measures of [`crate::report::comparison`];
 //! - `summary.json`: the status (`running`, `complete`, `stopped`, `failed`,
 //!   `interrupted`), the runs not finished, the config, the source library, each run's
 //!   totals and test returns; written when the protocol starts and after every run;
@@ -31,17 +31,9 @@
 //! (Algorithm 3's last step); the sources beside it are never touched, and no policy
 //! already there is replaced.
 
-mod assemble;
-pub mod comparison;
 mod observer;
 mod output;
-mod plots;
-mod progress;
-mod records;
-mod replot;
-mod results;
 
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::Receiver;
 use std::time::Instant;
@@ -50,16 +42,13 @@ use anyhow::{bail, Context, Result};
 
 use crate::config::{Config, MethodKind};
 use crate::experiment::{self, LibraryCopies};
-use crate::trainer::{Command, MethodId};
+use crate::progress::{Progress, Unit};
+use crate::report::LibraryEntry;
+use crate::results::{self, assemble, records, Ending, Status, Summary};
+use crate::trainer::Command;
 
-use assemble::{assemble, Ending};
 use observer::ResultFiles;
 use output::prepare_output;
-pub use plots::{write_all as write_plots, Curve, PlotData};
-pub(crate) use progress::{Progress, Unit};
-pub use records::run_name;
-pub use replot::{read as read_plot_data, replot};
-pub use results::{LibraryEntry, RunSummary, Status, Summary};
 
 /// Where results go and whether old ones may be replaced.
 #[derive(Debug, Clone)]
@@ -131,7 +120,7 @@ pub fn resume(
     options: &RunOptions,
     commands: &Receiver<Command>,
 ) -> Result<Summary> {
-    let mut header = replot::read_header(dir)?;
+    let mut header = results::read_header(dir)?;
     if let Some(runs) = runs {
         let had = header.config.protocol.runs;
         if runs < had {
@@ -173,42 +162,20 @@ pub fn resume(
     )
 }
 
-/// A finished results directory, read back: its config, library, runs and each run's
-/// training returns (what the comparison is computed from).
-pub struct Results {
-    pub config: Config,
-    pub library: Option<Vec<results::LibraryEntry>>,
-    pub runs: Vec<RunSummary>,
-    pub rewards: BTreeMap<(MethodId, u32), Vec<f64>>,
-}
-
-/// Reads the results in `dir` from its summary and run records.
-pub fn read_results(dir: &Path) -> Result<Results> {
-    let header = replot::read_header(dir)?;
-    let folders = records::read(dir, &header.config)?;
-    let rewards = assemble::rewards(&folders)?;
-    Ok(Results {
-        config: header.config,
-        library: header.library,
-        runs: folders.into_iter().map(|f| f.summary).collect(),
-        rewards,
-    })
-}
-
 /// The protocol into `out`. `resumed` is `None` for a new protocol, else the library the
 /// protocol began with (which must be the one loaded now).
 fn protocol(
     config: &Config,
     out: &Path,
     options: &RunOptions,
-    resumed: Option<Option<&[results::LibraryEntry]>>,
+    resumed: Option<Option<&[LibraryEntry]>>,
     commands: &Receiver<Command>,
 ) -> Result<Summary> {
     let mut plan = experiment::plan(config, &options.library, options.jobs, commands)?;
-    let library: Option<Vec<results::LibraryEntry>> = plan.sources.as_ref().map(|sources| {
+    let library: Option<Vec<LibraryEntry>> = plan.sources.as_ref().map(|sources| {
         sources
             .iter()
-            .map(|s| results::LibraryEntry {
+            .map(|s| LibraryEntry {
                 name: s.name.clone(),
                 hidden: s.description.hidden.clone(),
                 task: s.description.source_task.clone(),

@@ -61,9 +61,9 @@ pub fn train_library(
         );
     }
 
-    let mut progress = crate::headless::Progress::new(
+    let mut progress = crate::progress::Progress::new(
         u64::from(config.sources.training_episodes) * todo.len() as u64,
-        crate::headless::Unit::Episodes,
+        crate::progress::Unit::Episodes,
     );
     for (source, spec) in todo {
         let Some(entry) = train_source(&dir, source, spec, &mut progress, stop)? else {
@@ -97,7 +97,7 @@ fn train_source(
     dir: &Path,
     source: &SourcePlan,
     spec: &RunSpec,
-    progress: &mut crate::headless::Progress,
+    progress: &mut crate::progress::Progress,
     stop: &Receiver<Command>,
 ) -> Result<Option<ManifestEntry>> {
     let mut training = SourceTraining {
@@ -249,7 +249,7 @@ fn resumable(
 
 /// Progress of one source's training, and its outcome.
 struct SourceTraining<'a> {
-    progress: &'a mut crate::headless::Progress,
+    progress: &'a mut crate::progress::Progress,
     outcome: Option<RunOutcome>,
 }
 

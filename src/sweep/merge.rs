@@ -1,7 +1,7 @@
 //! `sapnet sweep merge`: the finished cells as one report in `SWEEP/merged/`.
 //!
 //! - `comparison.csv`: per axis and value, the comparison of the methods (the measures of
-//!   [`crate::headless::comparison`]) over the runs of every cell with that value;
+//!   [`crate::report::comparison`]) over the runs of every cell with that value;
 //! - `episodes.csv`: every episode of every cell, long format, the cell and its axis values
 //!   as leading columns (ready for pandas or R);
 //! - `<axis>=<value>/learning_curve.png` (and `.svg`, `tests.png`): the learning curves
@@ -17,7 +17,8 @@ use anyhow::{Context, Result};
 use super::{cell_name, cell_results, Manifest};
 use crate::config::{Config, Method};
 use crate::experiment::method_ids;
-use crate::headless::{self, comparison, Curve, PlotData, Results, RunSummary};
+use crate::report::{self, comparison, Curve, PlotData, RunSummary};
+use crate::results::{self, Results};
 use crate::trainer::MethodId;
 
 /// What a merge found.
@@ -37,7 +38,7 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
     for cell in &manifest.cells {
         let dir = cell_results(sweep, cell.id);
         if dir.is_dir() {
-            let results = headless::read_results(&dir)
+            let results = results::read_results(&dir)
                 .with_context(|| format!("reading cell {}", cell_name(cell.id)))?;
             done.push((cell, results));
         } else {
@@ -130,7 +131,7 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
             }
             let dir = out.join(folder_name(axis, value));
             std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-            headless::write_plots(&dir, &plot_data(&pooled))
+            report::write_plots(&dir, &plot_data(&pooled))
                 .with_context(|| format!("drawing the plots in {}", dir.display()))?;
             tables.push((format!("{axis} = {value}"), comparison::table(&rows)));
         }

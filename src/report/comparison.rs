@@ -14,7 +14,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use serde::Serialize;
 
-use super::results::{moving_average, LibraryEntry, RunSummary};
+use super::runs::{moving_average, LibraryEntry, RunSummary};
 use crate::config::Config;
 use crate::trainer::MethodId;
 

@@ -10,9 +10,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 
-use super::results::{self, RunKey, RunSummary};
+use super::files;
+use super::summary::{self, RunKey};
 use crate::config::Config;
 use crate::experiment;
+use crate::report::RunSummary;
 use crate::trainer::{self, EpisodeRecord, MethodId, RunRecord, TraceRecord};
 
 /// The folder of all run records in a results directory.
@@ -48,9 +50,9 @@ fn partial_dir(out: &Path, name: &str) -> PathBuf {
 pub struct RunWriter {
     name: String,
     partial: PathBuf,
-    episodes: results::EpisodeWriter,
-    activations: Option<results::ActivationsWriter>,
-    trace: Option<results::TraceWriter>,
+    episodes: files::EpisodeWriter,
+    activations: Option<files::ActivationsWriter>,
+    trace: Option<files::TraceWriter>,
     /// The library's sources, by which episodes and traces name policies.
     names: Vec<String>,
     /// Training returns so far, for the run's moving averages.
@@ -72,7 +74,7 @@ impl RunWriter {
         std::fs::create_dir_all(&partial)
             .with_context(|| format!("creating {}", partial.display()))?;
         let activations = if method.kind.reuses() && !names.is_empty() {
-            Some(results::ActivationsWriter::create(
+            Some(files::ActivationsWriter::create(
                 &partial.join("activations.csv"),
                 names,
             )?)
@@ -81,7 +83,7 @@ impl RunWriter {
         };
         Ok(Self {
             name,
-            episodes: results::EpisodeWriter::create(&partial.join("episodes.csv"))?,
+            episodes: files::EpisodeWriter::create(&partial.join("episodes.csv"))?,
             activations,
             trace: None,
             names: names.to_vec(),
@@ -133,7 +135,7 @@ impl RunWriter {
     /// One positive activation's spread calls.
     pub fn trace(&mut self, record: &TraceRecord) -> Result<()> {
         if self.trace.is_none() {
-            self.trace = Some(results::TraceWriter::create(
+            self.trace = Some(files::TraceWriter::create(
                 &self.partial.join("trace.csv"),
                 &self.names,
             )?);
@@ -146,12 +148,12 @@ impl RunWriter {
 
     /// Writes the run's tests and summary and renames its folder into place.
     pub fn finish(mut self, out: &Path, summary: &RunSummary) -> Result<()> {
-        let mut tests = results::TestsWriter::create(&self.partial.join("tests.csv"))?;
+        let mut tests = files::TestsWriter::create(&self.partial.join("tests.csv"))?;
         tests.write(&summary.record)?;
         if let Some(trace) = &mut self.trace {
             trace.flush()?;
         }
-        results::write_json(&self.partial.join("run.json"), summary)?;
+        summary::write_json(&self.partial.join("run.json"), summary)?;
         let finished = finished_dir(out, &self.name);
         if finished.exists() {
             std::fs::remove_dir_all(&finished)

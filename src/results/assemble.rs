@@ -12,10 +12,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde::Deserialize;
 
+use super::files;
 use super::records::{self, RunFolder};
-use super::results::{self, LibraryEntry, Status, Summary};
-use super::{comparison, plots, replot};
+use super::replot;
+use super::summary::{self, Status, Summary};
 use crate::config::Config;
+use crate::report::{comparison, plots, LibraryEntry};
 use crate::trainer::MethodId;
 
 /// How the protocol ended, for `summary.json`.
@@ -42,21 +44,21 @@ pub fn assemble(
             .collect()
     };
     concatenate(&out.join("episodes.csv"), &parts("episodes.csv"), |p| {
-        results::EpisodeWriter::create(p).map(drop)
+        files::EpisodeWriter::create(p).map(drop)
     })?;
     concatenate(&out.join("tests.csv"), &parts("tests.csv"), |p| {
-        results::TestsWriter::create(p).map(drop)
+        files::TestsWriter::create(p).map(drop)
     })?;
     if let Some(library) = &library {
         let names: Vec<String> = library.iter().map(|e| e.name.clone()).collect();
         concatenate(
             &out.join("activations.csv"),
             &parts("activations.csv"),
-            |p| results::ActivationsWriter::create(p, &names).map(drop),
+            |p| files::ActivationsWriter::create(p, &names).map(drop),
         )?;
         if trace {
             concatenate(&out.join("trace.csv"), &parts("trace.csv"), |p| {
-                results::TraceWriter::create(p, &names).map(drop)
+                files::TraceWriter::create(p, &names).map(drop)
             })?;
         }
     }
@@ -76,7 +78,7 @@ pub fn assemble(
     );
     summary.library = library;
     comparison::write_csv(&out.join("comparison.csv"), &summary.comparison)?;
-    results::write_json(&out.join("summary.json"), &summary)?;
+    summary::write_json(&out.join("summary.json"), &summary)?;
     if !summary.runs.is_empty() {
         let data = replot::read(out)?;
         plots::write_all(out, &data)

@@ -11,9 +11,9 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 
-use super::plots::{self, Curve, PlotData, SelectionHistory};
-use super::results::{Status, SummaryHeader};
+use super::summary::{read_header, Status};
 use crate::config::MethodKind;
+use crate::report::plots::{self, Curve, PlotData, SelectionHistory};
 
 #[derive(Deserialize)]
 struct EpisodeRow {
@@ -153,14 +153,6 @@ fn by_run(rows: impl IntoIterator<Item = (String, u32, u32, f64)>) -> ByRun {
             (key, values.into_iter().map(|(_, v)| v).collect())
         })
         .collect()
-}
-
-/// What `summary.json` says of the protocol: its status, config and library.
-pub fn read_header(dir: &Path) -> Result<SummaryHeader> {
-    let path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("reading {} (is this a results directory?)", path.display()))?;
-    serde_json::from_str(&text).with_context(|| format!("reading {}", path.display()))
 }
 
 fn rows<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {

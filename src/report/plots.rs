@@ -10,7 +10,7 @@ use anyhow::{anyhow, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::results::moving_average;
+use super::runs::moving_average;
 
 /// DejaVu Sans (licence in `assets/fonts/`): plotters' `ab_glyph` backend needs a font and
 /// a headless machine may have none.
