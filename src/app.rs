@@ -27,12 +27,12 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Sources(args)) => run_sources(&cli, args),
         Some(Command::Sweep(args)) => run_sweep(&cli, &args.command),
         Some(Command::Plot(args)) => {
-            results::replot(&args.dir)?;
+            let summary = results::replot(&args.dir)?;
             eprintln!(
-                "plots in {}: learning_curve.png, learning_curve.svg, tests.png, activations.png, selections.png",
+                "{} made again: comparison.csv, improvement.csv, scores.csv, intervals.png, profiles.png, improvement.png, learning_curve.png, tests.png, activations.png, selections.png",
                 args.dir.display()
             );
-            Ok(())
+            print_comparison(&summary)
         }
         None => run_experiment(&cli),
     }
@@ -232,7 +232,7 @@ fn report(summary: &results::Summary, dir: &Path) -> Result<()> {
     if summary.stopped() {
         eprintln!("stopped by the user: what was done so far is in {dir} (episodes.csv, tests.csv, summary.json, plots); `sapnet --headless --resume --out {dir}` finishes it");
     } else {
-        eprintln!("results in {dir}: episodes.csv, tests.csv, activations.csv, comparison.csv, summary.json, runs/, policies/, learning_curve.png, learning_curve.svg, tests.png, activations.png, selections.png");
+        eprintln!("results in {dir}: episodes.csv, tests.csv, activations.csv, comparison.csv, improvement.csv, scores.csv, summary.json, runs/, policies/, intervals.png, profiles.png, improvement.png, learning_curve.png, tests.png, activations.png, selections.png (the plots also as .svg)");
     }
     for run in &summary.runs {
         let tests: Vec<String> = run
@@ -261,13 +261,19 @@ fn report(summary: &results::Summary, dir: &Path) -> Result<()> {
             eprintln!("  added to the policy library as {}", copy.display());
         }
     }
-    if !summary.comparison.is_empty() {
-        let mut out = std::io::stdout().lock();
-        write!(out, "{}", report::comparison::table(&summary.comparison))
-            .and_then(|()| out.flush())
-            .context("writing to stdout")?;
+    print_comparison(summary)
+}
+
+/// The comparison table of a protocol, on stdout.
+fn print_comparison(summary: &results::Summary) -> Result<()> {
+    if summary.comparison.is_empty() {
+        return Ok(());
     }
-    Ok(())
+    let mut out = std::io::stdout().lock();
+    let table = report::comparison::table(&summary.comparison, report::Units::Returns);
+    write!(out, "{table}")
+        .and_then(|()| out.flush())
+        .context("writing to stdout")
 }
 
 /// The bands of a finished protocol's methods (`--compare DIR`), from its episodes.csv;

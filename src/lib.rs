@@ -34,6 +34,7 @@ pub mod sapnet;
 pub mod seeds;
 pub mod signals;
 pub mod sources;
+pub mod stats;
 pub mod sweep;
 pub mod teach;
 pub mod trainer;

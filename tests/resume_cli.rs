@@ -93,6 +93,8 @@ fn numbers(out: &Path) -> Vec<(String, String)> {
         "tests.csv",
         "activations.csv",
         "comparison.csv",
+        "improvement.csv",
+        "scores.csv",
     ]
     .iter()
     .map(|name| {

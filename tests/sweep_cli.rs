@@ -270,3 +270,72 @@ fn prepare_readies_a_library_once_for_every_seed() {
     let said = stderr(&prepared);
     assert_eq!(said.matches(" ready").count(), 1, "{said}");
 }
+
+/// A sweep over tasks: each task's rows in its returns, and the rows of axis `*` pooling
+/// every cell, normalised and stratified by task.
+#[test]
+fn a_sweep_over_tasks_is_pooled_with_normalised_scores() {
+    let tmp = tempfile::tempdir().unwrap();
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/configs/tiny_transfer.ron");
+    // Both tasks reuse one library trained on the default CartPole.
+    let text = std::fs::read_to_string(base).unwrap().replace(
+        "training_episodes: 3)",
+        "training_episodes: 3, env: Some(CartPole()))",
+    );
+    assert!(text.contains("env: Some(CartPole())"), "{text}");
+    std::fs::write(tmp.path().join("base.ron"), text).unwrap();
+    let grid = tmp.path().join("grid.ron");
+    std::fs::write(
+        &grid,
+        "(base: \"base.ron\", axes: [(path: \"env\", values: [CartPole(), \
+         CartPole(length: 1.0)])])",
+    )
+    .unwrap();
+    let (library, s) = (tmp.path().join("lib"), tmp.path().join("s"));
+    ok(plan(&grid, &s, &library));
+    ok(sweep(&["prepare"], &s));
+    ok(sweep(&["run", "--all", "--jobs", "2"], &s));
+    let merged = ok(sweep(&["merge"], &s));
+    let table = String::from_utf8_lossy(&merged.stdout).into_owned();
+    assert!(table.contains("* = every cell"), "{table}");
+    assert!(table.contains("normalised to [0, 1]"), "{table}");
+    let comparison = std::fs::read_to_string(s.join("merged/comparison.csv")).unwrap();
+    let header: Vec<&str> = comparison.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = comparison
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    // Two env values and the pooled rows, SAP-Net and DQN each.
+    assert_eq!(rows.len(), 3 * 2, "{comparison}");
+    for row in &rows {
+        let pooled = row[col("axis")] == "*";
+        let units = row[col("units")];
+        assert_eq!(
+            units,
+            if pooled { "normalised" } else { "return" },
+            "{row:?}"
+        );
+        let iqm: f64 = row[col("test_iqm")].parse().unwrap();
+        if pooled {
+            // Both tasks' runs, on [0, 1]; no thresholds (each task has its own).
+            assert_eq!(row[col("runs")], "4");
+            assert!((0.0..=1.0).contains(&iqm), "{row:?}");
+            assert_eq!(row[col("episodes_to_195")], "");
+        }
+    }
+    let improvement = std::fs::read_to_string(s.join("merged/improvement.csv")).unwrap();
+    assert!(
+        improvement.starts_with("axis,value,score,method,over,p,lo,hi\n"),
+        "{improvement}"
+    );
+    assert!(
+        improvement.contains("\n*,every cell,test,sapnet,dqn[8],"),
+        "{improvement}"
+    );
+    // The pooled folder's report, and each task's curves apart.
+    let pooled = s.join("merged/across-tasks");
+    assert!(pooled.join("intervals.png").exists());
+    assert!(pooled.join("task=cartpole/learning_curve.png").exists());
+}

@@ -182,16 +182,19 @@ fn a_missing_library_is_trained_then_every_result_is_written() {
         assert!(out.join(plot).metadata().unwrap().len() > 1000, "{plot}");
     }
 
-    // `sapnet plot` draws the same plots again from the files alone.
+    // `sapnet plot` makes the same report and plots again from summary.json and the run
+    // records alone.
     let again = tmp.path().join("again");
     std::fs::create_dir(&again).unwrap();
-    for file in [
-        "summary.json",
-        "episodes.csv",
-        "tests.csv",
-        "activations.csv",
-    ] {
-        std::fs::copy(out.join(file), again.join(file)).unwrap();
+    std::fs::copy(out.join("summary.json"), again.join("summary.json")).unwrap();
+    for run in std::fs::read_dir(out.join("runs")).unwrap() {
+        let run = run.unwrap().path();
+        let to = again.join("runs").join(run.file_name().unwrap());
+        std::fs::create_dir_all(&to).unwrap();
+        for file in std::fs::read_dir(&run).unwrap() {
+            let file = file.unwrap().path();
+            std::fs::copy(&file, to.join(file.file_name().unwrap())).unwrap();
+        }
     }
     let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
         .arg("plot")
@@ -199,10 +202,16 @@ fn a_missing_library_is_trained_then_every_result_is_written() {
         .output()
         .unwrap();
     assert!(output.status.success(), "{}", stderr(&output));
-    for plot in plots {
+    for file in plots.iter().chain(&[
+        "comparison.csv",
+        "improvement.csv",
+        "scores.csv",
+        "intervals.png",
+        "episodes.csv",
+    ]) {
         assert!(
-            std::fs::read(again.join(plot)).unwrap() == std::fs::read(out.join(plot)).unwrap(),
-            "{plot} differs when drawn again"
+            std::fs::read(again.join(file)).unwrap() == std::fs::read(out.join(file)).unwrap(),
+            "{file} differs when made again"
         );
     }
 }
@@ -491,8 +500,99 @@ fn every_method_runs_and_the_comparison_has_a_row_for_each() {
         assert!(row.starts_with(&format!("{method},2,")), "{row}");
     }
     assert!(comparison.starts_with(
-        "method,runs,episodes_to_15,reached_15,episodes_to_500,reached_500,mean_return,"
+        "method,runs,tested,episodes_to_15,episodes_to_15_lo,episodes_to_15_hi,reached_15,\
+         reached_15_share,reached_15_share_lo,reached_15_share_hi,episodes_to_500,"
     ));
+    // The columns a script looks for, each once, beside the ones kept from before.
+    let header: Vec<&str> = comparison.lines().next().unwrap().split(',').collect();
+    for column in [
+        "test_iqm",
+        "test_iqm_lo",
+        "test_iqm_hi",
+        "test_mean",
+        "test_mean_lo",
+        "test_mean_hi",
+        "return_iqm",
+        "return_iqm_lo",
+        "return_iqm_hi",
+        "return_mean_lo",
+        "return_mean_hi",
+        "test_median",
+        "test_optimality_gap",
+        "units",
+        "mean_return",
+        "test_std",
+        "ranks",
+        "lock_in_median_step",
+    ] {
+        assert_eq!(
+            header.iter().filter(|h| **h == column).count(),
+            1,
+            "{column}"
+        );
+    }
+    // Every row's interval holds its point.
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    for row in &rows {
+        let cells: Vec<&str> = row.split(',').collect();
+        let v = |name: &str| cells[col(name)].parse::<f64>().unwrap();
+        assert!(
+            v("test_iqm_lo") <= v("test_iqm") && v("test_iqm") <= v("test_iqm_hi"),
+            "{row}"
+        );
+        assert!(v("return_mean_lo") <= v("mean_return") && v("mean_return") <= v("return_mean_hi"));
+        assert_eq!(&cells[col("units")], &"return");
+    }
+    // The tested rule of each method, by name.
+    let tested = |method: &str| {
+        rows.iter()
+            .find(|r| r.starts_with(&format!("{method},")))
+            .unwrap()
+            .split(',')
+            .nth(2)
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(tested("sapnet"), "highest-activation");
+    assert_eq!(tested("random"), "drawn-at-start");
+    assert_eq!(tested("ucb1"), "most-played");
+    assert_eq!(tested("prql[8]"), "learner");
+    assert_eq!(tested("best-source"), "best-recorded");
+    // P(X > Y) of every ordered pair, for both scores: 9 · 8 · 2 rows.
+    let improvement = std::fs::read_to_string(out.join("improvement.csv")).unwrap();
+    let mut lines = improvement.lines();
+    assert_eq!(lines.next(), Some("score,method,over,p,lo,hi"));
+    let pairs: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(pairs.len(), 9 * 8 * 2, "{improvement}");
+    for pair in &pairs {
+        let (p, lo, hi) = (
+            pair[3].parse::<f64>().unwrap(),
+            pair[4].parse::<f64>().unwrap(),
+            pair[5].parse::<f64>().unwrap(),
+        );
+        assert!(
+            (0.0..=1.0).contains(&lo) && lo <= p && p <= hi && hi <= 1.0,
+            "{pair:?}"
+        );
+        // P(X > Y) + P(Y > X) = 1: ties count half both ways.
+        let back = pairs
+            .iter()
+            .find(|q| q[0] == pair[0] && q[1] == pair[2] && q[2] == pair[1])
+            .unwrap();
+        assert!(
+            (p + back[3].parse::<f64>().unwrap() - 1.0).abs() < 1e-12,
+            "{pair:?}"
+        );
+    }
+    // One row per run in scores.csv; the three interval plots, PNG and SVG.
+    let scores = std::fs::read_to_string(out.join("scores.csv")).unwrap();
+    assert_eq!(scores.lines().count(), 1 + 9 * 2, "{scores}");
+    for plot in ["intervals", "profiles", "improvement"] {
+        for ext in ["png", "svg"] {
+            let bytes = std::fs::read(out.join(format!("{plot}.{ext}"))).unwrap();
+            assert!(bytes.len() > 1000, "{plot}.{ext}");
+        }
+    }
     // The table on stdout names every method.
     let table = String::from_utf8_lossy(&output.stdout);
     assert!(methods.iter().all(|m| table.contains(m)), "{table}");

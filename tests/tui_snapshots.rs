@@ -343,7 +343,7 @@ fn the_zoomed_table_shows_each_policys_activation_over_time() {
     insta::assert_snapshot!("dashboard_zoomed_table_120x40", terminal.backend());
 }
 
-/// `--compare DIR`: a finished protocol's mean ± sd under the live curves of the same
+/// `--compare DIR`: a finished protocol's mean and its 95% interval under the live curves of the same
 /// methods, named in the legend.
 #[test]
 fn a_finished_protocol_is_drawn_as_bands_under_the_live_curves() {
@@ -364,7 +364,7 @@ fn a_finished_protocol_is_drawn_as_bands_under_the_live_curves() {
     ];
     let terminal = draw_dashboard(&d, (120, 40));
     let screen = format!("{}", terminal.backend());
-    assert!(screen.contains("sapnet ± sd, 3 runs"), "{screen}");
+    assert!(screen.contains("sapnet mean, 95% CI, 3 runs"), "{screen}");
     assert!(
         !screen.contains("ucb1"),
         "a method not on screen has no band: {screen}"

@@ -5,27 +5,19 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 
-use super::{records, OutputOptions};
+use super::OutputOptions;
+use crate::report;
+use crate::results::records;
 
 /// Entries that mark a directory as holding results already.
-const RESULT_FILES: [&str; 8] = [
+const RESULT_FILES: [&str; 7] = [
     "episodes.csv",
     "tests.csv",
     "activations.csv",
     "trace.csv",
-    "comparison.csv",
     "summary.json",
     "policies",
     records::RUNS,
-];
-
-/// Files a run draws, replaced with the results.
-const PLOT_FILES: [&str; 5] = [
-    "learning_curve.png",
-    "learning_curve.svg",
-    "tests.png",
-    "activations.png",
-    "selections.png",
 ];
 
 /// Where `--force` moves the results it replaces until the new ones are written.
@@ -46,6 +38,7 @@ pub(super) fn prepare_output(output: &OutputOptions) -> Result<Option<PathBuf>> 
         .with_context(|| format!("creating the output directory {}", dir.display()))?;
     let existing: Vec<&str> = RESULT_FILES
         .into_iter()
+        .chain(["comparison.csv"])
         .filter(|f| dir.join(f).exists())
         .collect();
     if existing.is_empty() {
@@ -73,7 +66,7 @@ pub(super) fn prepare_output(output: &OutputOptions) -> Result<Option<PathBuf>> 
         )
     })?;
     let mut moved = Vec::new();
-    for name in RESULT_FILES.iter().chain(PLOT_FILES.iter()) {
+    for name in RESULT_FILES.iter().chain(report::FILES.iter()) {
         let (from, to) = (dir.join(name), replaced.join(name));
         if !from.exists() {
             continue;

@@ -1,35 +1,40 @@
 //! The methods side by side: `comparison.csv` and the table printed at the end of a run.
 //!
-//! Per method, over its runs: episodes until the moving average of returns first reached
-//! each threshold (median over the runs that reached it, and how many did), the mean
-//! return over the whole run (the area under the learning curve per episode), the greedy
-//! test mean ± std over runs (of each run's mean); and for methods that reuse the library:
-//! each source's share of the acting steps, the library rank (1 = the best recorded score)
-//! of each run's chosen or most-used source, and when one source first held P > 0.99.
+//! Per method, over its runs ([`super::scores`]), each with a 95% stratified bootstrap
+//! interval ([`crate::stats`]): the greedy test score and the training return as mean,
+//! median, interquartile mean (IQM) and optimality gap; per threshold of the moving
+//! average, the share of runs that reached it (Wilson interval) and the median episode at
+//! which they did, runs that never did counted as beyond the end (censored). On one task
+//! the scores are in the task's returns; pooled over several tasks, normalised to [0, 1].
+//! For methods that reuse the library: each source's share of the acting steps, the
+//! library rank (1 = the best recorded score) of each run's chosen or most-used source,
+//! and when one source first held P > 0.99.
 
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::path::Path;
 
-use anyhow::{Context, Result};
 use serde::Serialize;
 
-use super::runs::{moving_average, LibraryEntry, RunSummary};
-use crate::config::Config;
-use crate::trainer::MethodId;
+use super::runs::LibraryEntry;
+use super::{MethodRuns, Units};
+use crate::config::MethodKind;
+use crate::seeds::{self, Part};
+use crate::stats::{aggregate, bootstrap, proportion, Estimate, Scores};
 
 /// One method's measures.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct MethodComparison {
     pub method: String,
+    pub kind: MethodKind,
     pub runs: usize,
-    /// Per threshold of the moving average: (threshold, median episode over the runs that
-    /// reached it, runs that reached it).
+    /// What its runs hand over to be tested ([`crate::config::Tested`]).
+    pub tested: &'static str,
+    /// Per threshold of the moving average (one task only: tasks have their own levels).
     pub thresholds: Vec<ThresholdReached>,
-    /// Mean training return per episode, mean over runs.
-    pub mean_return: Option<f64>,
-    /// Greedy test return: mean and standard deviation over the tested runs' means.
-    pub test_mean: Option<f64>,
+    /// The training return: mean over episodes, aggregated over runs.
+    pub training: Option<Aggregates>,
+    /// The greedy test score: mean over a run's test episodes, aggregated over runs.
+    pub test: Option<Aggregates>,
+    /// The sample standard deviation of the runs' test scores.
     pub test_std: Option<f64>,
     /// Share of the acting steps (after the warm-up) taken by each source, over all runs.
     pub source_shares: Vec<f64>,
@@ -47,122 +52,126 @@ pub struct MethodComparison {
     pub lock_in_measured: bool,
 }
 
+/// A score aggregated over runs, each with its 95% interval. The optimality gap is of the
+/// normalised scores (how far below the task's best return, on [0, 1]), whatever the units
+/// of the rest.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Aggregates {
+    pub mean: Estimate,
+    pub median: Estimate,
+    pub iqm: Estimate,
+    pub optimality_gap: Estimate,
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ThresholdReached {
     pub threshold: f64,
+    /// The median episode at which the moving average first reached the threshold, runs
+    /// that never did counted as beyond their last episode; `None` when half or more never
+    /// did. `lo` and `hi` bound it (`hi` is `None` when the interval reaches past the end).
     pub median_episode: Option<f64>,
+    pub median_lo: Option<f64>,
+    pub median_hi: Option<f64>,
+    /// Runs that reached it, and that share with its Wilson interval.
     pub reached: usize,
+    pub share: Estimate,
 }
 
-/// The measures of every method of `config`, from the finished runs and their returns.
-pub fn compare(
-    config: &Config,
-    library: &[LibraryEntry],
-    runs: &[RunSummary],
-    rewards: &BTreeMap<(MethodId, u32), Vec<f64>>,
-) -> Vec<MethodComparison> {
-    let thresholds = config.protocol.thresholds(&config.env);
-    let window = config.protocol.moving_average;
-    let ranks = library_ranks(library);
-    let tasks = library_tasks(library);
-    let mut out = Vec::new();
-    for method in crate::experiment::method_ids(config) {
-        let mine: Vec<&RunSummary> = runs.iter().filter(|r| r.record.method == method).collect();
-        if mine.is_empty() {
-            continue;
-        }
-        let curves: Vec<&Vec<f64>> = mine
-            .iter()
-            .filter_map(|r| rewards.get(&(method.clone(), r.record.run)))
-            .collect();
-        let thresholds = thresholds
-            .iter()
-            .map(|&threshold| {
-                let episodes: Vec<f64> = curves
-                    .iter()
-                    .filter_map(|returns| {
-                        moving_average(returns, window)
-                            .iter()
-                            .position(|&a| a >= threshold)
-                            .map(|i| (i + window) as f64)
-                    })
-                    .collect();
-                ThresholdReached {
-                    threshold,
-                    median_episode: median(&episodes),
-                    reached: episodes.len(),
-                }
-            })
-            .collect();
-        let run_means: Vec<f64> = curves
-            .iter()
-            .filter(|c| !c.is_empty())
-            .map(|c| c.iter().sum::<f64>() / c.len() as f64)
-            .collect();
-        let tests: Vec<f64> = mine.iter().filter_map(|r| r.mean_test_return).collect();
-        let steps: Vec<u64> = mine.iter().fold(Vec::new(), |mut total, r| {
-            total.resize(r.record.source_steps.len().max(total.len()), 0);
-            for (t, s) in total.iter_mut().zip(&r.record.source_steps) {
-                *t += s;
+/// The measures of every method.
+pub(super) fn compare(methods: &[MethodRuns], units: Units) -> Vec<MethodComparison> {
+    methods.iter().map(|m| measures(m, units)).collect()
+}
+
+fn measures(m: &MethodRuns, units: Units) -> MethodComparison {
+    let seed = |what: &str| {
+        seeds::derive(
+            0,
+            &[
+                Part::Name("bootstrap"),
+                Part::Name(&m.label),
+                Part::Name(what),
+            ],
+        )
+    };
+    let aggregates = |scores: &Option<(Scores, Scores)>, what: &str| {
+        scores.as_ref().map(|(shown, normalised)| {
+            let shown = match units {
+                Units::Returns => shown,
+                Units::Normalised => normalised,
+            };
+            Aggregates {
+                mean: bootstrap::interval(shown, aggregate::mean, seed(&format!("{what} mean"))),
+                median: bootstrap::interval(
+                    shown,
+                    aggregate::median,
+                    seed(&format!("{what} median")),
+                ),
+                iqm: bootstrap::interval(shown, aggregate::iqm, seed(&format!("{what} iqm"))),
+                optimality_gap: bootstrap::interval(
+                    normalised,
+                    aggregate::optimality_gap,
+                    seed(&format!("{what} gap")),
+                ),
             }
-            total
-        });
-        let all: u64 = steps.iter().sum();
-        let source_shares = if all == 0 {
-            Vec::new()
-        } else {
-            steps.iter().map(|&s| s as f64 / all as f64).collect()
-        };
-        let task_shares = if tasks.len() > 1 && !source_shares.is_empty() {
-            tasks
-                .iter()
-                .map(|task| {
-                    let share = library
-                        .iter()
-                        .zip(&source_shares)
-                        .filter(|(entry, _)| &entry.task == task)
-                        .map(|(_, s)| s)
-                        .sum::<f64>();
-                    (task.clone(), share)
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
-        let ranks = mine
-            .iter()
-            .filter_map(|r| {
-                let index = match &r.record.chosen {
-                    Some(chosen) => chosen.index,
-                    None => most_used(&r.record.source_steps)?,
-                };
-                ranks.get(index).copied()
-            })
-            .collect();
-        let locks: Vec<f64> = mine
-            .iter()
-            .filter_map(|r| r.record.lock_in_step.map(|s| s as f64))
-            .collect();
-        out.push(MethodComparison {
-            method: method.label().to_string(),
-            runs: mine.len(),
-            thresholds,
-            mean_return: mean(&run_means),
-            test_mean: mean(&tests),
-            test_std: std_dev(&tests),
-            source_shares,
-            task_shares,
-            ranks,
-            lock_in_median: median(&locks),
-            locked_runs: locks.len(),
-            lock_in_measured: method.kind.picks_by_probability(),
-        });
+        })
+    };
+    let thresholds = m
+        .reached
+        .iter()
+        .map(|(threshold, episodes)| {
+            reached(*threshold, episodes, seed(&format!("reached {threshold}")))
+        })
+        .collect();
+    let tests = m
+        .test
+        .as_ref()
+        .map(|(raw, _)| raw.pooled())
+        .unwrap_or_default();
+    MethodComparison {
+        method: m.label.clone(),
+        kind: m.kind,
+        runs: m.runs,
+        tested: m.kind.tested().name(),
+        thresholds,
+        training: aggregates(&m.training, "training"),
+        test: aggregates(&m.test, "test"),
+        test_std: std_dev(&tests),
+        source_shares: m.source_shares.clone(),
+        task_shares: m.task_shares.clone(),
+        ranks: m.ranks.clone(),
+        lock_in_median: median(&m.lock_in_steps),
+        locked_runs: m.lock_in_steps.len(),
+        lock_in_measured: m.kind.picks_by_probability(),
     }
-    out
+}
+
+/// The threshold's measures from each run's episode of reaching it (infinite: never).
+fn reached(threshold: f64, episodes: &[f64], seed: u64) -> ThresholdReached {
+    let hits = episodes.iter().filter(|e| e.is_finite()).count();
+    let finite = |x: f64| x.is_finite().then_some(x);
+    let (median_episode, median_lo, median_hi) = match Scores::one_task(episodes.to_vec()) {
+        Some(scores) => {
+            let e = bootstrap::interval(&scores, aggregate::median, seed);
+            (finite(e.point), finite(e.lo), finite(e.hi))
+        }
+        None => (None, None, None),
+    };
+    ThresholdReached {
+        threshold,
+        median_episode,
+        median_lo,
+        median_hi,
+        reached: hits,
+        share: proportion::wilson(hits, episodes.len()).unwrap_or(Estimate {
+            point: 0.0,
+            lo: 0.0,
+            hi: 1.0,
+        }),
+    }
 }
 
 /// The library's task labels, each once, in the order the sources list them.
-fn library_tasks(library: &[LibraryEntry]) -> Vec<String> {
+pub(super) fn library_tasks(library: &[LibraryEntry]) -> Vec<String> {
     let mut tasks: Vec<String> = Vec::new();
     for entry in library {
         if !tasks.contains(&entry.task) {
@@ -174,7 +183,7 @@ fn library_tasks(library: &[LibraryEntry]) -> Vec<String> {
 
 /// Rank of each source by recorded score, 1 for the best (ties share the better rank;
 /// unscored sources rank last).
-fn library_ranks(library: &[LibraryEntry]) -> Vec<usize> {
+pub(super) fn library_ranks(library: &[LibraryEntry]) -> Vec<usize> {
     let score = |e: &LibraryEntry| e.final_score.unwrap_or(f64::NEG_INFINITY);
     library
         .iter()
@@ -182,71 +191,64 @@ fn library_ranks(library: &[LibraryEntry]) -> Vec<usize> {
         .collect()
 }
 
-fn most_used(steps: &[u64]) -> Option<usize> {
+pub(super) fn most_used(steps: &[u64]) -> Option<usize> {
     let most = *steps.iter().max()?;
     (most > 0).then(|| steps.iter().position(|&s| s == most).unwrap_or(0))
 }
 
-fn mean(values: &[f64]) -> Option<f64> {
-    (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
-}
-
-/// The sample standard deviation (n − 1); 0 for one value.
+/// The sample standard deviation (n − 1); 0 for one value, `None` for none.
 fn std_dev(values: &[f64]) -> Option<f64> {
-    let m = mean(values)?;
+    if values.is_empty() {
+        return None;
+    }
     if values.len() < 2 {
         return Some(0.0);
     }
+    let m = aggregate::mean(values);
     let ss: f64 = values.iter().map(|v| (v - m).powi(2)).sum();
     Some((ss / (values.len() - 1) as f64).sqrt())
 }
 
 fn median(values: &[f64]) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    let mut sorted = values.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    let n = sorted.len();
-    Some(if n % 2 == 1 {
-        sorted[n / 2]
-    } else {
-        (sorted[n / 2 - 1] + sorted[n / 2]) / 2.0
-    })
+    (!values.is_empty()).then(|| aggregate::median(values))
 }
 
 fn cell(x: Option<f64>) -> String {
     x.map_or(String::new(), |v| format!("{v:?}"))
 }
 
-/// Writes `comparison.csv`: one row per method; the columns named by threshold and source.
-pub fn write_csv(path: &Path, rows: &[MethodComparison]) -> Result<()> {
-    let mut csv =
-        csv::Writer::from_path(path).with_context(|| format!("creating {}", path.display()))?;
-    let (header, records) = csv_records(rows);
-    csv.write_record(&header)
-        .with_context(|| format!("writing {}", path.display()))?;
-    for record in records {
-        csv.write_record(&record)
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
-    csv.flush()
-        .with_context(|| format!("writing {}", path.display()))
-}
-
-/// The header and the rows of `comparison.csv`.
-pub fn csv_records(rows: &[MethodComparison]) -> (Vec<String>, Vec<Vec<String>>) {
-    let mut header: Vec<String> = vec!["method".into(), "runs".into()];
+/// The header and the rows of `comparison.csv`. The columns a script looks for are named
+/// `<score>_<aggregate>[_lo|_hi]`: `test_iqm`, `test_iqm_lo`, `return_mean_hi`, … (`return`
+/// is the training return), `units` saying whether they are returns or normalised; per
+/// threshold `episodes_to_<t>` (the censored median) with `_lo`/`_hi`, `reached_<t>` (a
+/// count) and `reached_<t>_share` with `_lo`/`_hi`.
+pub fn csv_records(rows: &[MethodComparison], units: Units) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut header: Vec<String> = vec!["method".into(), "runs".into(), "tested".into()];
     if let Some(first) = rows.first() {
         for t in &first.thresholds {
-            header.push(format!("episodes_to_{}", t.threshold));
-            header.push(format!("reached_{}", t.threshold));
+            let t = t.threshold;
+            header.extend([
+                format!("episodes_to_{t}"),
+                format!("episodes_to_{t}_lo"),
+                format!("episodes_to_{t}_hi"),
+                format!("reached_{t}"),
+                format!("reached_{t}_share"),
+                format!("reached_{t}_share_lo"),
+                format!("reached_{t}_share_hi"),
+            ]);
+        }
+    }
+    header.push("units".into());
+    for score in ["return", "test"] {
+        for aggregate in ["mean", "median", "iqm", "optimality_gap"] {
+            for end in ["", "_lo", "_hi"] {
+                header.push(format!("{score}_{aggregate}{end}"));
+            }
         }
     }
     header.extend(
         [
             "mean_return",
-            "test_mean",
             "test_std",
             "ranks",
             "lock_in_median_step",
@@ -255,18 +257,31 @@ pub fn csv_records(rows: &[MethodComparison]) -> (Vec<String>, Vec<Vec<String>>)
         ]
         .map(String::from),
     );
-    let tasks: Vec<String> = rows
-        .iter()
-        .find(|r| !r.task_shares.is_empty())
-        .map(|r| r.task_shares.iter().map(|(t, _)| t.clone()).collect())
-        .unwrap_or_default();
+    let tasks = share_tasks(rows);
     header.extend(tasks.iter().map(|t| format!("share_{t}")));
     let mut records = Vec::new();
     for row in rows {
-        let mut record = vec![row.method.clone(), row.runs.to_string()];
+        let mut record = vec![row.method.clone(), row.runs.to_string(), row.tested.into()];
         for t in &row.thresholds {
-            record.push(cell(t.median_episode));
-            record.push(t.reached.to_string());
+            record.extend([
+                cell(t.median_episode),
+                cell(t.median_lo),
+                cell(t.median_hi),
+                t.reached.to_string(),
+                cell(Some(t.share.point)),
+                cell(Some(t.share.lo)),
+                cell(Some(t.share.hi)),
+            ]);
+        }
+        record.push(units.name().into());
+        for score in [&row.training, &row.test] {
+            for e in aggregates(score.as_ref()) {
+                record.extend([
+                    cell(e.map(|e| e.point)),
+                    cell(e.map(|e| e.lo)),
+                    cell(e.map(|e| e.hi)),
+                ]);
+            }
         }
         let ranks: Vec<String> = row.ranks.iter().map(ToString::to_string).collect();
         let shares: Vec<String> = row
@@ -275,8 +290,7 @@ pub fn csv_records(rows: &[MethodComparison]) -> (Vec<String>, Vec<Vec<String>>)
             .map(|s| format!("{s:.4}"))
             .collect();
         record.extend([
-            cell(row.mean_return),
-            cell(row.test_mean),
+            cell(row.training.map(|a| a.mean.point)),
             cell(row.test_std),
             ranks.join(" "),
             cell(row.lock_in_median),
@@ -292,20 +306,55 @@ pub fn csv_records(rows: &[MethodComparison]) -> (Vec<String>, Vec<Vec<String>>)
     (header, records)
 }
 
-/// The comparison as a plain-text table, for stdout.
-pub fn table(rows: &[MethodComparison]) -> String {
+fn aggregates(a: Option<&Aggregates>) -> [Option<Estimate>; 4] {
+    match a {
+        Some(a) => [
+            Some(a.mean),
+            Some(a.median),
+            Some(a.iqm),
+            Some(a.optimality_gap),
+        ],
+        None => [None; 4],
+    }
+}
+
+fn share_tasks(rows: &[MethodComparison]) -> Vec<String> {
+    rows.iter()
+        .find(|r| !r.task_shares.is_empty())
+        .map(|r| r.task_shares.iter().map(|(t, _)| t.clone()).collect())
+        .unwrap_or_default()
+}
+
+/// An interval as the table shows it: `123.4 [100.2, 140.0]`, with `digits` decimals.
+fn interval(e: &Estimate, digits: usize) -> String {
+    format!(
+        "{:.digits$} [{:.digits$}, {:.digits$}]",
+        e.point, e.lo, e.hi
+    )
+}
+
+/// The comparison as a plain-text table, for stdout: IQMs with their 95% intervals.
+pub fn table(rows: &[MethodComparison], units: Units) -> String {
+    let digits = match units {
+        Units::Returns => 1,
+        Units::Normalised => 3,
+    };
     let mut header = vec!["method".to_string(), "runs".to_string()];
     if let Some(first) = rows.first() {
         for t in &first.thresholds {
             header.push(format!("ep→{}", t.threshold));
         }
     }
-    header.extend(["mean return", "test mean ± std", "ranks", "lock-in step"].map(String::from));
-    let tasks: Vec<String> = rows
-        .iter()
-        .find(|r| !r.task_shares.is_empty())
-        .map(|r| r.task_shares.iter().map(|(t, _)| t.clone()).collect())
-        .unwrap_or_default();
+    header.extend(
+        [
+            "return IQM [95% CI]",
+            "test IQM [95% CI]",
+            "ranks",
+            "lock-in step",
+        ]
+        .map(String::from),
+    );
+    let tasks = share_tasks(rows);
     if !tasks.is_empty() {
         header.push("% steps by task".into());
     }
@@ -315,14 +364,12 @@ pub fn table(rows: &[MethodComparison]) -> String {
         for t in &row.thresholds {
             line.push(match t.median_episode {
                 Some(e) => format!("{e:.0} ({}/{})", t.reached, row.runs),
-                None => format!("- (0/{})", row.runs),
+                None => format!("- ({}/{})", t.reached, row.runs),
             });
         }
-        line.push(row.mean_return.map_or("-".into(), |m| format!("{m:.1}")));
-        line.push(match (row.test_mean, row.test_std) {
-            (Some(m), Some(s)) => format!("{m:.1} ± {s:.1}"),
-            _ => "-".into(),
-        });
+        for score in [&row.training, &row.test] {
+            line.push(score.map_or("-".into(), |a| interval(&a.iqm, digits)));
+        }
         let ranks: Vec<String> = row.ranks.iter().map(ToString::to_string).collect();
         line.push(if ranks.is_empty() {
             "-".into()
@@ -369,22 +416,18 @@ pub fn table(rows: &[MethodComparison]) -> String {
     if !tasks.is_empty() {
         let _ = writeln!(out, "% steps by task, in order: {}", tasks.join(", "));
     }
+    if units == Units::Normalised {
+        let _ = writeln!(
+            out,
+            "scores normalised to [0, 1] by each task's range of returns, pooled over tasks"
+        );
+    }
     out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn statistics_by_hand() {
-        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
-        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), Some(2.5));
-        assert_eq!(median(&[]), None);
-        // mean 2, squares 1 + 0 + 1 → variance 2/2 = 1.
-        assert_eq!(std_dev(&[1.0, 2.0, 3.0]), Some(1.0));
-        assert_eq!(std_dev(&[5.0]), Some(0.0));
-    }
 
     #[test]
     fn ranks_put_the_best_score_first_and_unscored_last() {
@@ -406,44 +449,27 @@ mod tests {
     }
 
     #[test]
-    fn steps_are_summed_per_source_task_in_the_librarys_order() {
-        let entry = |task: &str| LibraryEntry {
-            name: String::new(),
-            hidden: vec![4],
-            task: task.into(),
-            final_score: Some(1.0),
-        };
-        let library = [entry("long"), entry("mirrored"), entry("long")];
-        let config = Config::from_ron("(protocol: (methods: [Ucb1], runs: 1))", "t.ron").unwrap();
-        let method = crate::experiment::method_ids(&config)[0].clone();
-        let record = crate::trainer::RunRecord {
-            run: 0,
-            method: method.clone(),
-            seed: 0,
-            episodes: 1,
-            steps: 10,
-            updates: 0,
-            chosen: None,
-            // 2 + 6 steps on the long poles, 2 mirrored.
-            source_steps: vec![2, 2, 6],
-            lock_in_step: None,
-            test_returns: vec![],
-            stopped: false,
-            wall_s: 0.0,
-        };
-        let runs = [RunSummary::new(record, &[1.0], 1)];
-        let rewards = BTreeMap::from([((method, 0), vec![1.0])]);
-        let rows = compare(&config, &library, &runs, &rewards);
-        assert_eq!(
-            rows[0].task_shares,
-            [("long".to_string(), 0.8), ("mirrored".to_string(), 0.2)]
-        );
-        let table = table(&rows);
-        assert!(table.contains("% steps by task"), "{table}");
-        assert!(table.contains("80 20"), "{table}");
-        assert!(
-            table.ends_with("% steps by task, in order: long, mirrored\n"),
-            "{table}"
-        );
+    fn the_censored_median_counts_runs_that_never_reached_it_as_beyond_the_end() {
+        let never = f64::INFINITY;
+        // Reached at 100, 300, 200; two never: sorted 100, 200, 300, ∞, ∞ → 300.
+        let t = reached(195.0, &[100.0, never, 300.0, 200.0, never], 1);
+        assert_eq!(t.median_episode, Some(300.0));
+        assert_eq!(t.reached, 3);
+        assert_eq!(t.share.point, 0.6);
+        // Dropping the runs that never reached it would have said 200.
+        // Three of five never: the median is beyond the end.
+        let t = reached(195.0, &[100.0, never, never, 200.0, never], 1);
+        assert_eq!(t.median_episode, None);
+        assert_eq!(t.median_hi, None);
+        assert_eq!(t.reached, 2);
+    }
+
+    #[test]
+    fn statistics_by_hand() {
+        // mean 2, squares 1 + 0 + 1 → variance 2/2 = 1.
+        assert_eq!(std_dev(&[1.0, 2.0, 3.0]), Some(1.0));
+        assert_eq!(std_dev(&[5.0]), Some(0.0));
+        assert_eq!(std_dev(&[]), None);
+        assert_eq!(median(&[]), None);
     }
 }

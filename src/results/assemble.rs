@@ -17,7 +17,7 @@ use super::records::{self, RunFolder};
 use super::replot;
 use super::summary::{self, Status, Summary};
 use crate::config::Config;
-use crate::report::{comparison, plots, LibraryEntry};
+use crate::report::{plots, LibraryEntry, Report, TaskRuns};
 use crate::trainer::MethodId;
 
 /// How the protocol ended, for `summary.json`.
@@ -70,20 +70,25 @@ pub fn assemble(
     summary.wall_s = ending.wall_s;
     summary.unfinished = records::unfinished(config, &folders);
     summary.runs = folders.into_iter().map(|f| f.summary).collect();
-    summary.comparison = comparison::compare(
+    let library = library.unwrap_or_default();
+    let task = config.env.label();
+    let report = Report::of(&[TaskRuns {
+        task: &task,
         config,
-        library.as_deref().unwrap_or_default(),
-        &summary.runs,
-        &rewards,
-    );
-    summary.library = library;
-    comparison::write_csv(&out.join("comparison.csv"), &summary.comparison)?;
-    summary::write_json(&out.join("summary.json"), &summary)?;
+        library: &library,
+        runs: &summary.runs,
+        rewards: &rewards,
+    }]);
+    summary.comparison = report.comparison.clone();
+    summary.library = (!library.is_empty()).then_some(library);
+    // Everything the summary's status vouches for is on disk before it.
     if !summary.runs.is_empty() {
+        report.write(out)?;
         let data = replot::read(out)?;
         plots::write_all(out, &data)
             .with_context(|| format!("drawing the plots in {}", out.display()))?;
     }
+    summary::write_json(&out.join("summary.json"), &summary)?;
     Ok(summary)
 }
 

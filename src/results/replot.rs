@@ -1,9 +1,9 @@
-//! `sapnet plot DIR`: draws a results directory's plots again from its files —
-//! `summary.json` (the config: task, methods, moving-average window), `episodes.csv`,
-//! `tests.csv` and `activations.csv` — exactly as the run that wrote them drew them.
-//! For a run stopped before its plots, or plots of an older version. A directory whose
-//! protocol was killed (`summary.json` still says `running`) is first put together from
-//! its finished runs and marked `interrupted`.
+//! `sapnet plot DIR`: a results directory's report and plots made again from its files —
+//! `summary.json` (the config: task, methods, moving-average window) and the run records
+//! — exactly as the run that wrote them made them: for a run stopped before its plots, a
+//! folder of an older version, or one whose process was killed (`summary.json` still says
+//! `running`: its finished runs are put together and it is marked `interrupted`). Also
+//! the plots' data read back from the CSV files, for the dashboard's `--compare`.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -11,9 +11,9 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 
-use super::summary::{read_header, Status};
+use super::summary::{read_header, Status, Summary};
 use crate::config::MethodKind;
-use crate::report::plots::{self, Curve, PlotData, SelectionHistory};
+use crate::report::plots::{Curve, PlotData, SelectionHistory};
 
 #[derive(Deserialize)]
 struct EpisodeRow {
@@ -32,21 +32,29 @@ struct TestRow {
     test_return: f64,
 }
 
-/// Reads `dir`'s results and writes its plots (replacing those there).
-pub fn replot(dir: &Path) -> Result<()> {
+/// Puts `dir`'s files together again from its run records — the CSV files, the report
+/// (`comparison.csv`, `improvement.csv`, `scores.csv`), every plot and `summary.json` —
+/// replacing those there, and returns the summary. A protocol whose process was killed
+/// (`summary.json` still `running`) is marked `interrupted`.
+pub fn replot(dir: &Path) -> Result<Summary> {
     let header = read_header(dir)?;
+    let status = match header.status {
+        Some(Status::Running) => Status::Interrupted,
+        Some(status) => status,
+        None => Status::Complete,
+    };
+    let summary = super::assemble::assemble(
+        dir,
+        &header.config,
+        header.library,
+        header.trace,
+        super::assemble::Ending {
+            status,
+            error: header.error,
+            wall_s: header.wall_s,
+        },
+    )?;
     if header.status == Some(Status::Running) {
-        let summary = super::assemble::assemble(
-            dir,
-            &header.config,
-            header.library,
-            header.trace,
-            super::assemble::Ending {
-                status: Status::Interrupted,
-                error: None,
-                wall_s: 0.0,
-            },
-        )?;
         eprintln!(
             "{}: the protocol was interrupted; its {} finished runs are put together (`sapnet \
              --headless --resume --out {}` runs the other {})",
@@ -55,12 +63,8 @@ pub fn replot(dir: &Path) -> Result<()> {
             dir.display(),
             summary.unfinished.len()
         );
-        if !summary.runs.is_empty() {
-            return Ok(());
-        }
     }
-    let data = read(dir)?;
-    plots::write_all(dir, &data).with_context(|| format!("drawing the plots in {}", dir.display()))
+    Ok(summary)
 }
 
 /// The plots' data, from the files of a results directory.

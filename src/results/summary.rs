@@ -69,6 +69,10 @@ pub struct SummaryHeader {
     #[serde(default)]
     pub trace: bool,
     pub library: Option<Vec<LibraryEntry>>,
+    #[serde(default)]
+    pub wall_s: f64,
+    #[serde(default)]
+    pub error: Option<String>,
 }
 
 impl Summary {

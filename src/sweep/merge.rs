@@ -1,11 +1,17 @@
 //! `sapnet sweep merge`: the finished cells as one report in `SWEEP/merged/`.
 //!
 //! - `comparison.csv`: per axis and value, the comparison of the methods (the measures of
-//!   [`crate::report::comparison`]) over the runs of every cell with that value;
+//!   [`crate::report::comparison`], with their intervals) over the runs of every cell with
+//!   that value: in returns when the cells share one task, normalised and stratified by
+//!   task when they span several; and, for a sweep over tasks, the rows of axis `*`,
+//!   every cell pooled (its report in `across-tasks/`);
+//! - `improvement.csv`: the probability of improvement of every method over every other,
+//!   per axis value (`axis, value, score, method, over, p, lo, hi`);
 //! - `episodes.csv`: every episode of every cell, long format, the cell and its axis values
 //!   as leading columns (ready for pandas or R);
-//! - `<axis>=<value>/learning_curve.png` (and `.svg`, `tests.png`): the learning curves
-//!   of that value's runs, mean and band across runs (seeds).
+//! - `<axis>=<value>/`: that value's report (`comparison.csv`, `improvement.csv`,
+//!   `scores.csv`, the interval plots) and its learning curves (`learning_curve.png`,
+//!   `.svg`, `tests.png`; with several tasks, in `task=<task>/` each).
 //!
 //! Cells not done are named and left out.
 
@@ -17,7 +23,7 @@ use anyhow::{Context, Result};
 use super::{cell_name, cell_results, Manifest};
 use crate::config::{Config, Method};
 use crate::experiment::method_ids;
-use crate::report::{self, comparison, Curve, PlotData, RunSummary};
+use crate::report::{self, comparison, Curve, PlotData, Report, RunSummary, TaskRuns};
 use crate::results::{self, Results};
 use crate::trainer::MethodId;
 
@@ -91,12 +97,12 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
         .flush()
         .with_context(|| format!("writing {}", episodes.display()))?;
 
-    // The comparison per axis value, and its plots.
-    let comparison_path = out.join("comparison.csv");
-    let mut comparisons = csv::Writer::from_path(&comparison_path)
-        .with_context(|| format!("creating {}", comparison_path.display()))?;
-    let mut header_written = false;
+    // The comparison per axis value (pooled over its tasks when its cells have several),
+    // and over every cell when the sweep spans several tasks.
+    let mut comparisons = Table::default();
+    let mut improvements = Table::default();
     let mut tables = Vec::new();
+    let mut groups: Vec<(String, String, Vec<&Results>)> = Vec::new();
     for (a, axis) in axes.iter().enumerate() {
         let mut values: Vec<&String> = Vec::new();
         for (cell, _) in &done {
@@ -110,40 +116,160 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
                 .filter(|(cell, _)| &cell.axes[a].1 == value)
                 .map(|(_, r)| r)
                 .collect();
-            let pooled = pool(&group);
-            let rows = comparison::compare(
-                &pooled.config,
-                pooled.library.as_deref().unwrap_or_default(),
-                &pooled.runs,
-                &pooled.rewards,
-            );
-            let (header, records) = comparison::csv_records(&rows);
-            if !header_written {
-                let mut full = vec!["axis".to_string(), "value".to_string(), "cells".to_string()];
-                full.extend(header);
-                comparisons.write_record(&full)?;
-                header_written = true;
-            }
-            for record in records {
-                let mut full = vec![axis.clone(), value.clone(), group.len().to_string()];
-                full.extend(record);
-                comparisons.write_record(&full)?;
-            }
-            let dir = out.join(folder_name(axis, value));
-            std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-            report::write_plots(&dir, &plot_data(&pooled))
-                .with_context(|| format!("drawing the plots in {}", dir.display()))?;
-            tables.push((format!("{axis} = {value}"), comparison::table(&rows)));
+            groups.push((axis.clone(), value.clone(), group));
         }
     }
-    comparisons
-        .flush()
-        .with_context(|| format!("writing {}", comparison_path.display()))?;
+    let all: Vec<&Results> = done.iter().map(|(_, r)| r).collect();
+    if by_task(&all).len() > 1 {
+        groups.push((ACROSS_TASKS.into(), "every cell".into(), all));
+    }
+    for (axis, value, group) in &groups {
+        let strata: Vec<(String, Results)> = by_task(group)
+            .into_iter()
+            .map(|(task, cells)| (task, pool(&cells)))
+            .collect();
+        let tasks: Vec<TaskRuns> = strata
+            .iter()
+            .map(|(task, pooled)| TaskRuns {
+                task,
+                config: &pooled.config,
+                library: pooled.library.as_deref().unwrap_or_default(),
+                runs: &pooled.runs,
+                rewards: &pooled.rewards,
+            })
+            .collect();
+        let report = Report::of(&tasks);
+        let lead = [axis.clone(), value.clone(), group.len().to_string()];
+        let (header, records) = comparison::csv_records(&report.comparison, report.units);
+        comparisons.extend(&["axis", "value", "cells"], &lead, &header, records);
+        improvements.extend(
+            &["axis", "value"],
+            &lead[..2],
+            &["score", "method", "over", "p", "lo", "hi"].map(String::from),
+            report
+                .improvement
+                .iter()
+                .map(|r| {
+                    vec![
+                        r.score.to_string(),
+                        r.method.clone(),
+                        r.over.clone(),
+                        format!("{:?}", r.p.point),
+                        format!("{:?}", r.p.lo),
+                        format!("{:?}", r.p.hi),
+                    ]
+                })
+                .collect(),
+        );
+        let dir = if axis == ACROSS_TASKS {
+            out.join(ACROSS_TASKS_FOLDER)
+        } else {
+            out.join(folder_name(axis, value))
+        };
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        report
+            .write(&dir)
+            .with_context(|| format!("writing the report in {}", dir.display()))?;
+        for (task, pooled) in &strata {
+            // One task's curves in the value's folder; several tasks' each in its own.
+            let curves = if strata.len() == 1 {
+                dir.clone()
+            } else {
+                dir.join(folder_name("task", task))
+            };
+            std::fs::create_dir_all(&curves)
+                .with_context(|| format!("creating {}", curves.display()))?;
+            report::write_plots(&curves, &plot_data(pooled))
+                .with_context(|| format!("drawing the plots in {}", curves.display()))?;
+        }
+        let mut title = format!("{axis} = {value}");
+        if !report.left_out.is_empty() {
+            title.push_str(&format!(
+                " (left out, not run on every task: {})",
+                report.left_out.join(", ")
+            ));
+        }
+        tables.push((title, report.table()));
+    }
+    comparisons.write(&out.join("comparison.csv"))?;
+    improvements.write(&out.join("improvement.csv"))?;
     Ok(MergeReport {
         merged: done.len(),
         missing,
         tables,
     })
+}
+
+/// The axis of the rows pooled over every cell of a sweep that spans several tasks.
+pub const ACROSS_TASKS: &str = "*";
+/// Their folder in `merged/`.
+const ACROSS_TASKS_FOLDER: &str = "across-tasks";
+
+/// The cells of `group` by task (its target task's label), tasks in the order first met.
+fn by_task<'a>(group: &[&'a Results]) -> Vec<(String, Vec<&'a Results>)> {
+    let mut tasks: Vec<(String, Vec<&Results>)> = Vec::new();
+    for results in group {
+        let task = results.config.env.label();
+        match tasks.iter_mut().find(|(t, _)| *t == task) {
+            Some((_, cells)) => cells.push(results),
+            None => tasks.push((task, vec![results])),
+        }
+    }
+    tasks
+}
+
+/// Rows gathered under one header: reports of one task and of several have different
+/// columns (thresholds, units), so a column is found by its name and left empty in rows
+/// that lack it.
+#[derive(Default)]
+struct Table {
+    header: Vec<String>,
+    rows: Vec<Vec<(String, String)>>,
+}
+
+impl Table {
+    fn extend(
+        &mut self,
+        lead_names: &[&str],
+        lead: &[String],
+        header: &[String],
+        records: Vec<Vec<String>>,
+    ) {
+        let names: Vec<String> = lead_names
+            .iter()
+            .map(|n| n.to_string())
+            .chain(header.iter().cloned())
+            .collect();
+        for name in &names {
+            if !self.header.contains(name) {
+                self.header.push(name.clone());
+            }
+        }
+        for record in records {
+            let values = lead.iter().cloned().chain(record);
+            self.rows.push(names.iter().cloned().zip(values).collect());
+        }
+    }
+
+    fn write(&self, path: &Path) -> Result<()> {
+        let mut csv =
+            csv::Writer::from_path(path).with_context(|| format!("creating {}", path.display()))?;
+        csv.write_record(&self.header)?;
+        for row in &self.rows {
+            let record: Vec<&str> = self
+                .header
+                .iter()
+                .map(|h| {
+                    row.iter()
+                        .find(|(n, _)| n == h)
+                        .map_or("", |(_, v)| v.as_str())
+                })
+                .collect();
+            csv.write_record(record)?;
+        }
+        csv.flush()
+            .with_context(|| format!("writing {}", path.display()))
+    }
 }
 
 /// `sapnet.temperature=0.5`, with anything but letters, digits, `.`, `=`, `-` made `_`.

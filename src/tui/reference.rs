@@ -1,8 +1,17 @@
 //! A finished protocol beside the live run (`--compare DIR`): for each method the moving
-//! average of its runs' returns, their mean and a band of ± one standard deviation, drawn
-//! under the live curves of the same method.
+//! average of its runs' returns, their mean and the 95% bootstrap interval of that mean,
+//! drawn under the live curves of the same method.
 
-use super::dashboard::CURVE_POINTS;
+use crate::seeds::{self, Part};
+use crate::stats::{aggregate, bootstrap, Scores};
+
+/// Points of a band: the terminal draws a few hundred columns at most, and each point
+/// costs a bootstrap.
+pub const BAND_POINTS: usize = 512;
+
+/// Resamples per point of a band: the usual floor, which keeps `--compare` of a 55-run
+/// protocol to a fraction of a second.
+const BAND_RESAMPLES: usize = 2000;
 
 /// One method's finished runs, as the reward chart draws them.
 #[derive(Debug, Clone, PartialEq)]
@@ -13,15 +22,16 @@ pub struct Band {
     pub runs: usize,
     /// `(episode, mean of the runs' moving averages)`.
     pub mean: Vec<(f64, f64)>,
-    /// `(episode, mean − sd)` and `(episode, mean + sd)`.
+    /// `(episode, low end)` and `(episode, high end)` of the mean's 95% interval.
     pub low: Vec<(f64, f64)>,
     pub high: Vec<(f64, f64)>,
 }
 
 impl Band {
     /// The band of `runs` (each run's returns, episode 1 first) under a moving average of
-    /// `window` episodes: a point per episode from the `window`-th on, mean and sample
-    /// standard deviation over the runs that reach it, thinned to at most [`CURVE_POINTS`].
+    /// `window` episodes: from the `window`-th episode on, thinned to at most
+    /// [`BAND_POINTS`], the mean over the runs that reach it and its 95% bootstrap
+    /// interval (the runs resampled).
     pub fn from_runs(label: &str, runs: &[Vec<f64>], window: usize) -> Self {
         let window = window.max(1);
         let averages: Vec<Vec<f64>> = runs
@@ -34,7 +44,7 @@ impl Band {
             })
             .collect();
         let longest = averages.iter().map(Vec::len).max().unwrap_or(0);
-        let stride = longest.div_ceil(CURVE_POINTS).max(1);
+        let stride = longest.div_ceil(BAND_POINTS).max(1);
         let mut band = Band {
             label: label.to_string(),
             runs: runs.len(),
@@ -44,17 +54,18 @@ impl Band {
         };
         for i in (0..longest).step_by(stride) {
             let values: Vec<f64> = averages.iter().filter_map(|a| a.get(i).copied()).collect();
-            let n = values.len() as f64;
-            let mean = values.iter().sum::<f64>() / n;
-            let sd = if values.len() < 2 {
-                0.0
-            } else {
-                (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
-            };
             let episode = (i + window) as f64;
-            band.mean.push((episode, mean));
-            band.low.push((episode, mean - sd));
-            band.high.push((episode, mean + sd));
+            let Some(scores) = Scores::one_task(values) else {
+                continue;
+            };
+            let seed = seeds::derive(
+                0,
+                &[Part::Name("band"), Part::Name(label), Part::Index(i as u64)],
+            );
+            let e = bootstrap::interval_of(&scores, aggregate::mean, BAND_RESAMPLES, seed);
+            band.mean.push((episode, e.point));
+            band.low.push((episode, e.lo));
+            band.high.push((episode, e.hi));
         }
         band
     }
@@ -65,14 +76,14 @@ mod tests {
     use super::*;
 
     /// Two runs by hand, window 2: MA10s of [1, 3, 5] and [3, 5, 7] are [2, 4] and [4, 6];
-    /// their means 3 and 5 at episodes 2 and 3, sample sd √2 each.
+    /// their means 3 and 5 at episodes 2 and 3. Resampling two runs gives the mean of
+    /// (a, a), (a, b) or (b, b): the interval runs from the lower run to the higher.
     #[test]
-    fn the_band_is_the_mean_and_sd_of_the_runs_moving_averages() {
+    fn the_band_is_the_mean_of_the_runs_moving_averages_and_its_interval() {
         let band = Band::from_runs("sapnet", &[vec![1.0, 3.0, 5.0], vec![3.0, 5.0, 7.0]], 2);
         assert_eq!(band.mean, vec![(2.0, 3.0), (3.0, 5.0)]);
-        let sd = 2f64.sqrt();
-        assert_eq!(band.low, vec![(2.0, 3.0 - sd), (3.0, 5.0 - sd)]);
-        assert_eq!(band.high, vec![(2.0, 3.0 + sd), (3.0, 5.0 + sd)]);
+        assert_eq!(band.low, vec![(2.0, 2.0), (3.0, 4.0)]);
+        assert_eq!(band.high, vec![(2.0, 4.0), (3.0, 6.0)]);
         assert_eq!(band.runs, 2);
     }
 
@@ -80,8 +91,9 @@ mod tests {
     fn a_long_protocol_is_thinned_to_the_curves_budget() {
         let run: Vec<f64> = (0..20_000).map(f64::from).collect();
         let band = Band::from_runs("dqn[100]", &[run], 10);
-        assert!(band.mean.len() <= CURVE_POINTS, "{}", band.mean.len());
+        assert!(band.mean.len() <= BAND_POINTS, "{}", band.mean.len());
         assert_eq!(band.mean[0], (10.0, 4.5));
         assert_eq!(band.low, band.mean, "one run: no spread");
+        assert_eq!(band.high, band.mean);
     }
 }

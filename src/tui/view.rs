@@ -463,6 +463,11 @@ pub(super) fn probability_bar(p: f64, width: usize) -> String {
 /// The episode axis follows the first (leading) run, so that its curve fills the chart
 /// however far ahead a baseline of short episodes has raced; the others are drawn over the
 /// same episodes, and the title says where they are.
+/// A finished protocol's band as the legend names it.
+fn band_name(band: &Band) -> String {
+    format!("{} mean, 95% CI, {} runs", band.label, band.runs)
+}
+
 fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], reference: &[Band], theme: Theme) {
     let x_max = runs
         .first()
@@ -509,16 +514,12 @@ fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], reference: &[Ba
     let width = names
         .iter()
         .map(|n| n.chars().count())
-        .chain(
-            reference
-                .iter()
-                .map(|b| format!("{} ± sd, {} runs", b.label, b.runs).chars().count()),
-        )
+        .chain(reference.iter().map(|b| band_name(b).chars().count()))
         .max()
         .unwrap_or(0);
     let mut datasets = Vec::new();
     // The bands first, so the live curves draw over them: the mean a dim line named in
-    // the legend, ± one sd as dim dots.
+    // the legend, its 95% interval's ends as dim dots.
     for (band, [low, mean, high]) in bands.iter().zip(&band_points) {
         let i = runs
             .iter()
@@ -535,10 +536,7 @@ fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], reference: &[Ba
         }
         datasets.push(
             Dataset::default()
-                .name(format!(
-                    "{:width$}",
-                    format!("{} ± sd, {} runs", band.label, band.runs)
-                ))
+                .name(format!("{:width$}", band_name(band)))
                 .marker(Marker::Braille)
                 .graph_type(GraphType::Line)
                 .style(theme.series(i).add_modifier(Modifier::DIM))

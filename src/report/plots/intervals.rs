@@ -1,0 +1,339 @@
+//! The pictures researchers read since Agarwal et al. (NeurIPS 2021), in `rliable`'s
+//! style: `intervals.png`, each aggregate of each method as a bar from the low to the
+//! high end of its 95% interval with the point marked; `profiles.png`, the share of runs
+//! whose normalised test score exceeds τ, with its band; `improvement.png`, the
+//! probability that the reference method's run beats each other method's, with its
+//! interval, against the coin toss at 0.5. Each also as `.svg`.
+
+use std::path::Path;
+
+use anyhow::{anyhow, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{colour_of, register_font, Drawn, FAMILY};
+use crate::config::MethodKind;
+use crate::report::{Aggregates, Report, Units};
+use crate::stats::{bootstrap, profile, Estimate};
+
+/// Writes `intervals`, `profiles` and `improvement` (`.png` and `.svg`) into `dir`.
+pub fn write_intervals(dir: &Path, report: &Report) -> Result<()> {
+    register_font()?;
+    let methods = report.comparison.len().max(1) as u32;
+    let panels = (1400, 2 * (40 + 26 * methods) + 80);
+    let square = (1000, 650);
+    let improvement = (1200, 100 + 26 * methods);
+    macro_rules! both {
+        ($name:literal, $size:expr, $draw:expr) => {
+            for ext in ["png", "svg"] {
+                let path = dir.join(format!("{}.{ext}", $name));
+                let drawn = if ext == "png" {
+                    $draw(BitMapBackend::new(&path, $size).into_drawing_area(), report)
+                        .map_err(|e| e.to_string())
+                } else {
+                    $draw(SVGBackend::new(&path, $size).into_drawing_area(), report)
+                        .map_err(|e| e.to_string())
+                };
+                drawn.map_err(|e| anyhow!("{}: {e}", path.display()))?;
+            }
+        };
+    }
+    both!("intervals", panels, aggregates);
+    both!("profiles", square, profiles);
+    both!("improvement", improvement, probabilities);
+    Ok(())
+}
+
+/// What the scores are measured in, for titles.
+fn units(report: &Report) -> &'static str {
+    match report.units {
+        Units::Returns => "return",
+        Units::Normalised => "normalised score",
+    }
+}
+
+fn tasks(report: &Report) -> String {
+    report.tasks.join(", ")
+}
+
+/// The methods' colours, as the learning curves give them.
+fn colours(report: &Report) -> Vec<RGBColor> {
+    let sapnet: Vec<bool> = report
+        .comparison
+        .iter()
+        .map(|m| m.kind == MethodKind::SapNet)
+        .collect();
+    (0..sapnet.len()).map(|i| colour_of(&sapnet, i)).collect()
+}
+
+/// Two rows of panels (the test score, the training return), one column per aggregate:
+/// a method's bar spans its 95% interval, the tick marks the point.
+fn aggregates<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Report) -> Drawn<DB> {
+    root.fill(&WHITE)?;
+    let runs: Vec<usize> = report.comparison.iter().map(|m| m.runs).collect();
+    let runs = match (runs.iter().min(), runs.iter().max()) {
+        (Some(lo), Some(hi)) if lo == hi => format!("{lo} runs"),
+        (Some(lo), Some(hi)) => format!("{lo}–{hi} runs"),
+        _ => "no runs".into(),
+    };
+    let (title, body) = root.split_vertically(50);
+    title.titled(
+        &format!(
+            "{}: 95% stratified bootstrap intervals ({} resamples) over {runs} per method",
+            tasks(report),
+            bootstrap::RESAMPLES
+        ),
+        (FAMILY, 22),
+    )?;
+    let rows = body.split_evenly((2, 4));
+    let colours = colours(report);
+    let names: Vec<String> = report.comparison.iter().map(|m| m.method.clone()).collect();
+    type Pick = fn(&Aggregates) -> Estimate;
+    let columns: [(&str, Pick); 4] = [
+        ("median", |a| a.median),
+        ("IQM", |a| a.iqm),
+        ("mean", |a| a.mean),
+        ("optimality gap (normalised)", |a| a.optimality_gap),
+    ];
+    for (r, (score, pick_score)) in [
+        (
+            "test score",
+            (|m| m.test) as fn(&crate::report::MethodComparison) -> Option<Aggregates>,
+        ),
+        ("training return", |m| m.training),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        for (c, (aggregate, pick)) in columns.iter().enumerate() {
+            let area = &rows[r * 4 + c];
+            let estimates: Vec<Option<Estimate>> = report
+                .comparison
+                .iter()
+                .map(|m| pick_score(m).map(|a| pick(&a)))
+                .collect();
+            let unit = if c == 3 { "" } else { units(report) };
+            let caption = format!("{score}: {aggregate}");
+            interval_panel(area, &caption, unit, &names, &estimates, &colours, c == 0)?;
+        }
+    }
+    root.present()
+}
+
+/// One panel: a horizontal bar per method from lo to hi, a tick at the point.
+fn interval_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    caption: &str,
+    unit: &str,
+    names: &[String],
+    estimates: &[Option<Estimate>],
+    colours: &[RGBColor],
+    with_names: bool,
+) -> Drawn<DB> {
+    let (low, high) = super::value_range(
+        estimates
+            .iter()
+            .flatten()
+            .flat_map(|e| [e.lo, e.hi, e.point]),
+    );
+    let n = names.len().max(1);
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, (FAMILY, 16))
+        .margin(8)
+        .x_label_area_size(36)
+        .y_label_area_size(if with_names { 150 } else { 10 })
+        .build_cartesian_2d(low..high, -0.5f64..n as f64 - 0.5)?;
+    let names_shown = names.to_vec();
+    chart
+        .configure_mesh()
+        .disable_y_mesh()
+        .y_labels(if with_names { n } else { 0 })
+        .y_label_formatter(&move |y| {
+            let i = y.round();
+            if (y - i).abs() < 1e-6 && i >= 0.0 {
+                names_shown
+                    .get(n - 1 - i as usize)
+                    .cloned()
+                    .unwrap_or_default()
+            } else {
+                String::new()
+            }
+        })
+        .x_desc(unit)
+        .x_labels(5)
+        .x_label_formatter(&|x| {
+            if (high - low) >= 10.0 {
+                format!("{x:.0}")
+            } else {
+                format!("{x:.2}")
+            }
+        })
+        .label_style((FAMILY, 13))
+        .draw()?;
+    for (i, e) in estimates.iter().enumerate() {
+        let Some(e) = e else { continue };
+        // The first method at the top.
+        let y = (n - 1 - i) as f64;
+        let colour = colours[i];
+        chart.draw_series(std::iter::once(Rectangle::new(
+            [(e.lo, y - 0.32), (e.hi.max(e.lo), y + 0.32)],
+            colour.mix(0.55).filled(),
+        )))?;
+        chart.draw_series(std::iter::once(PathElement::new(
+            [(e.point, y - 0.4), (e.point, y + 0.4)],
+            BLACK.stroke_width(2),
+        )))?;
+    }
+    Ok(())
+}
+
+/// Performance profiles of the normalised test score: the share of runs above τ, with a
+/// 95% band.
+fn profiles<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Report) -> Drawn<DB> {
+    root.fill(&WHITE)?;
+    let levels = profile::levels();
+    let colours = colours(report);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!(
+                "{}: performance profiles of the greedy test score, 95% bands",
+                tasks(report)
+            ),
+            (FAMILY, 20),
+        )
+        .margin(12)
+        .margin_right(30)
+        .x_label_area_size(55)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0f64..1f64, 0f64..1.02f64)?;
+    chart
+        .configure_mesh()
+        .x_desc("normalised test score τ: (return − lowest) / (highest − lowest) of the task")
+        .y_desc("share of runs with score > τ")
+        .light_line_style(WHITE)
+        .label_style((FAMILY, 15))
+        .draw()?;
+    for profile in &report.profiles {
+        let Some(i) = report
+            .comparison
+            .iter()
+            .position(|m| m.method == profile.method)
+        else {
+            continue;
+        };
+        let colour = colours[i];
+        let band: Vec<(f64, f64)> = levels
+            .iter()
+            .zip(&profile.shares)
+            .map(|(&t, e)| (t, e.hi))
+            .chain(
+                levels
+                    .iter()
+                    .zip(&profile.shares)
+                    .rev()
+                    .map(|(&t, e)| (t, e.lo)),
+            )
+            .collect();
+        chart.draw_series(std::iter::once(Polygon::new(
+            band,
+            colour.mix(0.1).filled(),
+        )))?;
+        let runs = report.comparison[i].runs;
+        chart
+            .draw_series(LineSeries::new(
+                levels
+                    .iter()
+                    .zip(&profile.shares)
+                    .map(|(&t, e)| (t, e.point)),
+                colour.stroke_width(2),
+            ))?
+            .label(format!("{} ({runs} runs)", profile.method))
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FAMILY, 14))
+        .draw()?;
+    root.present()
+}
+
+/// P(reference > other) for the test score and the training return, each with its 95%
+/// interval, the coin toss (0.5) marked.
+fn probabilities<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Report) -> Drawn<DB> {
+    root.fill(&WHITE)?;
+    let Some(reference) = &report.reference else {
+        return root.present();
+    };
+    let (title, body) = root.split_vertically(46);
+    title.titled(
+        &format!(
+            "{}: probability that a run of {reference} beats a run of each method, 95% intervals",
+            tasks(report)
+        ),
+        (FAMILY, 18),
+    )?;
+    let panels = body.split_evenly((1, 2));
+    let colours = colours(report);
+    for (panel, score, caption) in [
+        (&panels[0], "test", "greedy test score"),
+        (&panels[1], "return", "training return"),
+    ] {
+        let mut names = Vec::new();
+        let mut estimates = Vec::new();
+        let mut shades = Vec::new();
+        for (i, m) in report.comparison.iter().enumerate() {
+            let row = report
+                .improvement
+                .iter()
+                .find(|r| r.score == score && &r.method == reference && r.over == m.method);
+            if let Some(row) = row {
+                names.push(format!("{reference} > {}", m.method));
+                estimates.push(Some(row.p));
+                shades.push(colours[i]);
+            }
+        }
+        let n = names.len().max(1);
+        let mut chart = ChartBuilder::on(panel)
+            .caption(caption, (FAMILY, 16))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(230)
+            .build_cartesian_2d(0f64..1f64, -0.5f64..n as f64 - 0.5)?;
+        let shown = names.clone();
+        chart
+            .configure_mesh()
+            .disable_y_mesh()
+            .y_labels(n)
+            .y_label_formatter(&move |y| {
+                let i = y.round();
+                if (y - i).abs() < 1e-6 && i >= 0.0 {
+                    shown.get(n - 1 - i as usize).cloned().unwrap_or_default()
+                } else {
+                    String::new()
+                }
+            })
+            .x_desc("P(X > Y)")
+            .label_style((FAMILY, 13))
+            .draw()?;
+        chart.draw_series(std::iter::once(PathElement::new(
+            [(0.5, -0.5), (0.5, n as f64 - 0.5)],
+            BLACK.mix(0.6).stroke_width(1),
+        )))?;
+        for (i, e) in estimates.iter().enumerate() {
+            let Some(e) = e else { continue };
+            let y = (n - 1 - i) as f64;
+            chart.draw_series(std::iter::once(Rectangle::new(
+                [(e.lo, y - 0.32), (e.hi.max(e.lo), y + 0.32)],
+                shades[i].mix(0.55).filled(),
+            )))?;
+            chart.draw_series(std::iter::once(PathElement::new(
+                [(e.point, y - 0.4), (e.point, y + 0.4)],
+                BLACK.stroke_width(2),
+            )))?;
+        }
+    }
+    root.present()
+}
