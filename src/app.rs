@@ -26,6 +26,22 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Teach(args)) => run_teach(&cli, args),
         Some(Command::Sources(args)) => run_sources(&cli, args),
         Some(Command::Sweep(args)) => run_sweep(&cli, &args.command),
+        Some(Command::Pool(args)) => {
+            let report = results::pool::pool(&args.dirs, &args.out)?;
+            eprintln!(
+                "pooled {} tasks into {}: comparison.csv, improvement.csv, scores.csv, intervals.png, profiles.png, improvement.png",
+                report.tasks.len(),
+                args.out.display()
+            );
+            if !report.left_out.is_empty() {
+                eprintln!(
+                    "left out, not run on every task: {}",
+                    report.left_out.join(", ")
+                );
+            }
+            print!("{}", report.table());
+            Ok(())
+        }
         Some(Command::Plot(args)) => {
             let summary = results::replot(&args.dir)?;
             eprintln!(
@@ -46,6 +62,7 @@ fn refuse_unread_flags(cli: &Cli, command: &Command) -> Result<()> {
         Command::Teach(_) => ("teach", &["--config"]),
         Command::Sources(_) => ("sources", &["--config", "--seed", "--library"]),
         Command::Plot(_) => ("plot", &[]),
+        Command::Pool(_) => ("pool", &[]),
         Command::Sweep(args) => match args.command {
             SweepCommand::Plan { .. } => ("sweep plan", &["--config", "--library"]),
             SweepCommand::Run { .. } => ("sweep run", &["--jobs"]),

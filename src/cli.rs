@@ -172,9 +172,14 @@ pub enum Command {
     /// Train the library of source policies the config describes (`sources`: N random
     /// architectures) and write it to <LIBRARY>/<task>/.
     Sources(SourcesArgs),
-    /// Draw a results directory's plots again from its files (summary.json, episodes.csv,
-    /// tests.csv, activations.csv): for a run stopped before its plots, or older plots.
+    /// Make a results directory's report and plots again from its files (summary.json and
+    /// the run records in runs/): for a run stopped before its plots, a killed one, or a
+    /// folder of an older version. Prints the comparison.
     Plot(PlotArgs),
+    /// One comparison of finished protocols on different tasks (e.g. the variants of
+    /// CartPole and of MountainCar): each method's scores normalised by each task's range
+    /// of returns and resampled within each task; written to --out with its plots.
+    Pool(PoolArgs),
     /// Sweeps: a grid of configs as independent cells, run by Slurm array jobs, GNU
     /// parallel or this machine, then merged (docs/SWEEPS.md).
     Sweep(SweepArgs),
@@ -234,6 +239,16 @@ pub struct PlotArgs {
     /// The results directory (a headless run's --out).
     #[arg(value_name = "DIR")]
     pub dir: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct PoolArgs {
+    /// The results directories (headless runs' --out), one per task.
+    #[arg(value_name = "DIR", num_args = 2.., required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// Where the pooled report goes (a new or empty directory).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
 }
 
 #[derive(Debug, Args)]

@@ -5,6 +5,7 @@
 
 pub mod assemble;
 pub mod files;
+pub mod pool;
 pub mod records;
 pub mod replot;
 pub mod summary;
