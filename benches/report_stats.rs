@@ -14,17 +14,14 @@ use rand::{Rng, SeedableRng};
 use sapnet::config::Config;
 use sapnet::experiment::method_ids;
 use sapnet::report::{Report, RunSummary, TaskRuns};
-use sapnet::trainer::RunRecord;
+use sapnet::trainer::{MethodId, RunRecord};
 
 /// The reuse comparison's methods with `runs` runs each: returns and test scores drawn at
 /// random (the statistics cost the same whatever the numbers), 1,000 episodes a run.
-fn protocol(
-    runs: u32,
-) -> (
-    Config,
-    Vec<RunSummary>,
-    BTreeMap<(sapnet::trainer::MethodId, u32), Vec<f64>>,
-) {
+/// What a report reads of a protocol: its config, its runs and their training returns.
+type Protocol = (Config, Vec<RunSummary>, BTreeMap<(MethodId, u32), Vec<f64>>);
+
+fn protocol(runs: u32) -> Protocol {
     let mut config = Config::from_ron(
         include_str!("../assets/reuse_cartpole.ron"),
         "reuse_cartpole.ron",
