@@ -21,6 +21,7 @@ pub fn run(cli: Cli) -> Result<()> {
     if let Some(command) = &cli.command {
         refuse_unread_flags(&cli, command)?;
     }
+    refuse_non_utf8_paths(&cli)?;
     match &cli.command {
         Some(Command::Env(args)) => run_env(&cli, args),
         Some(Command::Teach(args)) => run_teach(&cli, args),
@@ -54,6 +55,37 @@ pub fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// Paths that results record (in summary.json, run.json and policy metadata, which are
+/// text) must be text: a `--library` or `--out` that is not UTF-8 is refused before any
+/// run trains, not after, when the first record is written.
+fn refuse_non_utf8_paths(cli: &Cli) -> Result<()> {
+    let mut paths: Vec<(&str, &Path)> = Vec::new();
+    if let Some(library) = &cli.run.library {
+        paths.push(("--library", library));
+    }
+    if let Some(out) = &cli.run.out {
+        paths.push(("--out", out));
+    }
+    match &cli.command {
+        Some(Command::Pool(args)) => paths.push(("--out", &args.out)),
+        Some(Command::Sweep(args)) => {
+            if let SweepCommand::Plan { out, .. } = &args.command {
+                paths.push(("--out", out));
+            }
+        }
+        _ => {}
+    }
+    for (flag, path) in paths {
+        if path.to_str().is_none() {
+            anyhow::bail!(
+                "{flag} {}: expected a UTF-8 path (results record their paths as text)",
+                path.display()
+            );
+        }
+    }
+    Ok(())
+}
+
 /// A flag the subcommand would ignore is refused: `sapnet env --library DIR` reads no
 /// library, and saying nothing would let the user believe it did.
 fn refuse_unread_flags(cli: &Cli, command: &Command) -> Result<()> {
@@ -66,7 +98,7 @@ fn refuse_unread_flags(cli: &Cli, command: &Command) -> Result<()> {
         Command::Sweep(args) => match args.command {
             SweepCommand::Plan { .. } => ("sweep plan", &["--config", "--library"]),
             SweepCommand::Run { .. } => ("sweep run", &["--jobs"]),
-            SweepCommand::Prepare { .. } => ("sweep prepare", &[]),
+            SweepCommand::Prepare { .. } => ("sweep prepare", &["--library"]),
             SweepCommand::Status { .. } => ("sweep status", &[]),
             SweepCommand::Merge { .. } => ("sweep merge", &[]),
         },
@@ -464,7 +496,9 @@ fn run_sweep(cli: &Cli, command: &SweepCommand) -> Result<()> {
             );
             Ok(())
         }
-        SweepCommand::Prepare { sweep } => sweep::run::prepare(sweep, &on_interrupt()?),
+        SweepCommand::Prepare { sweep } => {
+            sweep::run::prepare(sweep, cli.run.library.as_deref(), &on_interrupt()?)
+        }
         SweepCommand::Run { sweep, cell, all } => {
             let jobs = cli.run.jobs.unwrap_or_else(|| {
                 std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)

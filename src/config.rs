@@ -14,6 +14,7 @@ use crate::dqn::Init;
 use crate::env::{CartPoleParams, EnvConfig};
 use crate::reuse::prql::PrqlKnobs;
 use crate::reuse::sapnet::SapNetKnobs;
+use crate::safe_io::Links;
 use crate::sapnet::SapNetParams;
 
 /// Everything one run needs.
@@ -316,6 +317,23 @@ impl Method {
     }
 }
 
+/// The most training episodes a run (or a source) may ask for: 1,000 times the paper's
+/// longest protocol. Each episode keeps a return in memory and a row on disk.
+pub const MAX_EPISODES: u32 = 10_000_000;
+
+/// The most greedy test episodes per run.
+pub const MAX_TEST_EPISODES: u32 = 100_000;
+
+/// The most source policies a library may hold (the paper's has 10).
+pub const MAX_SOURCES: usize = 10_000;
+
+/// The most gradient updates per round: each is a minibatch, and signals are read between
+/// them.
+pub const MAX_GRADIENT_STEPS: u32 = 10_000;
+
+/// The largest minibatch.
+pub const MAX_BATCH: usize = 1 << 16;
+
 /// The most runs per method a protocol may ask for: far beyond what a comparison needs
 /// (hundreds separate the closest methods), and refused before anything is planned.
 pub const MAX_RUNS: u32 = 10_000;
@@ -407,14 +425,25 @@ pub const MAX_HIDDEN_LAYERS: usize = 64;
 /// /dev/zero` is an error, not a machine out of memory.
 pub const MAX_TEXT_BYTES: u64 = 16 << 20;
 
-/// Reads the RON text at `path`, refusing more than [`MAX_TEXT_BYTES`].
+/// Reads the RON text at `path`, a file the user named (a link is followed), refusing
+/// more than [`MAX_TEXT_BYTES`] and anything but a regular file (a FIFO would block).
 pub fn read_text(path: &Path) -> Result<String, ConfigError> {
+    read_text_with(path, Links::Follow)
+}
+
+/// [`read_text`] of a file inside a folder that may have come from elsewhere (a library's
+/// manifest and metadata, a sweep's cells): a symbolic link there is refused.
+pub fn read_folder_text(path: &Path) -> Result<String, ConfigError> {
+    read_text_with(path, Links::Refuse)
+}
+
+fn read_text_with(path: &Path, links: Links) -> Result<String, ConfigError> {
     use std::io::Read;
     let io = |cause| ConfigError::Io {
         path: path.to_path_buf(),
         cause,
     };
-    let file = std::fs::File::open(path).map_err(io)?;
+    let file = crate::safe_io::open(path, links, u64::MAX).map_err(io)?;
     let mut bytes = Vec::new();
     file.take(MAX_TEXT_BYTES + 1)
         .read_to_end(&mut bytes)
@@ -493,13 +522,15 @@ pub fn parse_ron_as<T: serde::de::DeserializeOwned>(
     })?;
     let located = |de: &ron::Deserializer, field: String, code: ron::Error| {
         let spanned = de.span_error(code);
+        let (line, column) = (spanned.span.start.line, spanned.span.start.col);
+        let (field, message) = explained(text, line, column, field, spanned.code.to_string());
         ConfigError::Parse(Box::new(ParseError {
             kind,
             origin: origin.to_string(),
-            line: spanned.span.start.line,
-            column: spanned.span.start.col,
+            line,
+            column,
             field,
-            message: spanned.code.to_string(),
+            message,
         }))
     };
     let value = serde_path_to_error::deserialize(&mut de).map_err(|e| {
@@ -511,6 +542,68 @@ pub fn parse_ron_as<T: serde::de::DeserializeOwned>(
     })?;
     de.end().map_err(|e| located(&de, String::new(), e))?;
     Ok(value)
+}
+
+/// RON's wording for two number mistakes, said as the field sees them: a fraction where a
+/// whole number belongs reads to RON as a number followed by something other than a comma
+/// (`episodes: 5.5` → "Expected comma", at the struct around it), and a negative count as
+/// "Integer is out of bounds" without the bound.
+fn explained(
+    text: &str,
+    line: usize,
+    column: usize,
+    field: String,
+    message: String,
+) -> (String, String) {
+    let Some(row) = text.lines().nth(line.saturating_sub(1)) else {
+        return (field, message);
+    };
+    let chars: Vec<char> = row.chars().collect();
+    let at = column.saturating_sub(1).min(chars.len());
+    // The token around the error: back to `:`, forward to `,` or `)`.
+    let start = chars[..at]
+        .iter()
+        .rposition(|c| *c == ':' || *c == '(' || *c == ',')
+        .map_or(0, |i| i + 1);
+    let end = chars[at..]
+        .iter()
+        .position(|c| *c == ',' || *c == ')')
+        .map_or(chars.len(), |i| at + i);
+    let token: String = chars[start..end]
+        .iter()
+        .collect::<String>()
+        .trim()
+        .to_string();
+    let name: String = chars[..start.saturating_sub(1)]
+        .iter()
+        .rev()
+        .skip_while(|c| c.is_whitespace())
+        .take_while(|c| c.is_alphanumeric() || **c == '_')
+        .collect::<Vec<_>>()
+        .into_iter()
+        .rev()
+        .collect();
+    let is_fraction = message == "Expected comma"
+        && chars.get(at) == Some(&'.')
+        && token.parse::<f64>().is_ok()
+        && !name.is_empty();
+    if is_fraction {
+        let field = if field.is_empty() {
+            name
+        } else {
+            format!("{field}.{name}")
+        };
+        return (field, format!("expected a whole number, got {token}"));
+    }
+    if message == "Integer is out of bounds" {
+        let why = if token.starts_with('-') {
+            format!("expected a whole number ≥ 0, got {token}")
+        } else {
+            format!("{token} is too large a whole number for this field")
+        };
+        return (field, why);
+    }
+    (field, message)
 }
 
 impl Config {
@@ -659,7 +752,12 @@ impl Config {
             self.sapnet.coefficient,
         )?;
         let src = &self.sources;
-        check(src.count > 0, "sources.count", "at least 1", src.count)?;
+        check(
+            (1..=MAX_SOURCES).contains(&src.count),
+            "sources.count",
+            &format!("1 to {MAX_SOURCES} policies"),
+            src.count,
+        )?;
         check(
             src.training_episodes > 0,
             "sources.training_episodes",
@@ -692,11 +790,31 @@ impl Config {
             p.runs,
         )?;
         check(
-            p.episodes > 0,
+            (1..=MAX_EPISODES).contains(&p.episodes),
             "protocol.episodes",
-            "at least 1",
+            &format!("1 to {MAX_EPISODES}"),
             p.episodes,
         )?;
+        check(
+            p.test_episodes <= MAX_TEST_EPISODES,
+            "protocol.test_episodes",
+            &format!("at most {MAX_TEST_EPISODES}"),
+            p.test_episodes,
+        )?;
+        check(
+            src.training_episodes <= MAX_EPISODES,
+            "sources.training_episodes",
+            &format!("at most {MAX_EPISODES}"),
+            src.training_episodes,
+        )?;
+        if let Some(thresholds) = &p.thresholds {
+            check(
+                thresholds.len() <= 16 && thresholds.iter().all(|t| t.is_finite()),
+                "protocol.thresholds",
+                "None or Some([...]) of at most 16 finite returns",
+                format!("{thresholds:?}"),
+            )?;
+        }
         if let Some(steps) = p.max_steps {
             check(
                 steps > 0,
@@ -835,10 +953,16 @@ fn check_dqn(d: &DqnConfig, prefix: &str) -> Result<(), String> {
         d.update_interval,
     )?;
     check(
-        d.gradient_steps > 0,
+        (1..=MAX_GRADIENT_STEPS).contains(&d.gradient_steps),
         &format!("{prefix}.gradient_steps"),
-        "at least 1 (0 never learns)",
+        &format!("1 to {MAX_GRADIENT_STEPS} updates per round (0 never learns)"),
         d.gradient_steps,
+    )?;
+    check(
+        d.batch_size <= MAX_BATCH,
+        &format!("{prefix}.batch_size"),
+        &format!("at most {MAX_BATCH}"),
+        d.batch_size,
     )?;
     check(
         d.replay_start_size <= d.replay_capacity,
@@ -906,7 +1030,13 @@ mod tests {
         let err = Config::from_ron("(\n    dqn: (batch_size: 32.5),\n)", "bad.ron")
             .unwrap_err()
             .to_string();
-        assert!(err.contains("line 2, column 25, field `dqn`: "), "{err}");
+        // A fraction where a whole number belongs: named at its field, not the struct.
+        assert!(
+            err.contains(
+                "line 2, column 25, field `dqn.batch_size`: expected a whole number, got 32.5"
+            ),
+            "{err}"
+        );
         let err = Config::from_ron("(\n    dqn: (batch_size: 32),\n", "bad.ron")
             .unwrap_err()
             .to_string();

@@ -138,7 +138,7 @@ pub fn save(
     info: &PolicyInfo,
 ) -> Result<PolicyMetadata, StoreError> {
     check_name(name)?;
-    fs::create_dir_all(dir).map_err(|source| StoreError::Write {
+    crate::safe_io::real_dir(dir).map_err(|source| StoreError::Write {
         path: dir.to_path_buf(),
         cause: source,
     })?;
@@ -229,7 +229,7 @@ pub fn load(dir: &Path, name: &str) -> Result<StoredPolicy, StoreError> {
             path: metadata_path,
         });
     }
-    let text = crate::config::read_text(&metadata_path)?;
+    let text = crate::config::read_folder_text(&metadata_path)?;
     let metadata: PolicyMetadata = parse_ron_as(
         &text,
         &metadata_path.display().to_string(),
@@ -251,7 +251,23 @@ pub fn load(dir: &Path, name: &str) -> Result<StoredPolicy, StoreError> {
         });
     }
 
-    let weights = read(&weights_path)?;
+    if let Some(score) = metadata.final_score.filter(|s| !s.is_finite()) {
+        return Err(StoreError::Invalid {
+            path: metadata_path,
+            message: format!("field `final_score`: expected a finite return, got {score}"),
+        });
+    }
+    // The weights are the parameters' f32s and a JSON header naming them: a file much
+    // larger than its architecture needs is not these weights (a link to /dev/zero is
+    // refused as a link before that).
+    let parameters: usize = metadata
+        .architecture
+        .parameter_shapes()
+        .iter()
+        .map(|(_, shape)| shape.iter().product::<usize>())
+        .sum();
+    let limit = 4 * parameters as u64 + MAX_HEADER_BYTES;
+    let weights = read(&weights_path, limit)?;
     let mismatch = |mismatch: String| StoreError::Mismatch {
         weights: weights_path.clone(),
         metadata: metadata_path.clone(),
@@ -284,6 +300,20 @@ pub fn load(dir: &Path, name: &str) -> Result<StoredPolicy, StoreError> {
                 tensor.dtype(),
                 tensor.dims()
             )));
+        }
+        let finite = tensor
+            .flatten_all()
+            .and_then(|t| t.to_vec1::<f32>())
+            .map_err(|e| mismatch(format!("tensor {name}: {e}")))?
+            .iter()
+            .all(|v| v.is_finite());
+        if !finite {
+            return Err(StoreError::Invalid {
+                path: weights_path.clone(),
+                message: format!(
+                    "tensor {name} holds a NaN or infinite weight: not a policy to reuse"
+                ),
+            });
         }
         values.push(tensor);
     }
@@ -414,6 +444,10 @@ pub fn remove_temporaries(dir: &Path) -> std::io::Result<()> {
 }
 
 /// A hidden sibling of `path`, unique to this process; `*.tmp` is ignored by git.
+/// Room for a weights file's JSON header beyond the tensors themselves: the names,
+/// shapes and offsets of a 64-layer network take a few kilobytes.
+const MAX_HEADER_BYTES: u64 = 1 << 20;
+
 fn temporary(path: &Path) -> PathBuf {
     let file = path
         .file_name()
@@ -422,8 +456,12 @@ fn temporary(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{file}.{}.tmp", std::process::id()))
 }
 
-fn read(path: &Path) -> Result<Vec<u8>, StoreError> {
-    fs::read(path).map_err(|source| match source.kind() {
+/// The bytes of a weights file, a regular file of at most `limit` bytes read without
+/// following a link.
+fn read(path: &Path, limit: u64) -> Result<Vec<u8>, StoreError> {
+    crate::safe_io::read(path, crate::safe_io::Links::Refuse, limit).map_err(|source| match source
+        .kind()
+    {
         std::io::ErrorKind::NotFound => StoreError::Missing {
             path: path.to_path_buf(),
         },
@@ -436,7 +474,7 @@ fn read(path: &Path) -> Result<Vec<u8>, StoreError> {
 
 fn write_synced(path: &Path, bytes: &[u8]) -> Result<(), StoreError> {
     let write = || {
-        let mut file = fs::File::create(path)?;
+        let mut file = crate::safe_io::create(path)?;
         file.write_all(bytes)?;
         file.sync_all()
     };

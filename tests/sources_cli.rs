@@ -125,7 +125,8 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let mut found: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
-        .filter(|p| p.is_file())
+        // The trainer's lock file says who trained last, not what was trained.
+        .filter(|p| p.is_file() && !p.ends_with(sapnet::folder_lock::LOCK_FILE))
         .map(|p| {
             (
                 p.file_name().unwrap().to_string_lossy().into_owned(),

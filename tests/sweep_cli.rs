@@ -266,7 +266,19 @@ fn prepare_readies_a_library_once_for_every_seed() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("sweep");
     ok(plan(&grid(tmp.path()), &dir, &tmp.path().join("lib")));
-    let prepared = ok(sweep(&["prepare"], &dir));
+    let library = tmp.path().join("lib");
+    // Without --library, prepare says how to name the library it would train.
+    let unnamed = sweep(&["prepare"], &dir);
+    assert_eq!(unnamed.status.code(), Some(2));
+    assert!(
+        stderr(&unnamed).contains("--library"),
+        "{}",
+        stderr(&unnamed)
+    );
+    let prepared = ok(sweep(
+        &["prepare", "--library", library.to_str().unwrap()],
+        &dir,
+    ));
     let said = stderr(&prepared);
     assert_eq!(said.matches(" ready").count(), 1, "{said}");
 }
@@ -293,7 +305,10 @@ fn a_sweep_over_tasks_is_pooled_with_normalised_scores() {
     .unwrap();
     let (library, s) = (tmp.path().join("lib"), tmp.path().join("s"));
     ok(plan(&grid, &s, &library));
-    ok(sweep(&["prepare"], &s));
+    ok(sweep(
+        &["prepare", "--library", library.to_str().unwrap()],
+        &s,
+    ));
     ok(sweep(&["run", "--all", "--jobs", "2"], &s));
     let merged = ok(sweep(&["merge"], &s));
     let table = String::from_utf8_lossy(&merged.stdout).into_owned();

@@ -100,7 +100,12 @@ impl DqnAgent {
         }
         let previous_statistic_loss = self.statistic_loss;
         let mut loss = 0.0;
-        for _ in 0..self.config.gradient_steps {
+        for k in 0..self.config.gradient_steps {
+            // A round of many updates (gradient_steps up to 10,000) hears a signal between
+            // two of them: what it learned so far is kept, the run stops at its step's end.
+            if k > 0 && crate::signals::received().is_some() {
+                break;
+            }
             let mut batch = std::mem::take(&mut self.batch);
             replay.sample_into(self.config.batch_size, &mut batch, rng);
             let result = self.update(&batch);

@@ -1,6 +1,7 @@
 //! Adding a run's chosen policy to the policy library (Algorithm 3's last step), beside
 //! the sources and never over them.
 
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
@@ -35,8 +36,12 @@ impl LibraryCopies {
     /// Writes `net` under a name no policy in the directory has yet (`…-2`, `…-3` after
     /// the first), and returns the path of its metadata file.
     pub fn add(&self, file_name: &str, net: &QNet, info: &PolicyInfo) -> Result<PathBuf> {
-        std::fs::create_dir_all(&self.dir)
-            .with_context(|| format!("creating {}", self.dir.display()))?;
+        // A library from elsewhere may hold a link where `<task>/` or `chosen/` belongs:
+        // the copy goes into real directories or nowhere.
+        if let Some(task) = self.dir.parent() {
+            crate::safe_io::real_dir(task).with_context(|| format!("{}", task.display()))?;
+        }
+        crate::safe_io::real_dir(&self.dir).with_context(|| format!("{}", self.dir.display()))?;
         let base = format!("{}-{file_name}", self.prefix);
         let mut k = 1;
         let (name, metadata) = loop {
@@ -52,6 +57,7 @@ impl LibraryCopies {
                 match std::fs::OpenOptions::new()
                     .write(true)
                     .create_new(true)
+                    .custom_flags(libc::O_NOFOLLOW)
                     .open(&metadata)
                 {
                     Ok(_) => break (name, metadata),

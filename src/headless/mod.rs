@@ -48,7 +48,7 @@ use crate::results::{self, assemble, records, Ending, Status, Summary};
 use crate::trainer::Command;
 
 use observer::ResultFiles;
-use output::prepare_output;
+use output::open_output;
 
 /// Where results go and whether old ones may be replaced.
 #[derive(Debug, Clone)]
@@ -83,16 +83,19 @@ pub fn run(
     commands: &Receiver<Command>,
 ) -> Result<Summary> {
     let created = !output.dir.exists();
-    let replaced = prepare_output(output)?;
+    let (lock, replaced) = open_output(output)?;
     let summary = protocol(config, &output.dir, options, None, commands);
     if summary.is_err() && created {
         // Refused before anything was written (a library that cannot load, a config the
         // library cannot take): leave no empty folder behind. A folder holding anything is
         // kept: it is a failed run's record.
+        drop(lock);
+        let _ = std::fs::remove_file(output.dir.join(crate::folder_lock::LOCK_FILE));
         let _ = std::fs::remove_dir(&output.dir);
     }
     // Delete last: the old results go only once the new ones are written.
     if let (Ok(_), Some(replaced)) = (&summary, &replaced) {
+        crate::failpoint::point("replaced-deleting");
         if let Err(err) = std::fs::remove_dir_all(replaced) {
             eprintln!(
                 "warning: the results --force replaced could not all be deleted from {}: {err}",
@@ -120,6 +123,13 @@ pub fn resume(
     options: &RunOptions,
     commands: &Receiver<Command>,
 ) -> Result<Summary> {
+    if !dir.is_dir() {
+        bail!(
+            "--out {}: no such results directory to resume (it would hold summary.json)",
+            dir.display()
+        );
+    }
+    let _lock = crate::folder_lock::FolderLock::acquire(dir, "a resume")?;
     let mut header = results::read_header(dir)?;
     if let Some(runs) = runs {
         let had = header.config.protocol.runs;
@@ -219,11 +229,13 @@ fn protocol(
     let runs_dir = out.join(records::RUNS);
     std::fs::create_dir_all(&runs_dir)
         .with_context(|| format!("creating {}", runs_dir.display()))?;
+    crate::failpoint::point("runs-created");
     let mut summary = Summary::new(config, options.trace);
     summary.library.clone_from(&library);
     summary.unfinished = records::unfinished(config, &kept);
     summary.runs = kept.into_iter().map(|f| f.summary).collect();
     results::write_json(&out.join("summary.json"), &summary)?;
+    crate::failpoint::point("summary-started");
 
     let names = plan
         .sources

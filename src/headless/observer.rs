@@ -136,6 +136,7 @@ impl Observer for ResultFiles {
             RunSummary::new(record, &writer.rewards, self.config.protocol.moving_average);
         summary.library_copy = library_copy;
         writer.finish(&self.out, &summary)?;
+        crate::failpoint::point("run-recorded");
 
         let runs = &mut self.summary.runs;
         runs.push(summary);

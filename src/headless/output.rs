@@ -1,13 +1,16 @@
-//! The results directory before a protocol writes to it: created, and refused if it
-//! holds results, unless they are to be replaced (`--force`: moved aside, deleted last).
+//! The results directory before a protocol writes to it: created, locked for this
+//! process, and refused if it holds results, unless they are to be replaced (`--force`:
+//! moved aside, deleted last); what a killed protocol or `--force` left is finished or
+//! cleared first.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 
 use super::OutputOptions;
+use crate::folder_lock::FolderLock;
 use crate::report;
-use crate::results::records;
+use crate::results::{self, records, Status};
 
 /// Entries that mark a directory as holding results already.
 const RESULT_FILES: [&str; 7] = [
@@ -23,10 +26,16 @@ const RESULT_FILES: [&str; 7] = [
 /// Where `--force` moves the results it replaces until the new ones are written.
 const REPLACED: &str = ".replaced";
 
-/// Creates the output directory and refuses to mix new results with old ones. With
-/// `force`, the old results are moved into `<dir>/.replaced/` (returned), to be deleted
-/// once the new ones are written: a directory where nothing can be written loses nothing.
-pub(super) fn prepare_output(output: &OutputOptions) -> Result<Option<PathBuf>> {
+/// In `.replaced/` once every old result is in it: without it, a `--force` was killed
+/// while moving them, and they are put back first.
+const MOVED: &str = ".moved";
+
+/// The output directory, created and locked for this process ([`FolderLock`]: a second
+/// process into the same `--out` is refused naming the first), holding no results but
+/// those `--force` replaces: moved into `<dir>/.replaced/` (returned), to be deleted once
+/// the new ones are written, so that a directory where nothing can be written loses
+/// nothing.
+pub(super) fn open_output(output: &OutputOptions) -> Result<(FolderLock, Option<PathBuf>)> {
     let dir = &output.dir;
     if dir.exists() && !dir.is_dir() {
         bail!(
@@ -36,13 +45,33 @@ pub(super) fn prepare_output(output: &OutputOptions) -> Result<Option<PathBuf>> 
     }
     std::fs::create_dir_all(dir)
         .with_context(|| format!("creating the output directory {}", dir.display()))?;
+    let lock = FolderLock::acquire(dir, "a protocol")?;
+    let replaced = dir.join(REPLACED);
+    if replaced.exists() {
+        finish_interrupted_replacement(dir, &replaced)?;
+    }
+    if replaced.exists() {
+        // Kept: the results an earlier --force was replacing when it was killed; the top
+        // level holds a partial replacement.
+        if !output.force {
+            bail!(
+                "{} holds results an interrupted --force was replacing (kept in {}); pass \
+                 --force to replace them, or move them back by hand",
+                dir.display(),
+                replaced.display()
+            );
+        }
+        remove_results(dir)?;
+        return Ok((lock, Some(replaced)));
+    }
+    clear_killed_start(dir)?;
     let existing: Vec<&str> = RESULT_FILES
         .into_iter()
         .chain(["comparison.csv"])
-        .filter(|f| dir.join(f).exists())
+        .filter(|f| std::fs::symlink_metadata(dir.join(f)).is_ok())
         .collect();
     if existing.is_empty() {
-        return Ok(None);
+        return Ok((lock, None));
     }
     if !output.force {
         bail!(
@@ -51,12 +80,6 @@ pub(super) fn prepare_output(output: &OutputOptions) -> Result<Option<PathBuf>> 
             dir.display(),
             existing.join(", ")
         );
-    }
-    let replaced = dir.join(REPLACED);
-    if replaced.exists() {
-        // A replacement that never finished: its results were replaced already.
-        std::fs::remove_dir_all(&replaced)
-            .with_context(|| format!("removing {}", replaced.display()))?;
     }
     std::fs::create_dir(&replaced).with_context(|| {
         format!(
@@ -68,7 +91,7 @@ pub(super) fn prepare_output(output: &OutputOptions) -> Result<Option<PathBuf>> 
     let mut moved = Vec::new();
     for name in RESULT_FILES.iter().chain(report::FILES.iter()) {
         let (from, to) = (dir.join(name), replaced.join(name));
-        if !from.exists() {
+        if std::fs::symlink_metadata(&from).is_err() {
             continue;
         }
         if let Err(err) = std::fs::rename(&from, &to) {
@@ -86,8 +109,67 @@ pub(super) fn prepare_output(output: &OutputOptions) -> Result<Option<PathBuf>> 
             });
         }
         moved.push((from, to));
+        crate::failpoint::point("force-moving");
     }
-    Ok(Some(replaced))
+    std::fs::write(replaced.join(MOVED), "")
+        .with_context(|| format!("writing {}", replaced.join(MOVED).display()))?;
+    crate::failpoint::point("force-moved");
+    Ok((lock, Some(replaced)))
+}
+
+/// An earlier `--force` was killed. Killed while moving the old results aside (no
+/// [`MOVED`] mark), they are put back; killed after deleting them had begun — the new
+/// results complete — the rest of `.replaced` goes. Otherwise `.replaced` holds the old
+/// results whole and the folder's top level a partial replacement: `.replaced` is kept.
+fn finish_interrupted_replacement(dir: &Path, replaced: &Path) -> Result<()> {
+    if std::fs::symlink_metadata(replaced.join(MOVED)).is_err() {
+        for name in RESULT_FILES.iter().chain(report::FILES.iter()) {
+            let (from, to) = (replaced.join(name), dir.join(name));
+            if std::fs::symlink_metadata(&from).is_ok() && std::fs::symlink_metadata(&to).is_err() {
+                std::fs::rename(&from, &to)
+                    .with_context(|| format!("putting {} back", to.display()))?;
+            }
+        }
+        return std::fs::remove_dir_all(replaced)
+            .with_context(|| format!("removing {}", replaced.display()));
+    }
+    let complete = results::read_header(dir).is_ok_and(|h| h.status == Some(Status::Complete));
+    if complete {
+        std::fs::remove_dir_all(replaced)
+            .with_context(|| format!("removing {}", replaced.display()))?;
+    }
+    Ok(())
+}
+
+/// A protocol killed in its first instants leaves `runs/` with no finished record and no
+/// `summary.json` (or only its temporary): nothing to resume, nothing to keep.
+fn clear_killed_start(dir: &Path) -> Result<()> {
+    let runs = dir.join(records::RUNS);
+    if std::fs::symlink_metadata(dir.join("summary.json")).is_ok() || !runs.is_dir() {
+        return Ok(());
+    }
+    let recorded = std::fs::read_dir(&runs)
+        .with_context(|| format!("reading {}", runs.display()))?
+        .flatten()
+        .any(|e| e.path().join("run.json").exists());
+    if !recorded {
+        std::fs::remove_dir_all(&runs).with_context(|| format!("removing {}", runs.display()))?;
+    }
+    Ok(())
+}
+
+/// Removes every result from the folder's top level (a partial replacement's).
+fn remove_results(dir: &Path) -> Result<()> {
+    for name in RESULT_FILES.iter().chain(report::FILES.iter()) {
+        let path = dir.join(name);
+        match std::fs::symlink_metadata(&path) {
+            Ok(m) if m.is_dir() => std::fs::remove_dir_all(&path),
+            Ok(_) => std::fs::remove_file(&path),
+            Err(_) => continue,
+        }
+        .with_context(|| format!("removing {}", path.display()))?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -101,18 +183,18 @@ mod tests {
         std::fs::write(dir.join("episodes.csv"), "old").unwrap();
         std::fs::create_dir(dir.join("policies")).unwrap();
         std::fs::write(dir.join("policies/p.ron"), "old").unwrap();
-        let refused = prepare_output(&OutputOptions {
+        let refused = open_output(&OutputOptions {
             dir: dir.clone(),
             force: false,
         });
         assert!(format!("{:#}", refused.unwrap_err()).contains("--resume"));
 
-        let replaced = prepare_output(&OutputOptions {
+        let (_lock, replaced) = open_output(&OutputOptions {
             dir: dir.clone(),
             force: true,
         })
-        .unwrap()
         .unwrap();
+        let replaced = replaced.unwrap();
         assert!(!dir.join("episodes.csv").exists());
         assert_eq!(
             std::fs::read_to_string(replaced.join("policies/p.ron")).unwrap(),

@@ -4,9 +4,6 @@
 //! of `method` scores above a run of `over` with probability p"; an interval that holds
 //! 0.5 means these runs cannot tell which is better.
 
-use std::path::Path;
-
-use anyhow::{Context, Result};
 use serde::Serialize;
 
 use super::MethodRuns;
@@ -62,23 +59,23 @@ pub(super) fn every_pair(methods: &[MethodRuns]) -> Vec<Improvement> {
     rows
 }
 
-/// Writes `improvement.csv`.
-pub fn write_csv(path: &Path, rows: &[Improvement]) -> Result<()> {
-    let mut csv =
-        csv::Writer::from_path(path).with_context(|| format!("creating {}", path.display()))?;
-    csv.write_record(["score", "method", "over", "p", "lo", "hi"])
-        .with_context(|| format!("writing {}", path.display()))?;
-    for row in rows {
-        csv.write_record([
-            row.score.to_string(),
-            row.method.clone(),
-            row.over.clone(),
-            format!("{:?}", row.p.point),
-            format!("{:?}", row.p.lo),
-            format!("{:?}", row.p.hi),
-        ])
-        .with_context(|| format!("writing {}", path.display()))?;
-    }
-    csv.flush()
-        .with_context(|| format!("writing {}", path.display()))
+/// The header and rows of `improvement.csv`.
+pub fn records(rows: &[Improvement]) -> (Vec<String>, Vec<Vec<String>>) {
+    let header = ["score", "method", "over", "p", "lo", "hi"]
+        .map(String::from)
+        .to_vec();
+    let records = rows
+        .iter()
+        .map(|row| {
+            vec![
+                row.score.to_string(),
+                row.method.clone(),
+                row.over.clone(),
+                format!("{:?}", row.p.point),
+                format!("{:?}", row.p.lo),
+                format!("{:?}", row.p.hi),
+            ]
+        })
+        .collect();
+    (header, records)
 }

@@ -192,7 +192,8 @@ impl Report {
     pub fn write(&self, dir: &Path) -> Result<()> {
         let (header, records) = comparison::csv_records(&self.comparison, self.units);
         write_rows(&dir.join("comparison.csv"), &header, &records)?;
-        improvement::write_csv(&dir.join("improvement.csv"), &self.improvement)?;
+        let (header, records) = improvement::records(&self.improvement);
+        write_rows(&dir.join("improvement.csv"), &header, &records)?;
         write_scores(&dir.join("scores.csv"), &self.scores)?;
         plots::write_intervals(dir, self)
     }
@@ -338,17 +339,18 @@ fn shares(library: &[LibraryEntry], runs: &[&RunSummary]) -> (Vec<f64>, Vec<(Str
     (source_shares, task_shares)
 }
 
-fn write_rows(path: &Path, header: &[String], records: &[Vec<String>]) -> Result<()> {
-    let mut csv =
-        csv::Writer::from_path(path).with_context(|| format!("creating {}", path.display()))?;
-    csv.write_record(header)
-        .with_context(|| format!("writing {}", path.display()))?;
-    for record in records {
-        csv.write_record(record)
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
-    csv.flush()
-        .with_context(|| format!("writing {}", path.display()))
+/// Writes a CSV file of `header` and `records` atomically: a kill or a full disk leaves
+/// the old file or none, never a part of the new one.
+pub fn write_rows(path: &Path, header: &[String], records: &[Vec<String>]) -> Result<()> {
+    crate::safe_io::write_atomically(path, |out| {
+        let mut csv = csv::Writer::from_writer(out);
+        csv.write_record(header)?;
+        for record in records {
+            csv.write_record(record)?;
+        }
+        csv.flush()
+    })
+    .with_context(|| format!("writing {}", path.display()))
 }
 
 /// `scores.csv`: one row per run, `method, run, task, test, return, episodes` and, when

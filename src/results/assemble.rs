@@ -5,8 +5,9 @@
 //! `comparison.csv`, `summary.json` and the plots.
 
 use std::collections::BTreeMap;
-use std::fs::{File, OpenOptions};
+use std::fs::OpenOptions;
 use std::io::{BufRead, BufReader, Write};
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
@@ -63,6 +64,7 @@ pub fn assemble(
         }
     }
 
+    crate::failpoint::point("csv-assembled");
     let rewards = rewards(&folders)?;
     let mut summary = Summary::new(config, trace);
     summary.status = ending.status;
@@ -84,11 +86,14 @@ pub fn assemble(
     // Everything the summary's status vouches for is on disk before it.
     if !summary.runs.is_empty() {
         report.write(out)?;
+        crate::failpoint::point("report-written");
         let data = replot::read(out)?;
         plots::write_all(out, &data)
             .with_context(|| format!("drawing the plots in {}", out.display()))?;
+        crate::failpoint::point("plots-drawn");
     }
     summary::write_json(&out.join("summary.json"), &summary)?;
+    crate::failpoint::point("summary-written");
     Ok(summary)
 }
 
@@ -96,15 +101,22 @@ pub fn assemble(
 /// every part, in order, each part's own header skipped; through a temporary file renamed
 /// into place.
 fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<()>) -> Result<()> {
-    let tmp = path.with_extension("csv.tmp");
+    let tmp = crate::safe_io::sibling(path, "tmp");
     create(&tmp)?;
+    // Opened again for appending, never through a link (create made a regular file).
     let mut file = OpenOptions::new()
         .append(true)
+        .custom_flags(libc::O_NOFOLLOW)
         .open(&tmp)
         .with_context(|| format!("writing {}", tmp.display()))?;
     for part in parts {
         let mut reader = BufReader::new(
-            File::open(part).with_context(|| format!("reading {}", part.display()))?,
+            crate::safe_io::open(
+                part,
+                crate::safe_io::Links::Refuse,
+                crate::safe_io::MAX_CSV_BYTES,
+            )
+            .with_context(|| format!("reading {}", part.display()))?,
         );
         let mut header = Vec::new();
         reader
@@ -128,8 +140,8 @@ pub fn rewards(folders: &[RunFolder]) -> Result<BTreeMap<(MethodId, u32), Vec<f6
     let mut rewards = BTreeMap::new();
     for folder in folders {
         let path = folder.dir.join("episodes.csv");
-        let mut reader =
-            csv::Reader::from_path(&path).with_context(|| format!("reading {}", path.display()))?;
+        let mut reader = crate::safe_io::csv_reader(&path)
+            .with_context(|| format!("reading {}", path.display()))?;
         let returns = reader
             .deserialize::<Row>()
             .enumerate()

@@ -241,7 +241,8 @@ impl TraceWriter {
 
 /// A new CSV file at `path` with its header already on disk; rows are written by hand.
 fn with_header(path: &Path, header: &[impl AsRef<[u8]>]) -> Result<csv::Writer<File>> {
-    let file = File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    let file =
+        crate::safe_io::create(path).with_context(|| format!("creating {}", path.display()))?;
     let mut csv = csv::WriterBuilder::new()
         .has_headers(false)
         .from_writer(file);

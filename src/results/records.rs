@@ -20,6 +20,9 @@ use crate::trainer::{self, EpisodeRecord, MethodId, RunRecord, TraceRecord};
 /// The folder of all run records in a results directory.
 pub const RUNS: &str = "runs";
 
+/// The largest `run.json`: a run's totals and test returns take a few kilobytes.
+const MAX_RECORD_BYTES: u64 = 16 << 20;
+
 /// `dqn[100,100]`, run 0 → `dqn-100-100-run0`: a plain file name, of the run's folder and
 /// of its trained policy. A label too long for a file name (a deep network's) is cut and
 /// told apart by a hash of the whole.
@@ -67,12 +70,15 @@ impl RunWriter {
     pub fn create(out: &Path, method: &MethodId, run: u32, names: &[String]) -> Result<Self> {
         let name = run_name(method.label(), run);
         let partial = partial_dir(out, &name);
-        if partial.exists() {
+        let runs = out.join(RUNS);
+        crate::safe_io::real_dir(&runs).with_context(|| format!("{}", runs.display()))?;
+        // remove_dir_all removes a planted link itself, never what it points to.
+        if std::fs::symlink_metadata(&partial).is_ok() {
             std::fs::remove_dir_all(&partial)
+                .or_else(|_| std::fs::remove_file(&partial))
                 .with_context(|| format!("removing the partial record {}", partial.display()))?;
         }
-        std::fs::create_dir_all(&partial)
-            .with_context(|| format!("creating {}", partial.display()))?;
+        std::fs::create_dir(&partial).with_context(|| format!("creating {}", partial.display()))?;
         let activations = if method.kind.reuses() && !names.is_empty() {
             Some(files::ActivationsWriter::create(
                 &partial.join("activations.csv"),
@@ -155,8 +161,9 @@ impl RunWriter {
         }
         summary::write_json(&self.partial.join("run.json"), summary)?;
         let finished = finished_dir(out, &self.name);
-        if finished.exists() {
+        if std::fs::symlink_metadata(&finished).is_ok() {
             std::fs::remove_dir_all(&finished)
+                .or_else(|_| std::fs::remove_file(&finished))
                 .with_context(|| format!("replacing {}", finished.display()))?;
         }
         std::fs::rename(&self.partial, &finished)
@@ -183,21 +190,36 @@ pub fn read(out: &Path, config: &Config) -> Result<Vec<RunFolder>> {
         .into_iter()
         .map(|id| (id.label().to_string(), id))
         .collect();
-    let mut folders = Vec::new();
+    let mut folders: Vec<RunFolder> = Vec::new();
     for entry in entries {
-        let path = entry
-            .with_context(|| format!("reading {}", dir.display()))?
-            .path();
+        let entry = entry.with_context(|| format!("reading {}", dir.display()))?;
+        let path = entry.path();
         let hidden = path
             .file_name()
             .and_then(|n| n.to_str())
             .is_none_or(|n| n.starts_with('.'));
-        if hidden || !path.is_dir() {
+        let kind = entry
+            .file_type()
+            .with_context(|| format!("reading {}", path.display()))?;
+        if hidden {
             continue;
         }
+        if kind.is_symlink() {
+            bail!(
+                "{}: a symbolic link among the run records: a results folder's records are \
+                 its own directories, never links to elsewhere",
+                path.display()
+            );
+        }
         let json = path.join("run.json");
-        let text = std::fs::read_to_string(&json)
-            .with_context(|| format!("reading the run record {}", json.display()))?;
+        // A folder without its record is what a failed removal or a kill between its
+        // creation and its rename leaves: not a run, run again by a resume.
+        if !kind.is_dir() || std::fs::symlink_metadata(&json).is_err() {
+            continue;
+        }
+        let text =
+            crate::safe_io::read_text(&json, crate::safe_io::Links::Refuse, MAX_RECORD_BYTES)
+                .with_context(|| format!("reading the run record {}", json.display()))?;
         let stored: RunSummary<String> = serde_json::from_str(&text)
             .with_context(|| format!("reading the run record {}", json.display()))?;
         let Some(id) = ids.get(&stored.record.method) else {
@@ -207,6 +229,20 @@ pub fn read(out: &Path, config: &Config) -> Result<Vec<RunFolder>> {
                 stored.record.method
             );
         };
+        // A record is where its method and run put it, once, within the protocol.
+        let expected = run_name(id.label(), stored.record.run);
+        if stored.record.run >= config.protocol.runs
+            || path.file_name().and_then(|n| n.to_str()) != Some(expected.as_str())
+        {
+            bail!(
+                "{}: the record of {} run {} belongs in {} (runs 0 to {} of this protocol)",
+                json.display(),
+                stored.record.method,
+                stored.record.run,
+                dir.join(&expected).display(),
+                config.protocol.runs.saturating_sub(1)
+            );
+        }
         folders.push(RunFolder {
             summary: stored.with_method(id.clone()),
             dir: path,
@@ -259,7 +295,9 @@ pub fn clear_unfinished(out: &Path, finished: &[RunFolder]) -> Result<()> {
                 .file_name()
                 .and_then(|n| n.to_str())
                 .is_some_and(|n| n.starts_with('.') && n.ends_with(".partial"));
-            if partial {
+            let unrecorded = entry.file_type().is_ok_and(|t| t.is_dir())
+                && std::fs::symlink_metadata(path.join("run.json")).is_err();
+            if partial || unrecorded {
                 std::fs::remove_dir_all(&path)
                     .with_context(|| format!("removing {}", path.display()))?;
             }

@@ -161,7 +161,7 @@ fn by_run(rows: impl IntoIterator<Item = (String, u32, u32, f64)>) -> ByRun {
 
 fn rows<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {
     let mut reader =
-        csv::Reader::from_path(path).with_context(|| format!("reading {}", path.display()))?;
+        crate::safe_io::csv_reader(path).with_context(|| format!("reading {}", path.display()))?;
     reader
         .deserialize()
         .enumerate()
@@ -185,7 +185,7 @@ fn read_activations(path: &Path) -> Result<Activations> {
         return Ok(Activations::default());
     }
     let mut reader =
-        csv::Reader::from_path(path).with_context(|| format!("reading {}", path.display()))?;
+        crate::safe_io::csv_reader(path).with_context(|| format!("reading {}", path.display()))?;
     let headers = reader
         .headers()
         .with_context(|| format!("reading {}", path.display()))?

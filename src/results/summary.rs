@@ -2,7 +2,6 @@
 //! its library and every finished run; written when the protocol starts and after every
 //! run, always atomically.
 
-use std::fs::File;
 use std::io::Write;
 use std::path::Path;
 
@@ -100,23 +99,31 @@ impl Summary {
 /// What `summary.json` says of the protocol: its status, config and library.
 pub fn read_header(dir: &Path) -> Result<SummaryHeader> {
     let path = dir.join("summary.json");
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("reading {} (is this a results directory?)", path.display()))?;
-    serde_json::from_str(&text).with_context(|| format!("reading {}", path.display()))
+    let text = crate::safe_io::read_text(&path, crate::safe_io::Links::Refuse, MAX_SUMMARY_BYTES)
+        .with_context(|| {
+        format!("reading {} (is this a results directory?)", path.display())
+    })?;
+    let header: SummaryHeader =
+        serde_json::from_str(&text).with_context(|| format!("reading {}", path.display()))?;
+    // The config a folder carries is checked as `--config` is: what a resume builds from
+    // it (run folders named by method labels, a library named by `sources.name`) must stay
+    // inside the folders it names.
+    header
+        .config
+        .validate()
+        .map_err(|e| anyhow::anyhow!("{}: the stored config: {e}", path.display()))?;
+    Ok(header)
 }
+
+/// The largest `summary.json` read: every run's totals, a few kilobytes each, for the most
+/// runs a protocol may have.
+const MAX_SUMMARY_BYTES: u64 = 1 << 30;
 
 /// Writes `summary` (or a run's `run.json`) atomically: a reader never sees half a file.
 pub fn write_json(path: &Path, summary: &impl Serialize) -> Result<()> {
-    let tmp = path.with_extension("json.tmp");
-    let write = || -> std::io::Result<()> {
-        let mut file = File::create(&tmp)?;
-        serde_json::to_writer_pretty(&mut file, summary)?;
-        file.write_all(b"\n")?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    };
-    write().map_err(|err| {
-        let _ = std::fs::remove_file(&tmp);
-        anyhow::Error::new(err).context(format!("writing {}", path.display()))
+    crate::safe_io::write_atomically(path, |out| {
+        serde_json::to_writer_pretty(&mut *out, summary)?;
+        out.write_all(b"\n")
     })
+    .with_context(|| format!("writing {}", path.display()))
 }

@@ -210,7 +210,7 @@ pub fn read(dir: &Path) -> Result<Option<Manifest>, StoreError> {
     if !path.exists() {
         return Ok(None);
     }
-    let text = crate::config::read_text(&path)?;
+    let text = crate::config::read_folder_text(&path)?;
     Ok(Some(parse_ron_as(
         &text,
         &path.display().to_string(),

@@ -33,9 +33,12 @@ pub fn train_library(
         .map(|(i, source)| source_spec(config, i, source))
         .collect();
     crate::experiment::memory::check(&specs, 1)?;
+    crate::safe_io::real_dir(&dir)
+        .with_context(|| format!("the library folder {}", dir.display()))?;
+    // One trainer per library: a second `sapnet sources` (or a run training a missing
+    // library) into the same folder is refused while this one trains.
+    let _lock = crate::folder_lock::FolderLock::acquire(&dir, "library training")?;
     let kept = resumable(&dir, &training, &plans, retrain)?;
-    std::fs::create_dir_all(&dir)
-        .with_context(|| format!("creating the library folder {}", dir.display()))?;
     crate::policy_store::remove_temporaries(&dir)
         .with_context(|| format!("removing a killed save's leftovers from {}", dir.display()))?;
     let mut manifest = Manifest {

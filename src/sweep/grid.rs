@@ -23,6 +23,9 @@ use serde_json::Value;
 
 use crate::config::{parse_ron, read_text, Config};
 
+/// The most cells a grid may expand into.
+pub const MAX_CELLS: usize = 100_000;
+
 /// The grid file.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -100,19 +103,45 @@ impl Grid {
             if axes.iter().any(|(path, _)| path == "seed") {
                 bail!("{origin}: `seeds` and an axis `seed` both set the seed; keep one");
             }
+            if n == 0 || n > MAX_CELLS as u64 || base.seed.checked_add(n - 1).is_none() {
+                bail!(
+                    "{origin}: field `seeds`: expected Some(n) with 1 ≤ n ≤ {MAX_CELLS} (and the \
+                     base seed {} + n − 1 a 64-bit seed), got Some({n})",
+                    base.seed
+                );
+            }
             axes.push((
                 "seed".into(),
                 (0..n).map(|k| (base.seed + k).to_string()).collect(),
             ));
         }
-        for (path, values) in &axes {
+        for (i, (path, values)) in axes.iter().enumerate() {
             if values.is_empty() {
                 bail!("{origin}: axis `{path}` has no values");
             }
+            if axes[..i].iter().any(|(p, _)| p == path) {
+                bail!(
+                    "{origin}: axes[{i}]: `{path}` is an axis already; one axis per field \
+                     (list every value in one)"
+                );
+            }
         }
+        let total = axes
+            .iter()
+            .try_fold(1usize, |n, (_, v)| n.checked_mul(v.len()))
+            .filter(|&n| n <= MAX_CELLS);
+        let Some(total) = total else {
+            bail!(
+                "{origin}: the axes make more than {MAX_CELLS} cells ({}): a sweep that large \
+                 is several sweeps",
+                axes.iter()
+                    .map(|(p, v)| format!("{} {p}", v.len()))
+                    .collect::<Vec<_>>()
+                    .join(" × ")
+            );
+        };
         let base_json = serde_json::to_value(&base).context("the base config as JSON")?;
         let mut cells = Vec::new();
-        let total: usize = axes.iter().map(|(_, v)| v.len()).product();
         for k in 0..total {
             // Mixed radix, the last axis fastest.
             let mut rest = k;

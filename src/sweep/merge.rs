@@ -23,7 +23,7 @@ use anyhow::{Context, Result};
 use super::{cell_name, cell_results, Manifest};
 use crate::config::{Config, Method};
 use crate::experiment::method_ids;
-use crate::report::{self, comparison, Curve, PlotData, Report, RunSummary, TaskRuns};
+use crate::report::{self, comparison, improvement, Curve, PlotData, Report, RunSummary, TaskRuns};
 use crate::results::{self, Results};
 use crate::trainer::MethodId;
 
@@ -43,7 +43,7 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
     let mut missing = Vec::new();
     for cell in &manifest.cells {
         let dir = cell_results(sweep, cell.id);
-        if dir.is_dir() {
+        if super::status::state(sweep, cell.id) == super::status::CellState::Done {
             let results = results::read_results(&dir)
                 .with_context(|| format!("reading cell {}", cell_name(cell.id)))?;
             done.push((cell, results));
@@ -58,11 +58,15 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
         sweep.display(),
         sweep.display()
     );
-    let out = sweep.join("merged");
-    if out.exists() {
-        std::fs::remove_dir_all(&out).with_context(|| format!("replacing {}", out.display()))?;
+    let _lock = crate::folder_lock::FolderLock::acquire(sweep, "a sweep merge")?;
+    // Written whole into a hidden folder, renamed over `merged/` last: a killed merge
+    // leaves the previous merge or none, never a part that looks finished.
+    let merged = sweep.join("merged");
+    let out = sweep.join(".merged.partial");
+    if std::fs::symlink_metadata(&out).is_ok() {
+        std::fs::remove_dir_all(&out).with_context(|| format!("removing {}", out.display()))?;
     }
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    std::fs::create_dir(&out).with_context(|| format!("creating {}", out.display()))?;
     let axes: Vec<String> = manifest
         .cells
         .first()
@@ -71,13 +75,15 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
 
     // Every episode, long format.
     let episodes = out.join("episodes.csv");
-    let mut writer = csv::Writer::from_path(&episodes)
-        .with_context(|| format!("creating {}", episodes.display()))?;
+    let mut writer = csv::Writer::from_writer(
+        crate::safe_io::create(&episodes)
+            .with_context(|| format!("creating {}", episodes.display()))?,
+    );
     let mut header_written = false;
     for (cell, _) in &done {
         let path = cell_results(sweep, cell.id).join("episodes.csv");
-        let mut reader =
-            csv::Reader::from_path(&path).with_context(|| format!("reading {}", path.display()))?;
+        let mut reader = crate::safe_io::csv_reader(&path)
+            .with_context(|| format!("reading {}", path.display()))?;
         if !header_written {
             let mut header = vec!["cell".to_string()];
             header.extend(axes.iter().cloned());
@@ -142,25 +148,8 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
         let lead = [axis.clone(), value.clone(), group.len().to_string()];
         let (header, records) = comparison::csv_records(&report.comparison, report.units);
         comparisons.extend(&["axis", "value", "cells"], &lead, &header, records);
-        improvements.extend(
-            &["axis", "value"],
-            &lead[..2],
-            &["score", "method", "over", "p", "lo", "hi"].map(String::from),
-            report
-                .improvement
-                .iter()
-                .map(|r| {
-                    vec![
-                        r.score.to_string(),
-                        r.method.clone(),
-                        r.over.clone(),
-                        format!("{:?}", r.p.point),
-                        format!("{:?}", r.p.lo),
-                        format!("{:?}", r.p.hi),
-                    ]
-                })
-                .collect(),
-        );
+        let (header, records) = improvement::records(&report.improvement);
+        improvements.extend(&["axis", "value"], &lead[..2], &header, records);
         let dir = if axis == ACROSS_TASKS {
             out.join(ACROSS_TASKS_FOLDER)
         } else {
@@ -193,6 +182,14 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
     }
     comparisons.write(&out.join("comparison.csv"))?;
     improvements.write(&out.join("improvement.csv"))?;
+    crate::failpoint::point("merge-written");
+    if std::fs::symlink_metadata(&merged).is_ok() {
+        std::fs::remove_dir_all(&merged)
+            .or_else(|_| std::fs::remove_file(&merged))
+            .with_context(|| format!("replacing {}", merged.display()))?;
+    }
+    std::fs::rename(&out, &merged)
+        .with_context(|| format!("renaming {} into place", out.display()))?;
     Ok(MergeReport {
         merged: done.len(),
         missing,
@@ -252,23 +249,21 @@ impl Table {
     }
 
     fn write(&self, path: &Path) -> Result<()> {
-        let mut csv =
-            csv::Writer::from_path(path).with_context(|| format!("creating {}", path.display()))?;
-        csv.write_record(&self.header)?;
-        for row in &self.rows {
-            let record: Vec<&str> = self
-                .header
-                .iter()
-                .map(|h| {
-                    row.iter()
-                        .find(|(n, _)| n == h)
-                        .map_or("", |(_, v)| v.as_str())
-                })
-                .collect();
-            csv.write_record(record)?;
-        }
-        csv.flush()
-            .with_context(|| format!("writing {}", path.display()))
+        let records: Vec<Vec<String>> = self
+            .rows
+            .iter()
+            .map(|row| {
+                self.header
+                    .iter()
+                    .map(|h| {
+                        row.iter()
+                            .find(|(n, _)| n == h)
+                            .map_or(String::new(), |(_, v)| v.clone())
+                    })
+                    .collect()
+            })
+            .collect();
+        report::write_rows(path, &self.header, &records)
     }
 }
 

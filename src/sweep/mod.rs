@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::config::{parse_ron_as, read_text, ron_options};
+use crate::config::{parse_ron_as, read_folder_text, ron_options};
 
 /// `SWEEP/sweep.ron`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -57,7 +57,7 @@ pub struct CellEntry {
 impl Manifest {
     pub fn read(sweep: &Path) -> Result<Self> {
         let path = sweep.join("sweep.ron");
-        let text = read_text(&path)
+        let text = read_folder_text(&path)
             .with_context(|| format!("{} is not a sweep (sapnet sweep plan)", sweep.display()))?;
         Ok(parse_ron_as(
             &text,
@@ -94,6 +94,13 @@ pub fn cell_partial(sweep: &Path, id: usize) -> PathBuf {
     sweep
         .join("results")
         .join(format!(".{}.partial", cell_name(id)))
+}
+
+/// The lock a cell is run under (beside its results, which it must outlive).
+pub fn cell_lock(sweep: &Path, id: usize) -> PathBuf {
+    sweep
+        .join("results")
+        .join(format!(".{}.lock", cell_name(id)))
 }
 
 pub fn cell_failure(sweep: &Path, id: usize) -> PathBuf {

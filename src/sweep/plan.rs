@@ -84,8 +84,8 @@ pub fn plan(options: &PlanOptions) -> Result<Manifest> {
         return Ok(found);
     }
     for dir in ["cells", "results", "failed", "logs"] {
-        std::fs::create_dir_all(sweep.join(dir))
-            .with_context(|| format!("creating {}", sweep.join(dir).display()))?;
+        crate::safe_io::real_dir(&sweep.join(dir))
+            .with_context(|| format!("{}", sweep.join(dir).display()))?;
     }
     for (id, text) in texts.iter().enumerate() {
         write_atomically(&cell_config(&sweep, id), text.as_bytes())?;
@@ -105,40 +105,72 @@ pub fn plan(options: &PlanOptions) -> Result<Manifest> {
     Ok(manifest)
 }
 
-/// An array job with one task per cell, one CPU each, a log pair per cell.
+/// An array job with one task per cell, one CPU each, a log pair per cell. Every path is
+/// shell-quoted: a sweep folder named `a b` or `$(…)` is a name, never a command.
 pub fn slurm_script(exe: &Path, sweep: &Path, cells: usize) -> String {
-    let (exe, sweep) = (exe.display(), sweep.display());
+    let (exe, sweep_q) = (quote(exe), quote(sweep));
+    // `#SBATCH` lines are read by sbatch, not the shell: a path with a space or a quote
+    // cannot be said there, so the logs go to the working directory's default and are
+    // named in the script's first lines instead.
+    let logs = if plain(sweep) {
+        format!(
+            "#SBATCH --output={s}/logs/%a.out\n#SBATCH --error={s}/logs/%a.err\n",
+            s = sweep.display()
+        )
+    } else {
+        String::new()
+    };
     format!(
         "#!/bin/bash\n\
-         # The {cells} cells of {sweep} as a Slurm array job: `sbatch {sweep}/slurm.sbatch`.\n\
+         # The {cells} cells of {sweep_q} as a Slurm array job: `sbatch {sweep_q}/slurm.sbatch`.\n\
          # Throttle with `sbatch --array=0-{last}%8 …`; rerun only some cells by their\n\
-         # numbers, e.g. `sbatch --array=0,{last} …` (`sapnet sweep status {sweep}` lists\n\
+         # numbers, e.g. `sbatch --array=0,{last} …` (`sapnet sweep status {sweep_q}` lists\n\
          # what failed).\n\
          #SBATCH --job-name=sapnet-sweep\n\
          #SBATCH --array=0-{last}\n\
          #SBATCH --cpus-per-task=1\n\
-         #SBATCH --output={sweep}/logs/%a.out\n\
-         #SBATCH --error={sweep}/logs/%a.err\n\
-         exec {exe} sweep run {sweep} --jobs 1\n",
+         {logs}\
+         exec {exe} sweep run {sweep_q} --jobs 1\n",
         last = cells.saturating_sub(1)
     )
 }
 
-/// GNU parallel command lines: here, over machines, and rerunning what failed.
+/// GNU parallel command lines: here, over machines, and rerunning what failed. `-q`
+/// (`--quote`) passes the quoted paths to each job as the words they are (without it,
+/// parallel joins the command's words and a shell splits them again).
 pub fn parallel_lines(exe: &Path, sweep: &Path, cells: usize) -> String {
-    let (exe, sweep) = (exe.display(), sweep.display());
+    let (exe, sweep) = (quote(exe), quote(sweep));
     let last = cells.saturating_sub(1);
+    let log = quote_joined(&sweep, "/parallel.log");
     format!(
         "# The {cells} cells of {sweep} with GNU parallel, one core each, on this machine:\n\
-         parallel --joblog {sweep}/parallel.log -j 2 {exe} sweep run {sweep} --cell {{}} --jobs 1 ::: $(seq 0 {last})\n\
+         parallel -q --joblog {log} -j 2 {exe} sweep run {sweep} --cell {{}} --jobs 1 ::: $(seq 0 {last})\n\
          # Over machines that share the sweep folder (and have sapnet at the same path):\n\
-         parallel --joblog {sweep}/parallel.log --sshloginfile HOSTS {exe} sweep run {sweep} --cell {{}} --jobs 1 ::: $(seq 0 {last})\n\
+         parallel -q --joblog {log} --sshloginfile HOSTS {exe} sweep run {sweep} --cell {{}} --jobs 1 ::: $(seq 0 {last})\n\
          # Rerun only the cells that failed (a finished cell is skipped anyway):\n\
-         parallel --retry-failed --joblog {sweep}/parallel.log\n"
+         parallel --retry-failed --joblog {log}\n"
     )
 }
 
-fn absolute(path: &Path) -> Result<PathBuf> {
+/// `path` as one shell word: in single quotes, each `'` written `'\''`.
+pub fn quote(path: &Path) -> String {
+    format!("'{}'", path.display().to_string().replace('\'', "'\\''"))
+}
+
+/// A quoted word with `tail` appended inside its quotes.
+fn quote_joined(quoted: &str, tail: &str) -> String {
+    format!("{}{tail}'", &quoted[..quoted.len() - 1])
+}
+
+/// Whether `path` needs no quoting anywhere (letters, digits and `/._-+,=:@`).
+fn plain(path: &Path) -> bool {
+    path.display()
+        .to_string()
+        .chars()
+        .all(|c| c.is_ascii_alphanumeric() || "/._-+,=:@".contains(c))
+}
+
+pub(super) fn absolute(path: &Path) -> Result<PathBuf> {
     if path.is_absolute() {
         return Ok(path.to_path_buf());
     }

@@ -11,8 +11,11 @@ use std::time::Duration;
 use anyhow::{bail, Context, Result};
 
 use super::status::{state, CellState};
-use super::{cell_config, cell_failure, cell_name, cell_partial, cell_results, Manifest};
+use super::{
+    cell_config, cell_failure, cell_lock, cell_name, cell_partial, cell_results, Manifest,
+};
 use crate::config::Config;
+use crate::folder_lock::FolderLock;
 use crate::headless::{self, OutputOptions, RunOptions};
 use crate::policy_store::sha256_hex;
 use crate::sources::{self, LibraryRoot};
@@ -60,6 +63,15 @@ pub fn run_cell(
             manifest.cells.len().saturating_sub(1)
         );
     };
+    // One process per cell: a second `sweep run --cell K` (a requeued job, an orphan of a
+    // killed `--all`) is refused while the first runs, instead of deleting its partial.
+    let results = sweep.join("results");
+    crate::safe_io::real_dir(&results).with_context(|| format!("{}", results.display()))?;
+    let _lock = FolderLock::acquire_file(
+        &cell_lock(sweep, id),
+        &cell_results(sweep, id),
+        &format!("cell {}", cell_name(id)),
+    )?;
     if state(sweep, id) == CellState::Done {
         return Ok(CellRun::AlreadyDone);
     }
@@ -70,8 +82,10 @@ pub fn run_cell(
             // A failed attempt leaves its error, not a partial result that would read as
             // running.
             let _ = std::fs::remove_dir_all(cell_partial(sweep, id));
-            let _ = std::fs::create_dir_all(failure.parent().unwrap_or(sweep));
-            let _ = std::fs::write(&failure, format!("{err:#}\n"));
+            let failed = failure.parent().unwrap_or(sweep);
+            if crate::safe_io::real_dir(failed).is_ok() {
+                let _ = crate::safe_io::write_bytes(&failure, format!("{err:#}\n").as_bytes());
+            }
         }
         Ok(CellRun::Finished) => {
             let _ = std::fs::remove_file(&failure);
@@ -90,7 +104,7 @@ fn attempt(
 ) -> Result<CellRun> {
     let id = entry.id;
     let path = cell_config(sweep, id);
-    let text = crate::config::read_text(&path)?;
+    let text = crate::config::read_folder_text(&path)?;
     if sha256_hex(text.as_bytes()) != entry.config_sha256 {
         bail!(
             "{} changed after the sweep was planned (its SHA-256 differs from sweep.ron): \
@@ -101,8 +115,9 @@ fn attempt(
     }
     let config = Config::from_ron(&text, &path.display().to_string())?;
     let partial = cell_partial(sweep, id);
-    if partial.exists() {
+    if std::fs::symlink_metadata(&partial).is_ok() {
         std::fs::remove_dir_all(&partial)
+            .or_else(|_| std::fs::remove_file(&partial))
             .with_context(|| format!("removing the partial cell {}", partial.display()))?;
     }
     let output = OutputOptions {
@@ -133,15 +148,51 @@ fn attempt(
     if summary.stopped() {
         return Ok(CellRun::Stopped);
     }
+    // Done means every planned run is there, finished.
+    let planned = config.protocol.methods.len() * config.protocol.runs as usize;
+    let finished = summary.runs.iter().filter(|r| !r.record.stopped).count();
+    if summary.status != crate::results::Status::Complete || finished != planned {
+        bail!(
+            "cell {}: {finished} of its {planned} runs finished (status {:?}): not marked done",
+            cell_name(id),
+            summary.status
+        );
+    }
     let results = cell_results(sweep, id);
+    crate::failpoint::point("cell-finished");
     std::fs::rename(&partial, &results)
         .with_context(|| format!("renaming {} into place", partial.display()))?;
     Ok(CellRun::Finished)
 }
 
 /// Trains every library the cells reuse that is missing or unfinished, one after the other.
-pub fn prepare(sweep: &Path, stop: &Receiver<TrainerCommand>) -> Result<()> {
+/// Training writes a library where `sweep.ron` says, and a sweep folder may come from
+/// elsewhere: so a library that needs training is trained only into the `library` the
+/// user names (`--library`), which must be the sweep's.
+pub fn prepare(
+    sweep: &Path,
+    library: Option<&Path>,
+    stop: &Receiver<TrainerCommand>,
+) -> Result<()> {
     let manifest = Manifest::read(sweep)?;
+    let _lock = FolderLock::acquire(sweep, "a sweep prepare")?;
+    let confirmed = match library {
+        Some(given) => {
+            let given = super::plan::absolute(given)?;
+            if given != manifest.library {
+                bail!(
+                    "--library {}: the cells of {} reuse {} (sweep.ron); prepare trains that \
+                     library, or plan the sweep again with --library {}",
+                    given.display(),
+                    sweep.display(),
+                    manifest.library.display(),
+                    given.display()
+                );
+            }
+            true
+        }
+        None => false,
+    };
     let mut seen = Vec::new();
     for entry in &manifest.cells {
         let config = Config::from_file(&cell_config(sweep, entry.id))?;
@@ -160,6 +211,17 @@ pub fn prepare(sweep: &Path, stop: &Receiver<TrainerCommand>) -> Result<()> {
             continue;
         }
         seen.push((dir.clone(), training));
+        if !confirmed && sources::needs_training(&config, &manifest.library)? {
+            bail!(
+                "the library {} of cell {} needs training: `sapnet sweep prepare {} --library \
+                 {}` trains it (named on the command line, since a sweep folder from elsewhere \
+                 must not choose where sapnet writes)",
+                dir.display(),
+                entry.id,
+                super::plan::quote(sweep),
+                super::plan::quote(&manifest.library)
+            );
+        }
         let root = LibraryRoot {
             path: manifest.library.clone(),
             train_if_missing: true,
@@ -190,12 +252,16 @@ pub fn run_all(sweep: &Path, jobs: usize) -> Result<usize> {
     let mut running: Vec<(usize, Child)> = Vec::new();
     let mut said = String::new();
     let logs = sweep.join("logs");
-    std::fs::create_dir_all(&logs).with_context(|| format!("creating {}", logs.display()))?;
+    crate::safe_io::real_dir(&logs).with_context(|| format!("{}", logs.display()))?;
     loop {
         while running.len() < jobs.max(1) {
             let Some(id) = queue.next() else { break };
-            let log =
-                |ext: &str| std::fs::File::create(logs.join(format!("{}.{ext}", cell_name(id))));
+            // Created anew, never written through a link planted in the folder.
+            let log = |ext: &str| {
+                let path = logs.join(format!("{}.{ext}", cell_name(id)));
+                crate::safe_io::create(&path)
+                    .with_context(|| format!("creating {}", path.display()))
+            };
             let child = Command::new(&exe)
                 .args(["sweep", "run"])
                 .arg(sweep)

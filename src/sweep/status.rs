@@ -28,13 +28,20 @@ pub fn states(sweep: &Path) -> Result<Vec<(usize, CellState)>> {
 }
 
 pub fn state(sweep: &Path, id: usize) -> CellState {
-    if cell_results(sweep, id).is_dir() {
+    // A real directory each: a link planted in the folder is no cell's result.
+    let is_dir = |p: &Path| std::fs::symlink_metadata(p).is_ok_and(|m| m.is_dir());
+    if is_dir(&cell_results(sweep, id)) {
         return CellState::Done;
     }
-    if cell_partial(sweep, id).is_dir() {
+    if is_dir(&cell_partial(sweep, id)) {
         return CellState::Running;
     }
-    match std::fs::read_to_string(cell_failure(sweep, id)) {
+    let failure = crate::safe_io::read_text(
+        &cell_failure(sweep, id),
+        crate::safe_io::Links::Refuse,
+        crate::config::MAX_TEXT_BYTES,
+    );
+    match failure {
         Ok(text) => CellState::Failed(
             text.lines()
                 .rev()

@@ -7,11 +7,11 @@
 
 use std::path::Path;
 
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{colour_of, register_font, Drawn, FAMILY};
+use super::{atomically, colour_of, register_font, Drawn, FAMILY};
 use crate::config::MethodKind;
 use crate::report::{Aggregates, Report, Units};
 use crate::stats::{bootstrap, profile, Estimate};
@@ -25,17 +25,14 @@ pub fn write_intervals(dir: &Path, report: &Report) -> Result<()> {
     let improvement = (1200, 100 + 26 * methods);
     macro_rules! both {
         ($name:literal, $size:expr, $draw:expr) => {
-            for ext in ["png", "svg"] {
-                let path = dir.join(format!("{}.{ext}", $name));
-                let drawn = if ext == "png" {
-                    $draw(BitMapBackend::new(&path, $size).into_drawing_area(), report)
-                        .map_err(|e| e.to_string())
-                } else {
-                    $draw(SVGBackend::new(&path, $size).into_drawing_area(), report)
-                        .map_err(|e| e.to_string())
-                };
-                drawn.map_err(|e| anyhow!("{}: {e}", path.display()))?;
-            }
+            atomically(&dir.join(concat!($name, ".png")), |path| {
+                $draw(BitMapBackend::new(path, $size).into_drawing_area(), report)
+                    .map_err(|e| e.to_string())
+            })?;
+            atomically(&dir.join(concat!($name, ".svg")), |path| {
+                $draw(SVGBackend::new(path, $size).into_drawing_area(), report)
+                    .map_err(|e| e.to_string())
+            })?;
         };
     }
     both!("intervals", panels, aggregates);

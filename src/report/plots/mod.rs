@@ -60,30 +60,57 @@ pub struct SelectionHistory {
 /// activations, `activations.png` into `dir`.
 pub fn write_all(dir: &Path, data: &PlotData) -> Result<()> {
     register_font()?;
-    let png = dir.join("learning_curve.png");
-    curves::learning_curve(BitMapBackend::new(&png, SIZE).into_drawing_area(), data)
-        .map_err(|e| anyhow!("{}: {e}", png.display()))?;
-    let svg = dir.join("learning_curve.svg");
-    curves::learning_curve(SVGBackend::new(&svg, SIZE).into_drawing_area(), data)
-        .map_err(|e| anyhow!("{}: {e}", svg.display()))?;
-    let tests = dir.join("tests.png");
-    curves::test_bars(BitMapBackend::new(&tests, SIZE).into_drawing_area(), data)
-        .map_err(|e| anyhow!("{}: {e}", tests.display()))?;
+    atomically(&dir.join("learning_curve.png"), |path| {
+        curves::learning_curve(BitMapBackend::new(path, SIZE).into_drawing_area(), data)
+            .map_err(|e| e.to_string())
+    })?;
+    atomically(&dir.join("learning_curve.svg"), |path| {
+        curves::learning_curve(SVGBackend::new(path, SIZE).into_drawing_area(), data)
+            .map_err(|e| e.to_string())
+    })?;
+    atomically(&dir.join("tests.png"), |path| {
+        curves::test_bars(BitMapBackend::new(path, SIZE).into_drawing_area(), data)
+            .map_err(|e| e.to_string())
+    })?;
     if !data.activations.is_empty() {
-        let path = dir.join("activations.png");
-        library::activation_lines(BitMapBackend::new(&path, SIZE).into_drawing_area(), data)
-            .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        atomically(&dir.join("activations.png"), |path| {
+            library::activation_lines(BitMapBackend::new(path, SIZE).into_drawing_area(), data)
+                .map_err(|e| e.to_string())
+        })?;
     }
     if !data.acted.is_empty() {
-        let path = dir.join("selections.png");
         let height = 220 * data.acted.len() as u32 + 60;
-        library::selection_shares(
-            BitMapBackend::new(&path, (SIZE.0, height)).into_drawing_area(),
-            data,
-        )
-        .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        atomically(&dir.join("selections.png"), |path| {
+            library::selection_shares(
+                BitMapBackend::new(path, (SIZE.0, height)).into_drawing_area(),
+                data,
+            )
+            .map_err(|e| e.to_string())
+        })?;
     }
     Ok(())
+}
+
+/// Draws `path` by `draw`ing into a hidden sibling renamed over it: a kill or a full disk
+/// leaves the old plot or none, never a truncated one. (The backends open the file
+/// themselves: whatever a folder holds at the sibling's name, a planted link included, is
+/// removed first.)
+pub(super) fn atomically(
+    path: &Path,
+    draw: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<()> {
+    let tmp = crate::safe_io::sibling(path, "tmp");
+    let result = (|| {
+        if std::fs::symlink_metadata(&tmp).is_ok() {
+            std::fs::remove_file(&tmp).map_err(|e| e.to_string())?;
+        }
+        draw(&tmp)?;
+        std::fs::rename(&tmp, path).map_err(|e| e.to_string())
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
 pub(super) fn register_font() -> Result<()> {

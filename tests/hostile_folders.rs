@@ -1,0 +1,814 @@
+//! Folders from elsewhere and processes side by side (issue 24): each test builds the
+//! hostile or careless folder itself — a doctored summary, planted links, a second process,
+//! a kill at every write point, FIFOs, NaN weights, counts that cannot be allocated — and
+//! checks that sapnet writes nothing outside, corrupts nothing, and says why with exit 2.
+
+use std::os::unix::fs::symlink;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn sapnet() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_sapnet"))
+}
+
+fn configs(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/configs")
+        .join(name)
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+fn ok(output: Output) -> Output {
+    assert!(output.status.success(), "{}", stderr(&output));
+    output
+}
+
+/// Refused with exit 2 and a message holding `says`.
+fn refused(output: Output, says: &str) {
+    assert_eq!(output.status.code(), Some(2), "{}", stderr(&output));
+    assert!(
+        stderr(&output).contains(says),
+        "expected {says:?}: {}",
+        stderr(&output)
+    );
+}
+
+/// A headless DQN protocol (short_cartpole.ron: no library) into `out`, with `args`.
+fn dqn(out: &Path, args: &[&str]) -> Command {
+    let mut command = sapnet();
+    command
+        .args(["--headless", "--config"])
+        .arg(configs("short_cartpole.ron"))
+        .arg("--out")
+        .arg(out)
+        .args(args);
+    command
+}
+
+/// The tiny source library, trained for a test.
+fn library(tmp: &Path) -> PathBuf {
+    let library = tmp.join("lib");
+    ok(sapnet()
+        .args(["sources", "--config"])
+        .arg(configs("tiny_sources.ron"))
+        .arg("--library")
+        .arg(&library)
+        .output()
+        .unwrap());
+    library
+}
+
+/// The files whose every byte the seed decides (episodes without their wall time).
+fn numbers(out: &Path) -> Vec<String> {
+    [
+        "episodes.csv",
+        "tests.csv",
+        "comparison.csv",
+        "improvement.csv",
+        "scores.csv",
+    ]
+    .iter()
+    .map(|f| {
+        let text = std::fs::read_to_string(out.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+        if *f == "episodes.csv" {
+            text.lines()
+                .map(|l| l.rsplit_once(',').unwrap().0.to_string())
+                .collect::<Vec<_>>()
+                .join("\n")
+        } else {
+            text
+        }
+    })
+    .collect()
+}
+
+fn status(out: &Path) -> String {
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    summary["status"].as_str().unwrap().to_string()
+}
+
+/// Item 1: the config stored in summary.json is checked as `--config` is.
+#[test]
+fn a_doctored_summary_cannot_make_a_resume_write_outside_its_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("results");
+    ok(dqn(&out, &[]).output().unwrap());
+    let summary = out.join("summary.json");
+    let text = std::fs::read_to_string(&summary).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    json["status"] = "stopped".into();
+    // A method label that walks out of the folder.
+    json["config"]["protocol"]["methods"] = serde_json::json!([
+        {"SapNetWith": {"label": "/../../../../victim/pwn"}}
+    ]);
+    std::fs::write(&summary, serde_json::to_string(&json).unwrap()).unwrap();
+    let output = sapnet()
+        .args(["--headless", "--resume", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    refused(output, "expected a plain name");
+    // A library name that does.
+    json["config"]["protocol"]["methods"] = serde_json::json!([{"Dqn": {"hidden": [16]}}]);
+    json["config"]["sources"]["name"] = "../victim".into();
+    std::fs::write(&summary, serde_json::to_string(&json).unwrap()).unwrap();
+    let output = sapnet()
+        .args(["--headless", "--resume", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    refused(output, "sources.name");
+    assert!(!tmp.path().join("victim").exists());
+}
+
+/// Item 2: links planted where sapnet writes are replaced, never written through.
+#[test]
+fn planted_links_are_replaced_not_followed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let victim = tmp.path().join("victim.txt");
+    std::fs::write(&victim, "keep me").unwrap();
+    let out = tmp.path().join("results");
+    // A protocol stopped after its first run: --resume will write it again.
+    let out_arg = out.clone();
+    let mut child = dqn(&out_arg, &[])
+        .env("SAPNET_KILL_AT", "run-recorded")
+        .spawn()
+        .unwrap();
+    child.wait().unwrap();
+    for name in [
+        ".summary.tmp.json",
+        "summary.json.tmp",
+        ".episodes.tmp.csv",
+        "episodes.csv.tmp",
+        ".comparison.tmp.csv",
+        ".learning_curve.tmp.png",
+    ] {
+        let _ = std::fs::remove_file(out.join(name));
+        symlink(&victim, out.join(name)).unwrap();
+    }
+    ok(sapnet()
+        .args(["--headless", "--resume", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap());
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep me");
+    assert_eq!(status(&out), "complete");
+
+    // A link in place of a library's chosen/ receives nothing; the run goes on.
+    let library = library(tmp.path());
+    let elsewhere = tmp.path().join("elsewhere");
+    std::fs::create_dir(&elsewhere).unwrap();
+    symlink(&elsewhere, library.join("cartpole/chosen")).unwrap();
+    let run = ok(sapnet()
+        .args(["--headless", "--config"])
+        .arg(configs("tiny_transfer.ron"))
+        .arg("--library")
+        .arg(&library)
+        .arg("--out")
+        .arg(tmp.path().join("transfer"))
+        .output()
+        .unwrap());
+    assert!(
+        stderr(&run).contains("could not be added to the library"),
+        "{}",
+        stderr(&run)
+    );
+    assert_eq!(std::fs::read_dir(&elsewhere).unwrap().count(), 0);
+}
+
+/// A sweep of two tiny cells (DQN only) planned into `sweep`.
+fn plan_sweep(tmp: &Path, sweep: &Path) {
+    std::fs::copy(configs("short_cartpole.ron"), tmp.join("base.ron")).unwrap();
+    let grid = tmp.join("grid.ron");
+    std::fs::write(
+        &grid,
+        "(base: \"base.ron\", episodes: Some(5), seeds: Some(2))",
+    )
+    .unwrap();
+    ok(sapnet()
+        .args(["sweep", "plan", "--grid"])
+        .arg(&grid)
+        .arg("--out")
+        .arg(sweep)
+        .arg("--library")
+        .arg(tmp.join("lib"))
+        .output()
+        .unwrap());
+}
+
+/// Items 2 and 3: a sweep's logs and failure notes are created anew, and its scripts quote
+/// every path: a folder named with a space, a quote and `$(…)` is a name, not a command.
+#[test]
+fn sweep_scripts_quote_their_paths_and_logs_are_not_written_through_links() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = tmp.path().join("sw $(touch PWNED) it's");
+    plan_sweep(tmp.path(), &sweep);
+    let sbatch = std::fs::read_to_string(sweep.join("slurm.sbatch")).unwrap();
+    // The script as Slurm would run it, for one array task, in another directory.
+    let work = tmp.path().join("work");
+    std::fs::create_dir(&work).unwrap();
+    ok(Command::new("bash")
+        .arg(sweep.join("slurm.sbatch"))
+        .env("SLURM_ARRAY_TASK_ID", "0")
+        .current_dir(&work)
+        .output()
+        .unwrap());
+    assert!(sweep.join("results/0000/summary.json").exists(), "{sbatch}");
+    if Command::new("parallel").arg("--version").output().is_ok() {
+        let lines = std::fs::read_to_string(sweep.join("parallel.txt")).unwrap();
+        let line = lines.lines().find(|l| l.starts_with("parallel ")).unwrap();
+        ok(Command::new("bash")
+            .args(["-c", line])
+            .current_dir(&work)
+            .output()
+            .unwrap());
+        assert!(sweep.join("results/0001/summary.json").exists());
+    }
+    for dir in [tmp.path(), &work, &sweep] {
+        assert!(
+            !dir.join("PWNED").exists(),
+            "a path ran as a command in {}",
+            dir.display()
+        );
+    }
+
+    // Logs and a failure note planted as links: the victims stay as they were.
+    let victim = tmp.path().join("victim.txt");
+    std::fs::write(&victim, "keep me").unwrap();
+    let other = tmp.path().join("other");
+    plan_sweep(tmp.path(), &other);
+    symlink(&victim, other.join("logs/0000.out")).unwrap();
+    symlink(&victim, other.join("logs/0000.err")).unwrap();
+    symlink(&victim, other.join("failed/0001.txt")).unwrap();
+    // Cell 1's config edited: it fails, and writes its failure note.
+    std::fs::write(other.join("cells/0001.ron"), "()").unwrap();
+    let all = sapnet()
+        .args(["sweep", "run"])
+        .arg(&other)
+        .args(["--all", "--jobs", "1"])
+        .output()
+        .unwrap();
+    assert!(!all.status.success());
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep me");
+    assert!(std::fs::read_to_string(other.join("failed/0001.txt"))
+        .unwrap()
+        .contains("changed after the sweep was planned"));
+}
+
+/// Item 4: an edited sweep.ron cannot make `sweep prepare` train a library elsewhere, and
+/// policy metadata linked to another file is refused without quoting it.
+#[test]
+fn a_sweep_cannot_choose_where_a_library_is_trained_and_linked_metadata_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let base = tmp.path().join("base.ron");
+    std::fs::copy(configs("tiny_transfer.ron"), &base).unwrap();
+    std::fs::write(
+        tmp.path().join("grid.ron"),
+        "(base: \"base.ron\", seeds: Some(1))",
+    )
+    .unwrap();
+    let sweep = tmp.path().join("sweep");
+    ok(sapnet()
+        .args(["sweep", "plan", "--grid"])
+        .arg(tmp.path().join("grid.ron"))
+        .arg("--out")
+        .arg(&sweep)
+        .arg("--library")
+        .arg(tmp.path().join("lib"))
+        .output()
+        .unwrap());
+    let manifest = sweep.join("sweep.ron");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    let elsewhere = tmp.path().join("elsewhere");
+    std::fs::write(
+        &manifest,
+        text.replace(
+            &tmp.path().join("lib").display().to_string(),
+            &elsewhere.display().to_string(),
+        ),
+    )
+    .unwrap();
+    let prepare = sapnet()
+        .args(["sweep", "prepare"])
+        .arg(&sweep)
+        .output()
+        .unwrap();
+    refused(prepare, "--library");
+    assert!(!elsewhere.exists());
+    let wrong = sapnet()
+        .args(["sweep", "prepare"])
+        .arg(&sweep)
+        .arg("--library")
+        .arg(tmp.path().join("lib"))
+        .output()
+        .unwrap();
+    refused(wrong, "reuse");
+    assert!(!elsewhere.exists() && !tmp.path().join("lib").exists());
+
+    // A policy's metadata as a link to a secret: refused as a link, the secret unread.
+    let library = library(tmp.path());
+    let secret = tmp.path().join("secret.txt");
+    std::fs::write(&secret, "TOP-SECRET").unwrap();
+    let metadata = library.join("cartpole/source-0.ron");
+    std::fs::remove_file(&metadata).unwrap();
+    symlink(&secret, &metadata).unwrap();
+    let output = sapnet()
+        .args(["--headless", "--config"])
+        .arg(configs("tiny_transfer.ron"))
+        .arg("--library")
+        .arg(&library)
+        .arg("--out")
+        .arg(tmp.path().join("o"))
+        .output()
+        .unwrap();
+    refused(output, "symbolic link");
+}
+
+/// Waits for `path` to exist (at most 60 s).
+fn wait_for(path: &Path) {
+    let started = Instant::now();
+    while !path.exists() {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "{} never came",
+            path.display()
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+/// Items 5 and 6: a second process into a live folder or cell is refused, naming the
+/// first; the first finishes whole.
+#[test]
+fn a_second_process_into_a_live_folder_or_cell_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("results");
+    // 300 episodes: seconds, long enough to be overlapped.
+    let config = tmp.path().join("long.ron");
+    std::fs::write(
+        &config,
+        std::fs::read_to_string(configs("short_cartpole.ron"))
+            .unwrap()
+            .replace("episodes: 30,", "episodes: 300,"),
+    )
+    .unwrap();
+    let mut first = sapnet()
+        .args(["--headless", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(&out)
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    wait_for(&out.join("summary.json"));
+    let second = dqn(&out, &["--force"]).output().unwrap();
+    refused(second, &format!("running as PID {}", first.id()));
+    let resume = sapnet()
+        .args(["--headless", "--resume", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    refused(resume, "in use by another sapnet process");
+    assert!(first.wait().unwrap().success());
+    assert_eq!(status(&out), "complete");
+    let episodes = std::fs::read_to_string(out.join("episodes.csv")).unwrap();
+    assert_eq!(episodes.lines().count(), 1 + 2 * 300);
+
+    // Two `sweep run --cell 0` at once.
+    let sweep = tmp.path().join("sweep");
+    plan_sweep(tmp.path(), &sweep);
+    let cell = sweep.join("cells/0000.ron");
+    let text = std::fs::read_to_string(&cell)
+        .unwrap()
+        .replace("episodes: 5,", "episodes: 300,");
+    std::fs::write(&cell, &text).unwrap();
+    // The manifest hashes the cell: plan the edited one as the sweep's own.
+    let manifest = std::fs::read_to_string(sweep.join("sweep.ron")).unwrap();
+    let old = manifest
+        .lines()
+        .find(|l| l.contains("config_sha256"))
+        .unwrap()
+        .to_string();
+    let hash = sapnet::policy_store::sha256_hex(text.as_bytes());
+    std::fs::write(
+        sweep.join("sweep.ron"),
+        manifest.replacen(&old, &format!("            config_sha256: \"{hash}\","), 1),
+    )
+    .unwrap();
+    let mut first = sapnet()
+        .args(["sweep", "run"])
+        .arg(&sweep)
+        .args(["--cell", "0", "--jobs", "1"])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    wait_for(&sweep.join("results/.0000.partial/summary.json"));
+    let second = sapnet()
+        .args(["sweep", "run"])
+        .arg(&sweep)
+        .args(["--cell", "0", "--jobs", "1"])
+        .output()
+        .unwrap();
+    refused(second, &format!("running as PID {}", first.id()));
+    assert!(first.wait().unwrap().success());
+    let done = sweep.join("results/0000");
+    assert_eq!(status(&done), "complete");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(done.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["runs"].as_array().unwrap().len(), 2);
+}
+
+/// Items 7, 8 and 9: killed at each point where it writes, a protocol is resumable or
+/// cleaned up by the next run, and comes out as an uninterrupted one.
+#[test]
+fn a_kill_at_every_write_point_leaves_a_folder_that_finishes_to_the_same_numbers() {
+    let tmp = tempfile::tempdir().unwrap();
+    let reference = tmp.path().join("reference");
+    ok(dqn(&reference, &[]).output().unwrap());
+    let expected = numbers(&reference);
+    for point in [
+        "runs-created",
+        "summary-started",
+        "run-recorded",
+        "csv-assembled",
+        "report-written",
+        "plots-drawn",
+        "summary-written",
+    ] {
+        let out = tmp.path().join(point);
+        let killed = dqn(&out, &[])
+            .env("SAPNET_KILL_AT", point)
+            .output()
+            .unwrap();
+        assert!(!killed.status.success(), "{point}: not killed");
+        // Complete means complete: a folder that says so holds every file.
+        if out.join("summary.json").exists() && status(&out) == "complete" {
+            assert_eq!(numbers(&out), expected, "{point}");
+            for plot in ["learning_curve.png", "tests.png", "intervals.png"] {
+                assert!(
+                    out.join(plot).metadata().unwrap().len() > 1000,
+                    "{point}: {plot}"
+                );
+            }
+            continue;
+        }
+        // Otherwise it resumes (or, killed before anything was recorded, runs afresh).
+        let finish = if out.join("summary.json").exists() {
+            sapnet()
+                .args(["--headless", "--resume", "--out"])
+                .arg(&out)
+                .output()
+                .unwrap()
+        } else {
+            dqn(&out, &[]).output().unwrap()
+        };
+        assert!(finish.status.success(), "{point}: {}", stderr(&finish));
+        assert_eq!(status(&out), "complete", "{point}");
+        assert_eq!(numbers(&out), expected, "{point}");
+    }
+
+    // An empty run folder (a failed removal's) does not block a resume.
+    let out = tmp.path().join("empty-run");
+    dqn(&out, &[])
+        .env("SAPNET_KILL_AT", "run-recorded")
+        .output()
+        .unwrap();
+    std::fs::create_dir(out.join("runs/dqn-16-run1")).unwrap();
+    ok(sapnet()
+        .args(["--headless", "--resume", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap());
+    assert_eq!(numbers(&out), expected);
+
+    // --force killed while moving the old results aside, then after: each time the old
+    // results survive until new ones are whole.
+    for point in ["force-moving", "force-moved", "replaced-deleting"] {
+        let out = tmp.path().join(format!("forced-{point}"));
+        ok(dqn(&out, &["--seed", "3"]).output().unwrap());
+        let old = numbers(&out);
+        let killed = dqn(&out, &["--force"])
+            .env("SAPNET_KILL_AT", point)
+            .output()
+            .unwrap();
+        assert!(!killed.status.success());
+        let kept: Vec<PathBuf> = [out.clone(), out.join(".replaced")]
+            .into_iter()
+            .filter(|d| d.join("tests.csv").exists())
+            .collect();
+        assert!(!kept.is_empty(), "{point}: the old results are gone");
+        ok(dqn(&out, &["--force"]).output().unwrap());
+        assert_eq!(numbers(&out), expected, "{point}");
+        assert!(!out.join(".replaced").exists(), "{point}");
+        assert_ne!(old, expected, "seed 3 gave the old results other numbers");
+    }
+
+    // A killed merge leaves the previous merge, never a part that looks finished.
+    let sweep = tmp.path().join("sweep");
+    plan_sweep(tmp.path(), &sweep);
+    ok(sapnet()
+        .args(["sweep", "run"])
+        .arg(&sweep)
+        .args(["--all", "--jobs", "2"])
+        .output()
+        .unwrap());
+    let killed = sapnet()
+        .args(["sweep", "merge"])
+        .arg(&sweep)
+        .env("SAPNET_KILL_AT", "merge-written")
+        .output()
+        .unwrap();
+    assert!(!killed.status.success());
+    assert!(!sweep.join("merged").exists());
+    ok(sapnet()
+        .args(["sweep", "merge"])
+        .arg(&sweep)
+        .output()
+        .unwrap());
+    assert!(
+        sweep
+            .join("merged/comparison.csv")
+            .metadata()
+            .unwrap()
+            .len()
+            > 100
+    );
+}
+
+/// Item 10: a FIFO where a file belongs is refused at once; a weights file linked to
+/// /dev/zero is refused, not read until memory runs out.
+#[test]
+fn fifos_and_devices_are_refused_at_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let fifo = tmp.path().join("config.ron");
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let started = Instant::now();
+    let output = sapnet()
+        .args(["--headless", "--config"])
+        .arg(&fifo)
+        .arg("--out")
+        .arg(tmp.path().join("o"))
+        .output()
+        .unwrap();
+    refused(output, "a FIFO, not a regular file");
+    assert!(started.elapsed() < Duration::from_secs(10));
+
+    let library = library(tmp.path());
+    let manifest = library.join("cartpole/library.ron");
+    std::fs::rename(&manifest, tmp.path().join("library.ron")).unwrap();
+    assert!(Command::new("mkfifo")
+        .arg(&manifest)
+        .status()
+        .unwrap()
+        .success());
+    let run = |out: &str| {
+        sapnet()
+            .args(["--headless", "--config"])
+            .arg(configs("tiny_transfer.ron"))
+            .arg("--library")
+            .arg(&library)
+            .arg("--out")
+            .arg(tmp.path().join(out))
+            .output()
+            .unwrap()
+    };
+    refused(run("o1"), "a FIFO");
+    std::fs::remove_file(&manifest).unwrap();
+    std::fs::rename(tmp.path().join("library.ron"), &manifest).unwrap();
+    let weights = library.join("cartpole/source-0.safetensors");
+    std::fs::remove_file(&weights).unwrap();
+    symlink("/dev/zero", &weights).unwrap();
+    refused(run("o2"), "source-0.safetensors");
+}
+
+/// Item 11: NaN weights and a NaN score are refused where Inf is.
+#[test]
+fn nan_weights_and_a_nan_score_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = library(tmp.path());
+    let dir = library.join("cartpole");
+    let run = |out: &str| {
+        sapnet()
+            .args(["--headless", "--config"])
+            .arg(configs("tiny_transfer.ron"))
+            .arg("--library")
+            .arg(&library)
+            .arg("--out")
+            .arg(tmp.path().join(out))
+            .output()
+            .unwrap()
+    };
+    // A NaN in source-1's first weight, the hashes made to match: only the NaN is wrong.
+    let weights = dir.join("source-1.safetensors");
+    let original = std::fs::read(&weights).unwrap();
+    let mut bytes = original.clone();
+    let header = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    bytes[8 + header..8 + header + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    rehash(&dir, "source-1", Some(&bytes), None);
+    refused(run("o1"), "NaN or infinite weight");
+    rehash(&dir, "source-1", Some(&original), None);
+    // A NaN final score in another policy's metadata.
+    let metadata = std::fs::read_to_string(dir.join("source-2.ron")).unwrap();
+    let line = metadata
+        .lines()
+        .find(|l| l.contains("final_score"))
+        .unwrap();
+    rehash(
+        &dir,
+        "source-2",
+        None,
+        Some(&metadata.replace(line, "    final_score: Some(NaN),")),
+    );
+    let output = sapnet()
+        .args(["sources", "--config"])
+        .arg(configs("tiny_sources.ron"))
+        .arg("--library")
+        .arg(&library)
+        .arg("--evaluate")
+        .output()
+        .unwrap();
+    refused(output, "field `final_score`: expected a finite return");
+}
+
+/// Writes a policy's weights and/or metadata and re-records their hashes, in the
+/// metadata and in the library's manifest, as a careful forger would.
+fn rehash(dir: &Path, name: &str, weights: Option<&[u8]>, metadata: Option<&str>) {
+    use sapnet::policy_store::sha256_hex;
+    let weights_path = dir.join(format!("{name}.safetensors"));
+    let metadata_path = dir.join(format!("{name}.ron"));
+    let old_weights = sha256_hex(&std::fs::read(&weights_path).unwrap());
+    let old_metadata = sha256_hex(&std::fs::read(&metadata_path).unwrap());
+    if let Some(bytes) = weights {
+        std::fs::write(&weights_path, bytes).unwrap();
+    }
+    let new_weights = sha256_hex(&std::fs::read(&weights_path).unwrap());
+    let text = metadata
+        .map(str::to_string)
+        .unwrap_or_else(|| std::fs::read_to_string(&metadata_path).unwrap())
+        .replace(&old_weights, &new_weights);
+    std::fs::write(&metadata_path, &text).unwrap();
+    let new_metadata = sha256_hex(text.as_bytes());
+    let manifest = dir.join("library.ron");
+    let m = std::fs::read_to_string(&manifest)
+        .unwrap()
+        .replace(&old_weights, &new_weights)
+        .replace(&old_metadata, &new_metadata);
+    std::fs::write(&manifest, m).unwrap();
+}
+
+/// Item 12: counts that cannot be allocated are refused at once, with the bound, exit 2.
+#[test]
+fn counts_beyond_their_bounds_are_refused_before_anything_is_allocated() {
+    let tmp = tempfile::tempdir().unwrap();
+    let config = |name: &str, text: &str| {
+        let path = tmp.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    for (text, says) in [
+        ("(protocol: (runs: 4294967295))", "expected 1 to 10000"),
+        (
+            "(sources: (count: 100000000))",
+            "expected 1 to 10000 policies",
+        ),
+        ("(protocol: (thresholds: Some([NaN])))", "finite returns"),
+        ("(dqn: (gradient_steps: 1000000000))", "1 to 10000 updates"),
+        (
+            "(protocol: (episodes: 4000000000))",
+            "expected 1 to 10000000",
+        ),
+    ] {
+        let path = config("bad.ron", text);
+        let output = sapnet()
+            .args(["--headless", "--config"])
+            .arg(&path)
+            .arg("--out")
+            .arg(tmp.path().join("o"))
+            .output()
+            .unwrap();
+        refused(output, says);
+    }
+    config("base.ron", "()");
+    let values = (1..=50)
+        .map(|v| format!("{v}.0"))
+        .collect::<Vec<_>>()
+        .join(",");
+    let grid_of_cubes = format!(
+        "(base: \"base.ron\", axes: [(path: \"dqn.huber_delta\", values: [{values}]), \
+         (path: \"sapnet.temperature\", values: [{values}]), (path: \"dqn.learning_rate\", \
+         values: [{values}])])"
+    );
+    for (grid, says) in [
+        ("(base: \"base.ron\", seeds: Some(100000000))", "1 ≤ n ≤ 100000"),
+        ("(base: \"base.ron\", seeds: Some(18446744073709551615))", "1 ≤ n ≤ 100000"),
+        (
+            // 50 × 50 × 50 = 125,000 cells (the issue's 1000³ would be refused the same way).
+            grid_of_cubes.as_str(),
+"more than 100000 cells",
+        ),
+        (
+            "(base: \"base.ron\", axes: [(path: \"seed\", values: [1]), (path: \"seed\", values: [2])])",
+            "is an axis already",
+        ),
+    ] {
+        let path = config("grid.ron", grid);
+        let started = Instant::now();
+        let output = sapnet()
+            .args(["sweep", "plan", "--grid"])
+            .arg(&path)
+            .arg("--out")
+            .arg(tmp.path().join("s"))
+            .output()
+            .unwrap();
+        refused(output, says);
+        assert!(started.elapsed() < Duration::from_secs(10));
+    }
+}
+
+/// Item 13: a signal is heard inside a long round of gradient updates.
+#[test]
+fn a_signal_stops_a_long_round_of_updates_within_seconds() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("slow.ron");
+    std::fs::write(
+        &path,
+        "(dqn: (replay_start_size: 32, gradient_steps: 10000, batch_size: 256), \
+         protocol: (episodes: 1000, runs: 1, methods: [Dqn(hidden: [256, 256])]))",
+    )
+    .unwrap();
+    let out = tmp.path().join("o");
+    let mut child = sapnet()
+        .args(["--headless", "--config"])
+        .arg(&path)
+        .arg("--out")
+        .arg(&out)
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    wait_for(&out.join("summary.json"));
+    // Well into the updates (each round of 10,000 takes many seconds).
+    std::thread::sleep(Duration::from_secs(1));
+    assert!(Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let signalled = Instant::now();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(143));
+    assert!(
+        signalled.elapsed() < Duration::from_secs(10),
+        "{:?}",
+        signalled.elapsed()
+    );
+}
+
+/// Item 14: a path results cannot record is refused before training; a fraction or a
+/// negative count is said as such.
+#[test]
+fn untextual_paths_and_number_mistakes_are_said_before_anything_runs() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let bad = tmp.path().join(OsStr::from_bytes(b"lib\xff"));
+    let output = dqn(&tmp.path().join("o"), &[])
+        .arg("--library")
+        .arg(&bad)
+        .output()
+        .unwrap();
+    refused(output, "expected a UTF-8 path");
+    for (text, says) in [
+        (
+            "(protocol: (episodes: 5.5))",
+            "field `protocol.episodes`: expected a whole number, got 5.5",
+        ),
+        (
+            "(protocol: (runs: 2.5))",
+            "field `protocol.runs`: expected a whole number, got 2.5",
+        ),
+        (
+            "(protocol: (episodes: -5))",
+            "field `protocol.episodes`: expected a whole number ≥ 0, got -5",
+        ),
+    ] {
+        let path = tmp.path().join("bad.ron");
+        std::fs::write(&path, text).unwrap();
+        let output = sapnet()
+            .args(["--headless", "--config"])
+            .arg(&path)
+            .arg("--out")
+            .arg(tmp.path().join("o"))
+            .output()
+            .unwrap();
+        refused(output, says);
+    }
+}
