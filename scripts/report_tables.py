@@ -96,6 +96,9 @@ for score, name in (("test", "test score"), ("return", "training return")):
                 separated.append(f"{a['method']} > {b['method']}")
     print(f"\n{name}: pairs whose intervals of the mean do not overlap: {len(separated)} of "
           f"{len(ranked) * (len(ranked) - 1) // 2}")
+    if comparison[0]["units"] != "return":
+        # scores.csv holds each task's own returns: a pooled report's spread is per task.
+        continue
     column = "test" if score == "test" else "return"
     first, second = ranked[0]["method"], ranked[1]["method"]
     values = {m: [float(s[column]) for s in scores if s["method"] == m and s[column] != ""]
