@@ -45,10 +45,10 @@ fn draw_actions(action_count: usize, steps: usize, seed: u64) -> Vec<u8> {
 fn run<E: Environment + ?Sized>(env: &mut E, actions: &[u8]) -> usize {
     let mut resets = 0;
     for &a in actions {
-        let step = env.step(usize::from(a));
-        black_box(&step.obs);
+        let step = env.step(usize::from(a)).expect("a native step cannot fail");
+        black_box(step.obs);
         if step.done() {
-            env.reset(None);
+            env.reset(None).expect("a native reset cannot fail");
             resets += 1;
         }
     }
@@ -70,12 +70,12 @@ fn env_var(name: &str, default: usize) -> usize {
 fn report<E: Environment>(make: impl Fn() -> E, steps: usize, runs: usize) {
     let mut rates = Vec::with_capacity(runs);
     let mut resets = 0;
-    let mut id = "";
+    let mut id = String::new();
     for seed in 0..runs as u64 {
         let mut env = make();
-        id = env.id();
+        id = env.id().to_string();
         let actions = draw_actions(env.action_count(), steps, seed);
-        env.reset(Some(seed));
+        env.reset(Some(seed)).unwrap();
         let start = Instant::now();
         resets = black_box(run(&mut env, black_box(&actions)));
         rates.push(steps as f64 / start.elapsed().as_secs_f64());
@@ -129,12 +129,11 @@ fn criterion_benches(c: &mut Criterion) {
     let mut group = c.benchmark_group("boxed_env_random_actions");
     group.throughput(Throughput::Elements(CHUNK as u64));
     for config in configs() {
-        let mut env = make(&config);
+        let mut env = make(&config).unwrap();
         let actions = draw_actions(env.action_count(), CHUNK, 0);
-        env.reset(Some(0));
-        group.bench_function(env.id(), |b| {
-            b.iter(|| run(env.as_mut(), black_box(&actions)))
-        });
+        env.reset(Some(0)).unwrap();
+        let id = env.id().to_string();
+        group.bench_function(id, |b| b.iter(|| run(env.as_mut(), black_box(&actions))));
     }
     group.finish();
 }

@@ -152,8 +152,8 @@ fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
 
 fn run_env(cli: &Cli, args: &EnvArgs) -> Result<()> {
     let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
-    let mut env = env::make(&config.env);
-    let episodes = random_episodes::run(env.as_mut(), args.episodes, config.seed);
+    let mut env = env::make(&config.env)?;
+    let episodes = random_episodes::run(env.as_mut(), args.episodes, config.seed)?;
     let mut out = std::io::stdout().lock();
     random_episodes::print(&mut out, env.id(), &episodes)
         .and_then(|()| out.flush())
@@ -379,7 +379,7 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
     };
     // Read before training starts, so that a wrong folder is said at once.
     let reference = match &cli.run.compare {
-        Some(dir) => reference_bands(dir, env::make(&config.env).id())?,
+        Some(dir) => reference_bands(dir, &config.env.gym_id())?,
         None => Vec::new(),
     };
     // The followed run and the DQN baseline train side by side.
@@ -390,7 +390,7 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
         .iter()
         .position(|s| Some(&s.method) == followed.as_ref())
         .unwrap_or(0);
-    let task = env::make(&config.env).id().to_string();
+    let task = config.env.gym_id();
     tui::run_dashboard(
         &task,
         tui::DashboardRuns {
@@ -437,7 +437,7 @@ fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
     let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
     if args.evaluate {
         let evaluations = crate::sources::evaluate(&config, &cli.run.library_path())?;
-        let target = env::make(&config.env).id().to_string();
+        let target = config.env.gym_id();
         let mut out = std::io::stdout().lock();
         writeln!(
             out,

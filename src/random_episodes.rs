@@ -6,7 +6,7 @@ use std::io::Write;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-use crate::env::Environment;
+use crate::env::{EnvError, Environment};
 use crate::seeds;
 
 /// How one episode went.
@@ -21,24 +21,29 @@ pub struct EpisodeSummary {
 /// Runs `episodes` episodes with actions drawn uniformly. The actions and the environment's
 /// resets draw from two streams derived from `seed`; resets after the first continue the
 /// environment's generator.
-pub fn run(env: &mut dyn Environment, episodes: u32, seed: u64) -> Vec<EpisodeSummary> {
+pub fn run(
+    env: &mut dyn Environment,
+    episodes: u32,
+    seed: u64,
+) -> Result<Vec<EpisodeSummary>, EnvError> {
     let mut rng = StdRng::seed_from_u64(seeds::derive(seed, &[seeds::Part::Name("actions")]));
     let env_seed = seeds::derive(seed, &[seeds::Part::Name("env")]);
     (0..episodes)
         .map(|episode| {
-            env.reset((episode == 0).then_some(env_seed));
+            env.reset((episode == 0).then_some(env_seed))?;
             let mut summary = EpisodeSummary {
                 steps: 0,
                 episode_return: 0.0,
                 terminated: false,
             };
             loop {
-                let step = env.step(rng.random_range(0..env.action_count()));
+                let actions = env.action_count();
+                let step = env.step(rng.random_range(0..actions))?;
                 summary.steps += 1;
                 summary.episode_return += step.reward;
                 if step.done() {
                     summary.terminated = step.terminated;
-                    return summary;
+                    return Ok(summary);
                 }
             }
         })

@@ -4,7 +4,7 @@
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use sapnet::config::{DqnConfig, Exploration};
 use sapnet::dqn::{huber, Architecture, Batch, DqnAgent, DqnError, QNet, ReplayBuffer, Transition};
-use sapnet::env::{self, EnvConfig, Environment, Observation, StateError, Step};
+use sapnet::env::{self, EnvConfig, EnvError, Environment, Step};
 
 fn agent(hidden: &[usize], seed: u64, config: &DqnConfig) -> DqnAgent {
     let net = QNet::new(
@@ -251,12 +251,28 @@ fn a_non_finite_loss_is_an_error_naming_the_step_and_keeps_the_weights() {
 struct Corridor {
     position: usize,
     steps: u32,
+    obs: [f32; 2],
+}
+
+impl Corridor {
+    fn new() -> Self {
+        Self {
+            position: 0,
+            steps: 0,
+            obs: [0.0, 1.0],
+        }
+    }
+
+    fn observe(&mut self) {
+        let x = self.position as f32 / (LENGTH - 1) as f32;
+        self.obs = [x, 1.0 - x];
+    }
 }
 
 const LENGTH: usize = 4;
 
 impl Environment for Corridor {
-    fn id(&self) -> &'static str {
+    fn id(&self) -> &str {
         "Corridor"
     }
     fn observation_size(&self) -> usize {
@@ -265,12 +281,13 @@ impl Environment for Corridor {
     fn action_count(&self) -> usize {
         3
     }
-    fn reset(&mut self, _seed: Option<u64>) -> Observation {
+    fn reset(&mut self, _seed: Option<u64>) -> Result<&[f32], EnvError> {
         self.position = 0;
         self.steps = 0;
-        self.observation()
+        self.observe();
+        Ok(&self.obs)
     }
-    fn step(&mut self, action: usize) -> Step {
+    fn step(&mut self, action: usize) -> Result<Step<'_>, EnvError> {
         self.steps += 1;
         self.position = match action {
             0 => self.position.saturating_sub(1),
@@ -278,21 +295,21 @@ impl Environment for Corridor {
             _ => self.position + 1,
         };
         let terminated = self.position == LENGTH - 1;
-        Step {
-            obs: self.observation(),
+        self.observe();
+        Ok(Step {
+            obs: &self.obs,
             reward: if terminated { 1.0 } else { 0.0 },
             terminated,
             truncated: self.steps >= 20,
-        }
+        })
     }
-    fn observation(&self) -> Observation {
-        let x = self.position as f32 / (LENGTH - 1) as f32;
-        Observation::from_slice(&[x, 1.0 - x])
+    fn observation(&self) -> &[f32] {
+        &self.obs
     }
     fn state(&self) -> &[f64] {
         &[]
     }
-    fn set_state(&mut self, _state: &[f64]) -> Result<(), StateError> {
+    fn set_state(&mut self, _state: &[f64]) -> Result<(), EnvError> {
         Ok(())
     }
     fn elapsed_steps(&self) -> u32 {
@@ -309,24 +326,24 @@ fn train(
     seed: u64,
 ) {
     let mut rng = StdRng::seed_from_u64(seed);
-    let mut obs = env.reset(Some(seed));
+    let mut obs = env.reset(Some(seed)).unwrap().to_vec();
     for _ in 0..steps {
         let action = agent.act(&obs, &mut rng).unwrap();
-        let step = env.step(action);
+        let step = env.step(action).unwrap();
         replay.push(Transition {
             obs: &obs,
             action,
             reward: step.reward,
-            next_obs: &step.obs,
+            next_obs: step.obs,
             terminated: step.terminated,
             truncated: step.truncated,
         });
-        agent.observe(replay, &mut rng).unwrap();
-        obs = if step.done() {
-            env.reset(None)
+        if step.done() {
+            obs.copy_from_slice(env.reset(None).unwrap());
         } else {
-            step.obs
-        };
+            obs.copy_from_slice(step.obs);
+        }
+        agent.observe(replay, &mut rng).unwrap();
     }
 }
 
@@ -342,17 +359,14 @@ fn learns_to_walk_down_a_corridor() {
         },
         ..DqnConfig::default()
     };
-    let mut env = Corridor {
-        position: 0,
-        steps: 0,
-    };
+    let mut env = Corridor::new();
     let mut agent = agent(&[16], 7, &config);
     let mut replay = ReplayBuffer::new(config.replay_capacity, 2);
     train(&mut env, &mut agent, &mut replay, 3000, 7);
-    let mut obs = env.reset(None);
+    let mut obs = env.reset(None).unwrap().to_vec();
     for _ in 0..LENGTH - 1 {
-        let step = env.step(agent.greedy_action(&obs).unwrap());
-        obs = step.obs;
+        let step = env.step(agent.greedy_action(&obs).unwrap()).unwrap();
+        obs = step.obs.to_vec();
     }
     assert_eq!(
         env.position,
@@ -363,7 +377,7 @@ fn learns_to_walk_down_a_corridor() {
 
 #[test]
 fn trains_on_cartpole_through_env_make() {
-    let mut env = env::make(&EnvConfig::CartPole(Default::default()));
+    let mut env = env::make(&EnvConfig::CartPole(Default::default())).unwrap();
     let config = DqnConfig::default();
     let architecture = Architecture::new(env.observation_size(), &[100], env.action_count());
     let net = QNet::new(architecture, &mut StdRng::seed_from_u64(0)).unwrap();

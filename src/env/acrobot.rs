@@ -8,7 +8,7 @@ use std::hint::black_box;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-use super::{AcrobotParams, Environment, Observation, StateError, Step};
+use super::{AcrobotParams, EnvError, Environment, Step};
 
 /// Half-width of the uniform distribution of every state variable at reset (Gymnasium's
 /// default reset bounds, ±0.1).
@@ -34,6 +34,8 @@ pub struct Acrobot {
     /// `sin_cos(state[1])`: the observation and the next step's first evaluation of the
     /// dynamics both need it, and libm calls are most of the cost of a step.
     sin_cos_theta2: (f64, f64),
+    /// Gymnasium's `_get_ob` of the state.
+    obs: [f32; 6],
     rng: StdRng,
     elapsed: u32,
 }
@@ -174,14 +176,17 @@ fn bound(x: f64, lo: f64, hi: f64) -> f64 {
 
 impl Acrobot {
     pub fn new(params: AcrobotParams) -> Self {
-        Self {
+        let mut acrobot = Self {
             derived: Derived::new(&params),
             params,
             state: [0.0; 4],
             sin_cos_theta2: sin_cos(0.0),
+            obs: [0.0; 6],
             rng: StdRng::seed_from_u64(0),
             elapsed: 0,
-        }
+        };
+        acrobot.observe(sin_cos(0.0));
+        acrobot
     }
 
     fn set(&mut self, state: [f64; 4]) {
@@ -189,19 +194,19 @@ impl Acrobot {
         self.sin_cos_theta2 = sin_cos(state[1]);
     }
 
-    /// Gymnasium's `_get_ob`, given `sin_cos(state[0])`.
+    /// Keeps Gymnasium's `_get_ob` of the state, given `sin_cos(state[0])`.
     #[inline]
-    fn observation_with(&self, (sin_theta1, cos_theta1): (f64, f64)) -> Observation {
+    fn observe(&mut self, (sin_theta1, cos_theta1): (f64, f64)) {
         let (sin_theta2, cos_theta2) = self.sin_cos_theta2;
         let [_, _, dtheta1, dtheta2] = self.state;
-        Observation::from_slice(&[
+        self.obs = [
             cos_theta1 as f32,
             sin_theta1 as f32,
             cos_theta2 as f32,
             sin_theta2 as f32,
             dtheta1 as f32,
             dtheta2 as f32,
-        ])
+        ];
     }
 
     /// Gymnasium's `_dsdt` ("book" dynamics): the time derivative of `s` under torque `a`,
@@ -251,7 +256,7 @@ impl Acrobot {
 }
 
 impl Environment for Acrobot {
-    fn id(&self) -> &'static str {
+    fn id(&self) -> &str {
         "Acrobot-v1"
     }
 
@@ -270,7 +275,7 @@ impl Environment for Acrobot {
     /// own routines); here they are computed in `f64` and rounded, which differs by one ulp
     /// in about one reset in a thousand. Every later observation is computed as Gymnasium
     /// does.
-    fn reset(&mut self, seed: Option<u64>) -> Observation {
+    fn reset(&mut self, seed: Option<u64>) -> Result<&[f32], EnvError> {
         if let Some(seed) = seed {
             self.rng = StdRng::seed_from_u64(seed);
         }
@@ -278,8 +283,9 @@ impl Environment for Acrobot {
             f64::from(self.rng.random_range(-RESET_BOUND..RESET_BOUND) as f32)
         });
         self.set(state);
+        self.observe(sin_cos(self.state[0]));
         self.elapsed = 0;
-        self.observation()
+        Ok(&self.obs)
     }
 
     /// Gymnasium's `AcrobotEnv.step`, operation for operation, so the state matches its
@@ -289,7 +295,7 @@ impl Environment for Acrobot {
     /// # Panics
     /// If `action` is not 0, 1 or 2.
     #[inline]
-    fn step(&mut self, action: usize) -> Step {
+    fn step(&mut self, action: usize) -> Result<Step<'_>, EnvError> {
         assert!(action < 3, "Acrobot: action {action} is not 0, 1 or 2");
         let p = &self.params;
         let mut torque = p.available_torque[action];
@@ -310,28 +316,29 @@ impl Environment for Acrobot {
 
         let sin_cos_theta1 = sin_cos(theta1);
         let terminated = -sin_cos_theta1.1 - (theta2 + theta1).cos() > 1.0;
+        self.observe(sin_cos_theta1);
         self.elapsed += 1;
-        let p = &self.params;
-        Step {
-            obs: self.observation_with(sin_cos_theta1),
+        Ok(Step {
+            obs: &self.obs,
             reward: if terminated { 0.0 } else { -1.0 },
             terminated,
-            truncated: self.elapsed >= p.max_episode_steps,
-        }
+            truncated: self.elapsed >= self.params.max_episode_steps,
+        })
     }
 
     /// Gymnasium's `_get_ob`.
-    fn observation(&self) -> Observation {
-        self.observation_with(sin_cos(self.state[0]))
+    fn observation(&self) -> &[f32] {
+        &self.obs
     }
 
     fn state(&self) -> &[f64] {
         &self.state
     }
 
-    fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
-        let state = StateError::check_length("Acrobot", state)?;
+    fn set_state(&mut self, state: &[f64]) -> Result<(), EnvError> {
+        let state = EnvError::check_length("Acrobot", state)?;
         self.set(state);
+        self.observe(sin_cos(self.state[0]));
         Ok(())
     }
 
@@ -346,7 +353,7 @@ mod tests {
 
     fn env() -> Acrobot {
         let mut env = Acrobot::new(AcrobotParams::default());
-        env.reset(Some(11));
+        env.reset(Some(11)).unwrap();
         env
     }
 
@@ -416,12 +423,12 @@ mod tests {
     fn theta1_wraps_across_pi_in_both_directions() {
         let mut env = env();
         env.set_state(&[3.1, 0.0, 3.0, 0.0]).unwrap();
-        env.step(1);
+        env.step(1).unwrap();
         let theta1 = env.state()[0];
         assert!((-PI..0.0).contains(&theta1), "theta1 = {theta1}");
 
         env.set_state(&[-3.1, 0.0, -3.0, 0.0]).unwrap();
-        env.step(1);
+        env.step(1).unwrap();
         let theta1 = env.state()[0];
         assert!((0.0..=PI).contains(&theta1), "theta1 = {theta1}");
     }
@@ -433,7 +440,7 @@ mod tests {
         for sign in [1.0, -1.0] {
             env.set_state(&[0.0, 0.0, sign * 2.0 * p.max_vel_1, sign * 2.0 * p.max_vel_2])
                 .unwrap();
-            env.step(1);
+            env.step(1).unwrap();
             let [.., dtheta1, dtheta2] = env.state() else {
                 unreachable!()
             };
@@ -447,12 +454,12 @@ mod tests {
         let mut env = env();
         // Both links pointing up: the tip is 2 above the pivot.
         env.set_state(&[PI - 0.01, 0.0, 0.0, 0.0]).unwrap();
-        let step = env.step(1);
+        let step = env.step(1).unwrap();
         assert!(step.terminated);
         assert_eq!(step.reward, 0.0);
 
         env.set_state(&[0.0; 4]).unwrap();
-        let step = env.step(1);
+        let step = env.step(1).unwrap();
         assert!(!step.terminated);
         assert_eq!(step.reward, -1.0);
     }
@@ -461,10 +468,10 @@ mod tests {
     fn observation_is_trigonometry_of_the_state() {
         let mut env = env();
         env.set_state(&[0.3, -0.2, 0.1, -0.4]).unwrap();
-        let obs = env.step(2).obs;
+        let obs = env.step(2).unwrap().obs.to_vec();
         let [t1, t2, d1, d2] = env.state().try_into().unwrap();
         let expected = [t1.cos(), t1.sin(), t2.cos(), t2.sin(), d1, d2].map(|v| v as f32);
-        assert_eq!(*obs, expected);
+        assert_eq!(obs, expected);
     }
 
     #[test]
@@ -473,10 +480,10 @@ mod tests {
             max_episode_steps: 2,
             ..AcrobotParams::default()
         });
-        env.reset(Some(0));
-        assert!(!env.step(1).truncated);
+        env.reset(Some(0)).unwrap();
+        assert!(!env.step(1).unwrap().truncated);
         env.set_state(&[PI - 0.01, 0.0, 0.0, 0.0]).unwrap();
-        let step = env.step(1);
+        let step = env.step(1).unwrap();
         assert!(step.terminated && step.truncated);
     }
 
@@ -484,11 +491,11 @@ mod tests {
     fn same_seed_same_reset_and_resets_in_range_in_f32() {
         let mut a = Acrobot::new(AcrobotParams::default());
         let mut b = Acrobot::new(AcrobotParams::default());
-        assert_eq!(a.reset(Some(5)), b.reset(Some(5)));
+        assert_eq!(a.reset(Some(5)).unwrap(), b.reset(Some(5)).unwrap());
         assert_eq!(a.state(), b.state());
-        assert_eq!(a.reset(None), b.reset(None));
+        assert_eq!(a.reset(None).unwrap(), b.reset(None).unwrap());
         for _ in 0..1000 {
-            a.reset(None);
+            a.reset(None).unwrap();
             for &v in a.state() {
                 assert!((-0.1..=0.1).contains(&v));
                 assert_eq!(f64::from(v as f32), v);
@@ -500,8 +507,8 @@ mod tests {
     fn torque_noise_is_drawn_only_when_enabled() {
         let mut quiet = env();
         let mut reference = env();
-        quiet.step(0);
-        assert_eq!(quiet.reset(None), reference.reset(None));
+        quiet.step(0).unwrap();
+        assert_eq!(quiet.reset(None).unwrap(), reference.reset(None).unwrap());
 
         let noisy_params = AcrobotParams {
             torque_noise_max: 0.5,
@@ -509,23 +516,23 @@ mod tests {
         };
         let mut noisy = Acrobot::new(noisy_params.clone());
         let mut reference = Acrobot::new(noisy_params);
-        noisy.reset(Some(1));
-        reference.reset(Some(1));
-        noisy.step(1);
-        assert_ne!(noisy.reset(None), reference.reset(None));
+        noisy.reset(Some(1)).unwrap();
+        reference.reset(Some(1)).unwrap();
+        noisy.step(1).unwrap();
+        assert_ne!(noisy.reset(None).unwrap(), reference.reset(None).unwrap());
     }
 
     #[test]
     fn set_state_checks_length() {
         assert!(matches!(
             env().set_state(&[0.0; 6]),
-            Err(StateError::WrongLength { got: 6, .. })
+            Err(EnvError::WrongLength { got: 6, .. })
         ));
     }
 
     #[test]
     #[should_panic(expected = "action 3")]
     fn out_of_range_action_panics() {
-        env().step(3);
+        env().step(3).unwrap();
     }
 }

@@ -4,7 +4,7 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-use super::{CartPoleParams, Environment, Integrator, Observation, StateError, Step};
+use super::{CartPoleParams, EnvError, Environment, Integrator, Step};
 
 /// Half-width of the uniform distribution of every state variable at reset (Gymnasium's
 /// default reset bounds, ±0.05).
@@ -24,6 +24,8 @@ pub struct CartPole {
     /// Gymnasium's `polemass_length`.
     polemass_length: f64,
     state: [f64; 4],
+    /// The observation: the state cast to `f32`.
+    obs: [f32; 4],
     /// `(sin θ, cos θ)` of the state, computed as soon as θ is known so that the libm call
     /// overlaps the divisions of the step that sets θ.
     sin_cos_theta: (f64, f64),
@@ -41,6 +43,7 @@ impl CartPole {
             polemass_length: params.masspole * params.length,
             params,
             state: [0.0; 4],
+            obs: [0.0; 4],
             sin_cos_theta: (0.0, 1.0),
             rng: StdRng::seed_from_u64(0),
             elapsed: 0,
@@ -50,7 +53,7 @@ impl CartPole {
 }
 
 impl Environment for CartPole {
-    fn id(&self) -> &'static str {
+    fn id(&self) -> &str {
         if self.params.max_episode_steps == 200 {
             "CartPole-v0"
         } else {
@@ -66,7 +69,7 @@ impl Environment for CartPole {
         2
     }
 
-    fn reset(&mut self, seed: Option<u64>) -> Observation {
+    fn reset(&mut self, seed: Option<u64>) -> Result<&[f32], EnvError> {
         if let Some(seed) = seed {
             self.rng = StdRng::seed_from_u64(seed);
         }
@@ -74,9 +77,10 @@ impl Environment for CartPole {
             *v = self.rng.random_range(-RESET_BOUND..RESET_BOUND);
         }
         self.sin_cos_theta = self.state[2].sin_cos();
+        self.obs = self.state.map(|v| v as f32);
         self.elapsed = 0;
         self.fell = false;
-        self.observation()
+        Ok(&self.obs)
     }
 
     /// Gymnasium's `CartPoleEnv.step`, operation for operation, so the state matches its
@@ -85,7 +89,7 @@ impl Environment for CartPole {
     /// # Panics
     /// If `action` is not 0 or 1.
     #[inline]
-    fn step(&mut self, action: usize) -> Step {
+    fn step(&mut self, action: usize) -> Result<Step<'_>, EnvError> {
         assert!(action < 2, "CartPole: action {action} is not 0 or 1");
         let p = &self.params;
         let [mut x, mut x_dot, mut theta, mut theta_dot] = self.state;
@@ -117,6 +121,7 @@ impl Environment for CartPole {
             }
         }
         self.state = [x, x_dot, theta, theta_dot];
+        self.obs = self.state.map(|v| v as f32);
         self.sin_cos_theta = theta.sin_cos();
 
         let terminated = x < -p.x_threshold
@@ -126,25 +131,26 @@ impl Environment for CartPole {
         let reward = if self.fell { 0.0 } else { 1.0 };
         self.fell |= terminated;
         self.elapsed += 1;
-        Step {
-            obs: self.observation(),
+        Ok(Step {
+            obs: &self.obs,
             reward,
             terminated,
             truncated: self.elapsed >= p.max_episode_steps,
-        }
+        })
     }
 
     #[inline]
-    fn observation(&self) -> Observation {
-        Observation::from_slice(&self.state.map(|v| v as f32))
+    fn observation(&self) -> &[f32] {
+        &self.obs
     }
 
     fn state(&self) -> &[f64] {
         &self.state
     }
 
-    fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
-        self.state = StateError::check_length("CartPole", state)?;
+    fn set_state(&mut self, state: &[f64]) -> Result<(), EnvError> {
+        self.state = EnvError::check_length("CartPole", state)?;
+        self.obs = self.state.map(|v| v as f32);
         self.sin_cos_theta = self.state[2].sin_cos();
         Ok(())
     }
@@ -160,7 +166,7 @@ mod tests {
 
     fn env() -> CartPole {
         let mut env = CartPole::new(CartPoleParams::default());
-        env.reset(Some(7));
+        env.reset(Some(7)).unwrap();
         env
     }
 
@@ -169,11 +175,12 @@ mod tests {
         for (x, x_dot, action) in [(2.39, 1.0, 1), (-2.39, -1.0, 0)] {
             let mut env = env();
             env.set_state(&[x, x_dot, 0.0, 0.0]).unwrap();
-            let step = env.step(action);
+            let step = env.step(action).unwrap();
+            let (terminated, truncated, reward) = (step.terminated, step.truncated, step.reward);
             assert!(env.state()[0].abs() > 2.4);
-            assert!(step.terminated, "x = {} should terminate", env.state()[0]);
-            assert!(!step.truncated);
-            assert_eq!(step.reward, 1.0);
+            assert!(terminated, "x = {} should terminate", env.state()[0]);
+            assert!(!truncated);
+            assert_eq!(reward, 1.0);
         }
     }
 
@@ -184,10 +191,11 @@ mod tests {
             let mut env = env();
             env.set_state(&[0.0, 0.0, sign * (limit - 1e-4), sign * 0.5])
                 .unwrap();
-            let step = env.step(0);
+            let step = env.step(0).unwrap();
+            let (terminated, reward) = (step.terminated, step.reward);
             assert!(env.state()[2].abs() > limit);
-            assert!(step.terminated);
-            assert_eq!(step.reward, 1.0);
+            assert!(terminated);
+            assert_eq!(reward, 1.0);
         }
     }
 
@@ -195,7 +203,7 @@ mod tests {
     fn inside_thresholds_does_not_terminate() {
         let mut env = env();
         env.set_state(&[2.3, 0.0, 0.2, 0.0]).unwrap();
-        let step = env.step(1);
+        let step = env.step(1).unwrap();
         assert!(!step.terminated && !step.truncated);
         assert_eq!(step.reward, 1.0);
     }
@@ -204,10 +212,10 @@ mod tests {
     fn steps_after_the_fall_earn_nothing_until_reset() {
         let mut env = env();
         env.set_state(&[0.0, 0.0, 0.3, 0.0]).unwrap();
-        assert_eq!(env.step(0).reward, 1.0);
-        assert_eq!(env.step(0).reward, 0.0);
-        env.reset(None);
-        assert_eq!(env.step(0).reward, 1.0);
+        assert_eq!(env.step(0).unwrap().reward, 1.0);
+        assert_eq!(env.step(0).unwrap().reward, 0.0);
+        env.reset(None).unwrap();
+        assert_eq!(env.step(0).unwrap().reward, 1.0);
     }
 
     #[test]
@@ -216,12 +224,12 @@ mod tests {
             max_episode_steps: 3,
             ..CartPoleParams::default()
         });
-        env.reset(Some(1));
+        env.reset(Some(1)).unwrap();
         env.set_state(&[0.0; 4]).unwrap();
-        assert!(!env.step(0).truncated);
-        assert!(!env.step(1).truncated);
+        assert!(!env.step(0).unwrap().truncated);
+        assert!(!env.step(1).unwrap().truncated);
         env.set_state(&[3.0, 0.0, 0.0, 0.0]).unwrap();
-        let step = env.step(0);
+        let step = env.step(0).unwrap();
         assert!(step.terminated && step.truncated);
         assert_eq!(env.elapsed_steps(), 3);
     }
@@ -230,11 +238,12 @@ mod tests {
     fn same_seed_same_reset_and_resets_in_range() {
         let mut a = CartPole::new(CartPoleParams::default());
         let mut b = CartPole::new(CartPoleParams::default());
-        assert_eq!(a.reset(Some(42)), b.reset(Some(42)));
-        assert_eq!(a.reset(None), b.reset(None));
-        assert_ne!(a.reset(Some(1)), a.reset(Some(2)));
+        assert_eq!(a.reset(Some(42)).unwrap(), b.reset(Some(42)).unwrap());
+        assert_eq!(a.reset(None).unwrap(), b.reset(None).unwrap());
+        let one = a.reset(Some(1)).unwrap().to_vec();
+        assert_ne!(one, a.reset(Some(2)).unwrap());
         for _ in 0..1000 {
-            let obs = a.reset(None);
+            let obs = a.reset(None).unwrap().to_vec();
             assert!(a.state().iter().all(|v| (-0.05..0.05).contains(v)));
             assert!(obs.iter().zip(a.state()).all(|(&o, &s)| o == s as f32));
         }
@@ -244,7 +253,7 @@ mod tests {
     fn unseeded_fresh_env_is_deterministic() {
         let mut a = CartPole::new(CartPoleParams::default());
         let mut b = CartPole::new(CartPoleParams::default());
-        assert_eq!(a.reset(None), b.reset(Some(0)));
+        assert_eq!(a.reset(None).unwrap(), b.reset(Some(0)).unwrap());
     }
 
     #[test]
@@ -252,8 +261,8 @@ mod tests {
         let mut env = env();
         assert_eq!(
             env.set_state(&[0.0; 3]),
-            Err(StateError::WrongLength {
-                env: "CartPole",
+            Err(EnvError::WrongLength {
+                env: "CartPole".into(),
                 expected: 4,
                 got: 3
             })
@@ -263,6 +272,6 @@ mod tests {
     #[test]
     #[should_panic(expected = "action 2")]
     fn out_of_range_action_panics() {
-        env().step(2);
+        env().step(2).unwrap();
     }
 }

@@ -5,7 +5,7 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-use super::{Environment, MountainCarParams, Observation, StateError, Step};
+use super::{EnvError, Environment, MountainCarParams, Step};
 
 /// Range of the starting position (Gymnasium's default reset bounds); velocity starts at 0.
 const RESET_POSITION: std::ops::Range<f64> = -0.6..-0.4;
@@ -20,6 +20,8 @@ const RESET_POSITION: std::ops::Range<f64> = -0.6..-0.4;
 pub struct MountainCar {
     params: MountainCarParams,
     state: [f64; 2],
+    /// The observation: the state cast to `f32`.
+    obs: [f32; 2],
     rng: StdRng,
     elapsed: u32,
 }
@@ -29,6 +31,7 @@ impl MountainCar {
         Self {
             params,
             state: [0.0; 2],
+            obs: [0.0; 2],
             rng: StdRng::seed_from_u64(0),
             elapsed: 0,
         }
@@ -36,7 +39,7 @@ impl MountainCar {
 }
 
 impl Environment for MountainCar {
-    fn id(&self) -> &'static str {
+    fn id(&self) -> &str {
         "MountainCar-v0"
     }
 
@@ -48,13 +51,14 @@ impl Environment for MountainCar {
         3
     }
 
-    fn reset(&mut self, seed: Option<u64>) -> Observation {
+    fn reset(&mut self, seed: Option<u64>) -> Result<&[f32], EnvError> {
         if let Some(seed) = seed {
             self.rng = StdRng::seed_from_u64(seed);
         }
         self.state = [self.rng.random_range(RESET_POSITION), 0.0];
+        self.obs = self.state.map(|v| v as f32);
         self.elapsed = 0;
-        self.observation()
+        Ok(&self.obs)
     }
 
     /// Gymnasium's `MountainCarEnv.step`, operation for operation, so the state matches its
@@ -63,7 +67,7 @@ impl Environment for MountainCar {
     /// # Panics
     /// If `action` is not 0, 1 or 2.
     #[inline]
-    fn step(&mut self, action: usize) -> Step {
+    fn step(&mut self, action: usize) -> Result<Step<'_>, EnvError> {
         assert!(action < 3, "MountainCar: action {action} is not 0, 1 or 2");
         let p = &self.params;
         let [mut position, mut velocity] = self.state;
@@ -76,28 +80,30 @@ impl Environment for MountainCar {
             velocity = 0.0;
         }
         self.state = [position, velocity];
+        self.obs = self.state.map(|v| v as f32);
 
         let terminated = position >= p.goal_position && velocity >= p.goal_velocity;
         self.elapsed += 1;
-        Step {
-            obs: self.observation(),
+        Ok(Step {
+            obs: &self.obs,
             reward: -1.0,
             terminated,
             truncated: self.elapsed >= p.max_episode_steps,
-        }
+        })
     }
 
     #[inline]
-    fn observation(&self) -> Observation {
-        Observation::from_slice(&self.state.map(|v| v as f32))
+    fn observation(&self) -> &[f32] {
+        &self.obs
     }
 
     fn state(&self) -> &[f64] {
         &self.state
     }
 
-    fn set_state(&mut self, state: &[f64]) -> Result<(), StateError> {
-        self.state = StateError::check_length("MountainCar", state)?;
+    fn set_state(&mut self, state: &[f64]) -> Result<(), EnvError> {
+        self.state = EnvError::check_length("MountainCar", state)?;
+        self.obs = self.state.map(|v| v as f32);
         Ok(())
     }
 
@@ -112,7 +118,7 @@ mod tests {
 
     fn env() -> MountainCar {
         let mut env = MountainCar::new(MountainCarParams::default());
-        env.reset(Some(3));
+        env.reset(Some(3)).unwrap();
         env
     }
 
@@ -120,21 +126,21 @@ mod tests {
     fn left_wall_clips_position_and_stops_the_car() {
         let mut env = env();
         env.set_state(&[-1.19, -0.05]).unwrap();
-        let step = env.step(0);
-        assert_eq!(env.state(), &[-1.2, 0.0]);
+        let step = env.step(0).unwrap();
         assert_eq!(*step.obs, [-1.2f32, 0.0]);
         assert!(!step.terminated);
         assert_eq!(step.reward, -1.0);
+        assert_eq!(env.state(), &[-1.2, 0.0]);
     }
 
     #[test]
     fn velocity_is_clipped_to_max_speed() {
         let mut env = env();
         env.set_state(&[-0.5, 0.07]).unwrap();
-        env.step(2);
+        env.step(2).unwrap();
         assert_eq!(env.state()[1], 0.07);
         env.set_state(&[-0.5, -0.07]).unwrap();
-        env.step(0);
+        env.step(0).unwrap();
         assert_eq!(env.state()[1], -0.07);
     }
 
@@ -142,18 +148,18 @@ mod tests {
     fn reaching_the_goal_terminates() {
         let mut env = env();
         env.set_state(&[0.49, 0.02]).unwrap();
-        let step = env.step(2);
-        assert!(env.state()[0] >= 0.5);
+        let step = env.step(2).unwrap();
         assert!(step.terminated);
         assert!(!step.truncated);
         assert_eq!(step.reward, -1.0);
+        assert!(env.state()[0] >= 0.5);
     }
 
     #[test]
     fn moving_away_from_the_goal_does_not_terminate() {
         let mut env = env();
         env.set_state(&[0.45, 0.01]).unwrap();
-        assert!(!env.step(1).terminated);
+        assert!(!env.step(1).unwrap().terminated);
     }
 
     #[test]
@@ -161,13 +167,13 @@ mod tests {
         let mut env = env();
         for _ in 0..199 {
             env.set_state(&[-0.5, 0.0]).unwrap();
-            let step = env.step(1);
+            let step = env.step(1).unwrap();
             assert!(!step.truncated && !step.terminated);
         }
         env.set_state(&[0.55, 0.03]).unwrap();
-        let step = env.step(2);
+        let step = env.step(2).unwrap();
         assert!(step.terminated && step.truncated);
-        env.reset(None);
+        env.reset(None).unwrap();
         assert_eq!(env.elapsed_steps(), 0);
     }
 
@@ -175,10 +181,10 @@ mod tests {
     fn same_seed_same_reset_and_resets_in_range() {
         let mut a = MountainCar::new(MountainCarParams::default());
         let mut b = MountainCar::new(MountainCarParams::default());
-        assert_eq!(a.reset(Some(9)), b.reset(Some(9)));
-        assert_eq!(a.reset(None), b.reset(None));
+        assert_eq!(a.reset(Some(9)).unwrap(), b.reset(Some(9)).unwrap());
+        assert_eq!(a.reset(None).unwrap(), b.reset(None).unwrap());
         for _ in 0..1000 {
-            a.reset(None);
+            a.reset(None).unwrap();
             let [position, velocity] = a.state() else {
                 unreachable!()
             };
@@ -191,13 +197,13 @@ mod tests {
     fn set_state_checks_length() {
         assert!(matches!(
             env().set_state(&[0.0; 3]),
-            Err(StateError::WrongLength { got: 3, .. })
+            Err(EnvError::WrongLength { got: 3, .. })
         ));
     }
 
     #[test]
     #[should_panic(expected = "action 3")]
     fn out_of_range_action_panics() {
-        env().step(3);
+        env().step(3).unwrap();
     }
 }

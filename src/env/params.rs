@@ -2,8 +2,11 @@
 //!
 //! Defaults are Gymnasium's constants; a field left out of a config keeps its default.
 
-use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use std::f64::consts::PI;
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
 
 /// Which environment a config runs, with its physics.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -11,33 +14,76 @@ pub enum EnvConfig {
     CartPole(CartPoleParams),
     MountainCar(MountainCarParams),
     Acrobot(AcrobotParams),
+    /// Any registered Gymnasium task with `Discrete` actions and a 1-D `Box` observation,
+    /// run by its Python worker ([`super::gymnasium`]).
+    Gymnasium(GymnasiumParams),
 }
 
 impl EnvConfig {
-    /// Short name used for the policy library's folder (`saved_policies/<task>/`).
-    pub fn task_name(&self) -> &'static str {
+    /// Short name used for the policy library's folder (`saved_policies/<task>/`): the
+    /// native tasks' names, or a Gymnasium id in lower case with `_` for anything but
+    /// letters and digits (`lunarlander_v3`).
+    pub fn task_name(&self) -> String {
         match self {
-            EnvConfig::CartPole(_) => "cartpole",
-            EnvConfig::MountainCar(_) => "mountain_car",
-            EnvConfig::Acrobot(_) => "acrobot",
+            EnvConfig::CartPole(_) => "cartpole".into(),
+            EnvConfig::MountainCar(_) => "mountain_car".into(),
+            EnvConfig::Acrobot(_) => "acrobot".into(),
+            EnvConfig::Gymnasium(p) => {
+                p.id.chars()
+                    .map(|c| {
+                        if c.is_ascii_alphanumeric() {
+                            c.to_ascii_lowercase()
+                        } else {
+                            '_'
+                        }
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// Gymnasium's id of the task (`CartPole-v1`, `LunarLander-v3`), without starting it.
+    pub fn gym_id(&self) -> String {
+        match self {
+            EnvConfig::CartPole(p) if p.max_episode_steps == 200 => "CartPole-v0".into(),
+            EnvConfig::CartPole(_) => "CartPole-v1".into(),
+            EnvConfig::MountainCar(_) => "MountainCar-v0".into(),
+            EnvConfig::Acrobot(_) => "Acrobot-v1".into(),
+            EnvConfig::Gymnasium(p) => p.id.clone(),
         }
     }
 
     /// The lowest and highest return an episode can have: each step gives +1 (CartPole) or
-    /// −1 (MountainCar and Acrobot, until the goal), for at most the time limit.
+    /// −1 (MountainCar and Acrobot, until the goal), for at most the time limit. A
+    /// Gymnasium task's is its `return_range`, else the one [`known`] for its id: a scale
+    /// rather than a bound where the returns have none (LunarLander).
     pub fn return_range(&self) -> (f64, f64) {
-        let steps = f64::from(self.max_episode_steps());
+        let steps = f64::from(self.max_episode_steps().unwrap_or(1));
         match self {
             EnvConfig::CartPole(_) => (0.0, steps),
             EnvConfig::MountainCar(_) | EnvConfig::Acrobot(_) => (-steps, 0.0),
+            EnvConfig::Gymnasium(p) => p
+                .return_range
+                .as_deref()
+                .and_then(|r| match *r {
+                    [low, high] => Some((low, high)),
+                    _ => None,
+                })
+                .or_else(|| known(&p.id).map(|k| k.return_range))
+                .unwrap_or((0.0, 1.0)),
         }
     }
 
     /// The lowest and highest discounted return `Σ_{t<T} γ^t r_t` an episode can have: each
     /// step's reward lies in `return_range / T` (the rewards here are constant per step), so
     /// the bounds are those times `Σ_{t<T} γ^t = (1 − γ^T)/(1 − γ)`.
+    /// A Gymnasium task, whose rewards vary from step to step, keeps its undiscounted
+    /// range: PRQ-learning's W is then on about the same scale.
     pub fn discounted_return_range(&self, gamma: f64) -> (f64, f64) {
-        let steps = f64::from(self.max_episode_steps());
+        let steps = match (self, self.max_episode_steps()) {
+            (EnvConfig::Gymnasium(_), _) | (_, None) => return self.return_range(),
+            (_, Some(steps)) => f64::from(steps),
+        };
         let horizon = if gamma == 1.0 {
             steps
         } else {
@@ -48,12 +94,17 @@ impl EnvConfig {
     }
 
     /// Moving averages of returns a comparison reports reaching: Gymnasium's "solved"
-    /// levels (CartPole-v1 475, v0 195; MountainCar −110; Acrobot −100) and an easier one.
-    pub fn return_thresholds(&self) -> [f64; 2] {
+    /// levels (CartPole-v1 475, v0 195; MountainCar −110; Acrobot −100; LunarLander 200)
+    /// and an easier one; none for a Gymnasium task sapnet does not know
+    /// (`protocol.thresholds` gives them).
+    pub fn return_thresholds(&self) -> Vec<f64> {
         match self {
-            EnvConfig::CartPole(_) => [195.0, 475.0],
-            EnvConfig::MountainCar(_) => [-150.0, -110.0],
-            EnvConfig::Acrobot(_) => [-150.0, -100.0],
+            EnvConfig::CartPole(_) => vec![195.0, 475.0],
+            EnvConfig::MountainCar(_) => vec![-150.0, -110.0],
+            EnvConfig::Acrobot(_) => vec![-150.0, -100.0],
+            EnvConfig::Gymnasium(p) => {
+                known(&p.id).map_or_else(Vec::new, |k| k.thresholds.to_vec())
+            }
         }
     }
 
@@ -65,6 +116,24 @@ impl EnvConfig {
             EnvConfig::CartPole(_) => EnvConfig::CartPole(CartPoleParams::default()),
             EnvConfig::MountainCar(_) => EnvConfig::MountainCar(MountainCarParams::default()),
             EnvConfig::Acrobot(_) => EnvConfig::Acrobot(AcrobotParams::default()),
+            // `LunarLander-v3(gravity=-8.0)`: the id, then its kwargs and attributes.
+            EnvConfig::Gymnasium(p) => {
+                let mut changed: Vec<String> = p
+                    .kwargs
+                    .iter()
+                    .chain(&p.attributes)
+                    .map(|(name, value)| format!("{name}={}", value_text(value)))
+                    .collect();
+                if let Some(steps) = p.max_episode_steps {
+                    changed.push(format!("max_episode_steps={steps}"));
+                }
+                changed.sort();
+                return if changed.is_empty() {
+                    p.id.clone()
+                } else {
+                    format!("{}({})", p.id, changed.join(", "))
+                };
+            }
         };
         let fields = |env: &EnvConfig| -> serde_json::Map<String, serde_json::Value> {
             match serde_json::to_value(env) {
@@ -90,11 +159,16 @@ impl EnvConfig {
         }
     }
 
-    pub fn max_episode_steps(&self) -> u32 {
+    /// The time limit; a Gymnasium task's given one, else the registered one of a task
+    /// sapnet knows, else unknown until the task is made.
+    pub fn max_episode_steps(&self) -> Option<u32> {
         match self {
-            EnvConfig::CartPole(p) => p.max_episode_steps,
-            EnvConfig::MountainCar(p) => p.max_episode_steps,
-            EnvConfig::Acrobot(p) => p.max_episode_steps,
+            EnvConfig::CartPole(p) => Some(p.max_episode_steps),
+            EnvConfig::MountainCar(p) => Some(p.max_episode_steps),
+            EnvConfig::Acrobot(p) => Some(p.max_episode_steps),
+            EnvConfig::Gymnasium(p) => p
+                .max_episode_steps
+                .or_else(|| known(&p.id).map(|k| k.max_episode_steps)),
         }
     }
 }
@@ -105,8 +179,10 @@ impl EnvConfig {
     /// sits in the config (`env`, `sources.env`). A negative `force_mag` is allowed: it
     /// mirrors CartPole's actions.
     pub fn validate(&self, field: &str) -> Result<(), String> {
-        let mut rules = Rules::new(field, self.task_name());
+        let task = self.task_name();
+        let mut rules = Rules::new(field, &task);
         match self {
+            EnvConfig::Gymnasium(p) => p.check(&mut rules),
             EnvConfig::CartPole(p) => {
                 rules.time_limit(p.max_episode_steps);
                 rules.finite("gravity", p.gravity);
@@ -236,6 +312,117 @@ impl<'a> Rules<'a> {
     fn result(self) -> Result<(), String> {
         self.broken.map_or(Ok(()), Err)
     }
+}
+
+/// A Gymnasium task: `Gymnasium(id: "LunarLander-v3", kwargs: {"gravity": -8.0})`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GymnasiumParams {
+    /// The registered id, as `gymnasium.make` takes it.
+    pub id: String,
+    /// Keyword arguments of `gymnasium.make(id, **kwargs)`: the task's own (`gravity`,
+    /// `enable_wind` of LunarLander) or `make`'s.
+    pub kwargs: BTreeMap<String, serde_json::Value>,
+    /// Attributes set on `env.unwrapped` after it is made, for constants a task has no
+    /// keyword for (CartPole's `length`; derived ones such as its `polemass_length` are
+    /// the config's to set too).
+    pub attributes: BTreeMap<String, serde_json::Value>,
+    /// The time limit (`TimeLimit`'s); `None`: the registered one.
+    pub max_episode_steps: Option<u32>,
+    /// `Some([lowest, highest])`, the returns of an episode, which scale returns for UCB1,
+    /// PRQ-learning and pooled reports; required unless [`known`] has them for `id`.
+    pub return_range: Option<Vec<f64>>,
+    /// The Python that has Gymnasium; `None`: the active virtualenv's, else `python3`.
+    pub python: Option<PathBuf>,
+}
+
+impl GymnasiumParams {
+    fn check(&self, rules: &mut Rules) {
+        rules.holds(
+            "id",
+            !self.id.is_empty()
+                && self
+                    .id
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "-_/:.".contains(c)),
+            &format!(
+                "a registered Gymnasium id such as \"LunarLander-v3\", got {:?}",
+                self.id
+            ),
+        );
+        for (field, names) in [("kwargs", &self.kwargs), ("attributes", &self.attributes)] {
+            for name in names.keys() {
+                rules.holds(
+                    field,
+                    !name.is_empty()
+                        && !name.starts_with(|c: char| c.is_ascii_digit())
+                        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_'),
+                    &format!("Python identifiers as names, got {name:?}"),
+                );
+            }
+        }
+        if let Some(steps) = self.max_episode_steps {
+            rules.time_limit(steps);
+        }
+        match self.return_range.as_deref() {
+            Some(range) => rules.holds(
+                "return_range",
+                matches!(*range, [low, high] if low.is_finite() && high.is_finite() && low < high),
+                &format!("Some([lowest, highest]) finite with lowest < highest, got {range:?}"),
+            ),
+            None => rules.holds(
+                "return_range",
+                known(&self.id).is_some(),
+                &format!(
+                    "Some([lowest, highest]): the returns of {} an episode can have (it scales \
+                     returns for UCB1, PRQ-learning and pooled reports; sapnet knows it only \
+                     for CartPole, MountainCar, Acrobot and LunarLander)",
+                    self.id
+                ),
+            ),
+        }
+    }
+}
+
+/// What sapnet knows of some Gymnasium tasks, so that a config need not say it.
+pub struct Known {
+    pub return_range: (f64, f64),
+    pub thresholds: &'static [f64],
+    pub max_episode_steps: u32,
+}
+
+/// The classic-control tasks as Gymnasium registers them, and LunarLander-v3, whose
+/// returns have no bounds: its range is a scale, from about a random policy's return
+/// (−200) to above "solved" (200) at 300.
+pub fn known(id: &str) -> Option<Known> {
+    Some(match id {
+        "CartPole-v1" => Known {
+            return_range: (0.0, 500.0),
+            thresholds: &[195.0, 475.0],
+            max_episode_steps: 500,
+        },
+        "CartPole-v0" => Known {
+            return_range: (0.0, 200.0),
+            thresholds: &[195.0, 475.0],
+            max_episode_steps: 200,
+        },
+        "MountainCar-v0" => Known {
+            return_range: (-200.0, 0.0),
+            thresholds: &[-150.0, -110.0],
+            max_episode_steps: 200,
+        },
+        "Acrobot-v1" => Known {
+            return_range: (-500.0, 0.0),
+            thresholds: &[-150.0, -100.0],
+            max_episode_steps: 500,
+        },
+        "LunarLander-v3" => Known {
+            return_range: (-200.0, 300.0),
+            thresholds: &[100.0, 200.0],
+            max_episode_steps: 1000,
+        },
+        _ => return None,
+    })
 }
 
 /// CartPole's integrator (Gymnasium's `kinematics_integrator`).

@@ -30,9 +30,8 @@ fn parameter_bytes(architecture: &Architecture) -> f64 {
 /// About how many bytes `spec`'s run holds at most: each network (learning ones with their
 /// target, gradients and Adam state) and the replay memories, which hold at most every
 /// step of the run.
-pub fn run_bytes(spec: &RunSpec) -> f64 {
-    let env = crate::env::make(&spec.env);
-    let (obs, actions) = (env.observation_size(), env.action_count());
+pub fn run_bytes(spec: &RunSpec) -> Result<f64, crate::env::EnvError> {
+    let (obs, actions) = crate::env::spaces(&spec.env)?;
     let sources = spec
         .sources
         .iter()
@@ -49,12 +48,17 @@ pub fn run_bytes(spec: &RunSpec) -> f64 {
             spec.sources.len() as f64,
         ),
     };
+    // A Gymnasium task's time limit may be unknown here: the replay's capacity bounds it.
     let steps = spec.max_steps.map_or_else(
-        || f64::from(spec.episodes) * f64::from(spec.env.max_episode_steps()),
+        || {
+            spec.env
+                .max_episode_steps()
+                .map_or(f64::INFINITY, |t| f64::from(spec.episodes) * f64::from(t))
+        },
         |s| s as f64,
     );
     let replay = (learners * spec.dqn.replay_capacity as f64).min(steps) * transition_bytes(obs);
-    networks + replay
+    Ok(networks + replay)
 }
 
 /// Refuses `specs` run `jobs` at a time if the largest of them could not fit in this
@@ -63,11 +67,11 @@ pub fn check(specs: &[RunSpec], jobs: usize) -> Result<()> {
     let Some(machine) = total_memory() else {
         return Ok(());
     };
-    let Some((largest, bytes)) = specs
+    let sized = specs
         .iter()
-        .map(|s| (s, run_bytes(s)))
-        .max_by(|a, b| a.1.total_cmp(&b.1))
-    else {
+        .map(|s| Ok((s, run_bytes(s)?)))
+        .collect::<Result<Vec<_>, crate::env::EnvError>>()?;
+    let Some((largest, bytes)) = sized.into_iter().max_by(|a, b| a.1.total_cmp(&b.1)) else {
         return Ok(());
     };
     let together = jobs.clamp(1, specs.len()) as f64;
@@ -127,12 +131,12 @@ mod tests {
         // 100 episodes of at most 500 steps under a capacity of 1,000: 1,000 transitions of
         // 8·4 + 10 = 42 bytes.
         assert_eq!(
-            run_bytes(&dqn_spec(vec![10], 1_000)),
+            run_bytes(&dqn_spec(vec![10], 1_000)).unwrap(),
             5.0 * 288.0 + 42_000.0
         );
         // A capacity above the run's steps holds only the steps: 100·500.
         assert_eq!(
-            run_bytes(&dqn_spec(vec![10], 1_000_000)),
+            run_bytes(&dqn_spec(vec![10], 1_000_000)).unwrap(),
             5.0 * 288.0 + 50_000.0 * 42.0
         );
     }

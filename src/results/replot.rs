@@ -131,7 +131,7 @@ pub fn read(dir: &Path) -> Result<PlotData> {
         .filter(|(_, runs)| !runs.is_empty())
         .collect();
     Ok(PlotData {
-        task: crate::env::make(&config.env).id().to_string(),
+        task: config.env.gym_id(),
         window: config.protocol.moving_average,
         curves,
         policy_names: read.names,

@@ -37,7 +37,7 @@ pub fn evaluate(config: &Config, library: &Path) -> Result<Vec<Evaluation>> {
     sources
         .iter()
         .map(|source| {
-            let mut env = crate::env::make(&config.env);
+            let mut env = crate::env::make(&config.env)?;
             let returns = crate::trainer::test_greedy(&source.net, env.as_mut(), episodes, seed)?;
             Ok(Evaluation {
                 name: source.name.clone(),
@@ -147,17 +147,13 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
         );
     }
 
-    let env = crate::env::make(&config.env);
+    let (observation_size, action_count) = crate::env::spaces(&config.env)?;
     let plans = plan(config);
     let mut sources = Vec::with_capacity(found.policies.len());
     for (entry, planned) in found.policies.iter().zip(&plans) {
         let task = &wanted.tasks[planned.task];
-        let stored = policy_store::load_for_task(
-            &dir,
-            &entry.name,
-            env.observation_size(),
-            env.action_count(),
-        )?;
+        let stored =
+            policy_store::load_for_task(&dir, &entry.name, observation_size, action_count)?;
         let metadata_path = policy_store::paths(&dir, &entry.name).1;
         let metadata_sha256 = policy_store::sha256_hex(
             &std::fs::read(&metadata_path)

@@ -367,7 +367,7 @@ fn plot_data(pooled: &Results) -> PlotData {
         })
         .collect();
     PlotData {
-        task: crate::env::make(&pooled.config.env).id().to_string(),
+        task: pooled.config.env.gym_id(),
         window: pooled.config.protocol.moving_average,
         curves,
         policy_names: Vec::new(),

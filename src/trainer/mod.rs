@@ -29,6 +29,9 @@ pub enum TrainerError {
     // Not a `source`: the message says it, and a chain prints it once.
     #[error("building the selector over the source policies: {0}")]
     Reuse(ReuseError),
+    /// The environment failed: a Gymnasium task's worker raised, died or could not start.
+    #[error(transparent)]
+    Env(#[from] crate::env::EnvError),
     /// The loss or a gradient became NaN or infinite.
     #[error("policy {} (run {}) diverged: {}", .0.method, .0.run, .0.source)]
     Diverged(Box<Divergence>),

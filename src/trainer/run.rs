@@ -252,7 +252,7 @@ pub fn train(
 ) -> Result<RunOutcome, TrainerError> {
     let started = Instant::now();
     let streams = Streams::new(spec.seed);
-    let mut env = env::make(&spec.env);
+    let mut env = env::make(&spec.env)?;
     let descriptions: Vec<PolicyDescription> =
         spec.sources.iter().map(|s| s.description.clone()).collect();
     let mut selector = selector(spec)?;
@@ -348,7 +348,8 @@ pub fn train(
     // method's own learner.
     let mut last_source = 0;
     let mut steps: u64 = 0;
-    let mut obs = env.reset(Some(streams.env));
+    // The observation acted on, copied out of the environment each step (no allocation).
+    let mut obs: Vec<f32> = env.reset(Some(streams.env))?.to_vec();
 
     'episodes: for episode in 1..=spec.episodes {
         let mut reward = 0.0;
@@ -370,12 +371,12 @@ pub fn train(
                 selector.act(&mut selection_rng)
             };
             let action = learners.act(actor, &obs, &mut rng)?;
-            let step = env.step(action);
+            let step = env.step(action)?;
             replay.push(Transition {
                 obs: &obs,
                 action,
                 reward: step.reward,
-                next_obs: &step.obs,
+                next_obs: step.obs,
                 terminated: step.terminated,
                 truncated: step.truncated,
             });
@@ -466,11 +467,11 @@ pub fn train(
             discounted += discount * step.reward;
             discount *= spec.dqn.gamma;
             episode_steps += 1;
-            let done = step.done();
-            obs = if done { env.reset(None) } else { step.obs };
-            if done {
+            if step.done() {
+                obs.copy_from_slice(env.reset(None)?);
                 break;
             }
+            obs.copy_from_slice(step.obs);
         }
         record.episodes = episode;
         selector.set_tracing(control.trace());
@@ -522,7 +523,7 @@ pub fn train(
             .into_online(),
     };
     if !record.stopped {
-        let mut test_env = env::make(&spec.env);
+        let mut test_env = env::make(&spec.env)?;
         record.test_returns = test_greedy(
             &net,
             test_env.as_mut(),
@@ -543,16 +544,18 @@ pub fn test_greedy(
     seed: u64,
 ) -> Result<Vec<f64>, TrainerError> {
     let mut returns = Vec::with_capacity(episodes as usize);
+    let mut obs = Vec::with_capacity(env.observation_size());
     for episode in 0..episodes {
-        let mut obs = env.reset((episode == 0).then_some(seed));
+        obs.clear();
+        obs.extend_from_slice(env.reset((episode == 0).then_some(seed))?);
         let mut total = 0.0;
         loop {
-            let step = env.step(net.greedy_action(&obs)?);
+            let step = env.step(net.greedy_action(&obs)?)?;
             total += step.reward;
             if step.done() {
                 break;
             }
-            obs = step.obs;
+            obs.copy_from_slice(step.obs);
         }
         returns.push(total);
     }
