@@ -427,3 +427,106 @@ fn the_python_side_killed_fails_the_run_within_a_second() {
     );
     assert!(message.contains("was killed by signal 9"), "{message}");
 }
+
+/// A copy of a shipped library, so that the chosen policies the runs add to it stay out of
+/// the checkout.
+fn copy_library(task: &str, library: &Path) {
+    let from = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("saved_policies")
+        .join(task);
+    let to = library.join(task);
+    std::fs::create_dir_all(&to).unwrap();
+    for entry in std::fs::read_dir(&from).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_file() {
+            std::fs::copy(&path, to.join(path.file_name().unwrap())).unwrap();
+        }
+    }
+}
+
+#[test]
+fn the_shipped_lunar_lander_comparison_runs_through_the_bridge_and_writes_every_output() {
+    let python = python_or_skip!();
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    copy_library("lunarlander_v3", &library);
+    let out = tmp.path().join("out");
+    let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/reuse_lunar_lander.ron");
+    let output = sapnet()
+        .args(["--headless", "--quick", "--episodes", "2", "--config"])
+        .arg(&config)
+        .arg("--library")
+        .arg(&library)
+        .arg("--out")
+        .arg(&out)
+        .env("VIRTUAL_ENV", python.parent().unwrap().parent().unwrap())
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    for file in [
+        "summary.json",
+        "episodes.csv",
+        "tests.csv",
+        "comparison.csv",
+        "improvement.csv",
+        "scores.csv",
+        "activations.csv",
+        "learning_curve.png",
+        "tests.png",
+        "intervals.png",
+        "profiles.png",
+        "improvement.png",
+        "selections.png",
+        "activations.png",
+    ] {
+        let len = std::fs::metadata(out.join(file)).map_or(0, |m| m.len());
+        assert!(len > 0, "{file} missing or empty");
+    }
+    let comparison = std::fs::read_to_string(out.join("comparison.csv")).unwrap();
+    // Eleven methods, two runs each.
+    assert_eq!(comparison.lines().count(), 12, "{comparison}");
+    assert!(
+        comparison.lines().skip(1).all(|l| l.contains(",2,")),
+        "{comparison}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["status"], "complete");
+    assert_eq!(
+        summary["config"]["env"]["Gymnasium"]["id"], "LunarLander-v3",
+        "{summary}"
+    );
+}
+
+#[test]
+fn a_sweep_over_lunar_lander_keywords_plans_a_task_variant_per_cell() {
+    // Planning starts no Python: a task's spaces are asked for when a cell runs.
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = tmp.path().join("sweep");
+    let grid = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/sweep_lunar_lander.ron");
+    let output = sapnet()
+        .args(["sweep", "plan", "--grid"])
+        .arg(&grid)
+        .arg("--out")
+        .arg(&sweep)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    let mut tasks = Vec::new();
+    for cell in 0..6 {
+        let path = sweep.join(format!("cells/{cell:04}.ron"));
+        let config = sapnet::config::Config::from_file(&path).unwrap();
+        tasks.push(config.env.label());
+    }
+    assert_eq!(
+        tasks,
+        [
+            "LunarLander-v3(enable_wind=false, gravity=-6.0)",
+            "LunarLander-v3(enable_wind=true, gravity=-6.0)",
+            "LunarLander-v3(enable_wind=false, gravity=-8.0)",
+            "LunarLander-v3(enable_wind=true, gravity=-8.0)",
+            "LunarLander-v3(enable_wind=false, gravity=-10.0)",
+            "LunarLander-v3(enable_wind=true, gravity=-10.0)",
+        ]
+    );
+}

@@ -42,6 +42,19 @@ impl EnvConfig {
         }
     }
 
+    /// The task itself, without how this machine runs it (a Gymnasium task's `python`):
+    /// what a library records of its sources and compares with a config, so a library
+    /// shared between machines neither names nor depends on one's paths.
+    pub fn as_recorded(&self) -> EnvConfig {
+        match self {
+            EnvConfig::Gymnasium(p) => EnvConfig::Gymnasium(GymnasiumParams {
+                python: None,
+                ..p.clone()
+            }),
+            native => native.clone(),
+        }
+    }
+
     /// Gymnasium's id of the task (`CartPole-v1`, `LunarLander-v3`), without starting it.
     pub fn gym_id(&self) -> String {
         match self {

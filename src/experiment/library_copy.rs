@@ -87,7 +87,7 @@ pub fn policy_info(config: &Config, record: &RunRecord) -> PolicyInfo {
         .as_ref()
         .map(|chosen| format!("{}/{}", sources::library_name(config), chosen.name));
     PolicyInfo {
-        source_task: config.env.clone(),
+        source_task: config.env.as_recorded(),
         training: TrainingBudget {
             episodes: u64::from(record.episodes),
             steps: record.steps,

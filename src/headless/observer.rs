@@ -163,7 +163,7 @@ impl Observer for ResultFiles {
             last_good,
         } = *divergence;
         let info = PolicyInfo {
-            source_task: self.config.env.clone(),
+            source_task: self.config.env.as_recorded(),
             training: TrainingBudget {
                 episodes: u64::from(episodes),
                 steps,

@@ -169,7 +169,7 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
                 manifest_path.display()
             );
         }
-        if entry.name != planned.name || stored.metadata.source_task != task.env {
+        if entry.name != planned.name || stored.metadata.source_task != task.env.as_recorded() {
             bail!(
                 "policy {} was trained on {}, but the config puts {} on {}; retrain the library \
                  with `sapnet sources --retrain` or use another --library",

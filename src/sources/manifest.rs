@@ -62,7 +62,13 @@ impl LibraryTraining {
     pub fn of(config: &Config) -> Self {
         let s = &config.sources;
         Self {
-            tasks: super::tasks(config),
+            tasks: super::tasks(config)
+                .into_iter()
+                .map(|t| SourceTask {
+                    env: t.env.as_recorded(),
+                    ..t
+                })
+                .collect(),
             hidden_layers: s.hidden_layers,
             units: s.units,
             training_episodes: s.training_episodes,

@@ -117,7 +117,7 @@ fn train_source(
     }
     let returns = &outcome.record.test_returns;
     let info = PolicyInfo {
-        source_task: spec.env.clone(),
+        source_task: spec.env.as_recorded(),
         training: TrainingBudget {
             episodes: u64::from(outcome.record.episodes),
             steps: outcome.record.steps,

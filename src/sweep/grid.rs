@@ -12,7 +12,9 @@
 //!
 //! A path names struct fields from the top of the config (`sapnet.temperature`,
 //! `protocol.methods`, `seed`, `env`); a value is RON, read as that field reads it. An
-//! enum such as `env` is given whole (`CartPole(length: 1.0)`).
+//! enum such as `env` is given whole (`CartPole(length: 1.0)`), or one field of the base's
+//! task at a time (`env.length`), or one keyword of a Gymnasium task
+//! (`env.kwargs.gravity`, `env.attributes.length`): a task variant per value.
 
 use std::path::{Path, PathBuf};
 
@@ -187,6 +189,11 @@ fn set(json: &mut Value, path: &str, value: &str, origin: &str) -> Result<()> {
     if fields.iter().any(|f| f.is_empty()) {
         bail!("{origin}: axis path {path:?} is not a dotted list of config fields");
     }
+    if let ["env", task_fields @ ..] = fields.as_slice() {
+        if !task_fields.is_empty() {
+            return set_task_field(json, task_fields, path, value, origin);
+        }
+    }
     let mut patch = value.to_string();
     for field in fields.iter().rev() {
         patch = format!("({field}: {patch})");
@@ -205,6 +212,59 @@ fn set(json: &mut Value, path: &str, value: &str, origin: &str) -> Result<()> {
     };
     *slot = new.clone();
     Ok(())
+}
+
+/// Sets `env.<field>` (of the base's task, whichever it is) or `env.kwargs.<name>` /
+/// `env.attributes.<name>` (one keyword of a Gymnasium task) to `value`.
+fn set_task_field(
+    json: &mut Value,
+    fields: &[&str],
+    path: &str,
+    value: &str,
+    origin: &str,
+) -> Result<()> {
+    let Some((task, params)) = json
+        .get_mut("env")
+        .and_then(Value::as_object_mut)
+        .and_then(|env| env.iter_mut().next())
+    else {
+        bail!("{origin}: axis path {path:?}: the base config has no task");
+    };
+    let located = format!("{origin}, axis `{path}` value {value}");
+    match fields {
+        [map @ ("kwargs" | "attributes"), name] => {
+            if task != "Gymnasium" {
+                bail!(
+                    "{located}: `env.{map}` is a Gymnasium task's; the base's task is {task} \
+                     (set its fields as `env.<field>`)"
+                );
+            }
+            let keyword: Value = parse_ron(value, &located)?;
+            let Some(map) = params.get_mut(*map).and_then(Value::as_object_mut) else {
+                bail!("{located}: the base's task has no `{map}`");
+            };
+            map.insert(name.to_string(), keyword);
+            Ok(())
+        }
+        [field] => {
+            // The value goes into a task of defaults of the base's kind, whose JSON gives
+            // the field's representation, as [`set`] does for the whole config.
+            let patch = format!("(env: {task}({field}: {value}))");
+            let parsed: Config = parse_ron(&patch, &located).map_err(|e| {
+                anyhow::anyhow!("{e} (`env.<field>` names a field of the base's task, {task})")
+            })?;
+            let parsed = serde_json::to_value(&parsed).context("a config as JSON")?;
+            let Some(new) = parsed.pointer(&format!("/env/{task}/{field}")) else {
+                bail!("{located}: {task} has no field `{field}`");
+            };
+            params[*field] = new.clone();
+            Ok(())
+        }
+        _ => bail!(
+            "{origin}: axis path {path:?}: under `env`, a field of the task (`env.length`) or \
+             a Gymnasium keyword (`env.kwargs.gravity`)"
+        ),
+    }
 }
 
 #[cfg(test)]
@@ -245,9 +305,12 @@ mod tests {
         let err = format!("{:#}", g.cells(&Config::default(), "grid.ron").unwrap_err());
         assert!(err.contains("axis `sapnet.temprature`"), "{err}");
         assert!(err.contains("temprature"), "{err}");
-        let g = grid("(base: \"x.ron\", axes: [(path: \"env.length\", values: [1.0])])");
+        let g = grid("(base: \"x.ron\", axes: [(path: \"env.lenght\", values: [1.0])])");
         let err = format!("{:#}", g.cells(&Config::default(), "grid.ron").unwrap_err());
-        assert!(err.contains("given whole"), "{err}");
+        assert!(err.contains("lenght") && err.contains("CartPole"), "{err}");
+        let g = grid("(base: \"x.ron\", axes: [(path: \"env.kwargs.gravity\", values: [1.0])])");
+        let err = format!("{:#}", g.cells(&Config::default(), "grid.ron").unwrap_err());
+        assert!(err.contains("Gymnasium task's"), "{err}");
         let g = grid("(base: \"x.ron\", axes: [(path: \"sapnet.temperature\", values: [-1.0])])");
         let err = format!("{:#}", g.cells(&Config::default(), "grid.ron").unwrap_err());
         assert!(err.contains("cell 0 (sapnet.temperature=-1.0)"), "{err}");
@@ -261,5 +324,37 @@ mod tests {
         let cells = g.cells(&Config::default(), "grid.ron").unwrap();
         assert_eq!(cells[0].config.env.label(), "cartpole(length=1.0)");
         assert_eq!(cells[1].config.env.label(), "mountain_car");
+    }
+
+    #[test]
+    fn a_task_field_or_a_gymnasium_keyword_is_a_variant_per_value() {
+        let g = grid("(base: \"x.ron\", axes: [(path: \"env.length\", values: [0.25, 1.0])])");
+        let cells = g.cells(&Config::default(), "grid.ron").unwrap();
+        assert_eq!(cells[0].config.env.label(), "cartpole(length=0.25)");
+        assert_eq!(cells[1].config.env.label(), "cartpole(length=1.0)");
+
+        let mut base = Config::default();
+        base.env = parse_ron(
+            "Gymnasium(id: \"LunarLander-v3\", kwargs: {\"enable_wind\": true})",
+            "env",
+        )
+        .unwrap();
+        let g = grid(
+            "(base: \"x.ron\", axes: [(path: \"env.kwargs.gravity\", values: [-6.0, -11.5]), \
+             (path: \"env.max_episode_steps\", values: [Some(400)])])",
+        );
+        let cells = g.cells(&base, "grid.ron").unwrap();
+        let labels: Vec<String> = cells.iter().map(|c| c.config.env.label()).collect();
+        assert_eq!(
+            labels,
+            [
+                "LunarLander-v3(enable_wind=true, gravity=-6.0, max_episode_steps=400)",
+                "LunarLander-v3(enable_wind=true, gravity=-11.5, max_episode_steps=400)",
+            ]
+        );
+        assert_eq!(
+            cells[0].axes[0],
+            ("env.kwargs.gravity".into(), "-6.0".into())
+        );
     }
 }
