@@ -3,6 +3,8 @@
 //! environments to the same bits; failures are said, not hung. Without such a Python the
 //! tests say they are skipped.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -528,5 +530,69 @@ fn a_sweep_over_lunar_lander_keywords_plans_a_task_variant_per_cell() {
             "LunarLander-v3(enable_wind=false, gravity=-10.0)",
             "LunarLander-v3(enable_wind=true, gravity=-10.0)",
         ]
+    );
+}
+
+#[test]
+fn the_python_side_killed_under_the_dashboard_is_said_and_the_terminal_restored() {
+    let python = python_or_skip!();
+    if !common::tmux::available() {
+        eprintln!("tmux is not installed: the dashboard's bridge test is skipped");
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    copy_library("lunarlander_v3", &library);
+    let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/reuse_lunar_lander.ron");
+    let dashboard = format!(
+        "{} --config {} --library {} --seed 4343",
+        env!("CARGO_BIN_EXE_sapnet"),
+        config.display(),
+        library.display()
+    );
+    let session = common::tmux::Session::start(
+        120,
+        40,
+        &format!(
+            "VIRTUAL_ENV={} {dashboard}; echo SAPNET-EXITED $?; stty -a | grep -o -- '-*icanon'; \
+             sleep 60",
+            python.parent().unwrap().parent().unwrap().display()
+        ),
+    );
+    session.wait_for(&["sapnet ep", "RUNNING"]);
+    let found = Command::new("pgrep")
+        .args(["-f", &format!("^{dashboard}$")])
+        .output()
+        .unwrap();
+    let pid = String::from_utf8_lossy(&found.stdout).trim().to_string();
+    assert!(!pid.is_empty(), "no dashboard process found");
+    let killed = Instant::now();
+    let status = Command::new("pkill")
+        .args(["-KILL", "-P", &pid, "python"])
+        .status()
+        .unwrap();
+    assert!(status.success(), "no Gymnasium worker under the dashboard");
+    session.wait_for(&["FAILED"]);
+    // The screen is read every 200 ms and the machine may be busy: a bound with room, a
+    // hang would take the test's 120 s.
+    assert!(
+        killed.elapsed() < Duration::from_secs(3),
+        "the failure took {:?} to show",
+        killed.elapsed()
+    );
+    session.keys("q");
+    let screen = session.wait_for(&["SAPNET-EXITED", "icanon"]);
+    assert!(screen.contains("stopped answering"), "{screen}");
+    assert!(
+        !screen.contains("SAPNET-EXITED 0"),
+        "a failed run exits 0:\n{screen}"
+    );
+    assert!(
+        !screen.contains("SAP-Net graph"),
+        "the alternate screen was left:\n{screen}"
+    );
+    assert!(
+        screen.lines().any(|l| l.trim() == "icanon"),
+        "raw mode was left on:\n{screen}"
     );
 }

@@ -333,12 +333,14 @@ mod tests {
         assert_eq!(cells[0].config.env.label(), "cartpole(length=0.25)");
         assert_eq!(cells[1].config.env.label(), "cartpole(length=1.0)");
 
-        let mut base = Config::default();
-        base.env = parse_ron(
-            "Gymnasium(id: \"LunarLander-v3\", kwargs: {\"enable_wind\": true})",
-            "env",
-        )
-        .unwrap();
+        let base = Config {
+            env: parse_ron(
+                "Gymnasium(id: \"LunarLander-v3\", kwargs: {\"enable_wind\": true})",
+                "env",
+            )
+            .unwrap(),
+            ..Config::default()
+        };
         let g = grid(
             "(base: \"x.ron\", axes: [(path: \"env.kwargs.gravity\", values: [-6.0, -11.5]), \
              (path: \"env.max_episode_steps\", values: [Some(400)])])",

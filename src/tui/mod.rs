@@ -186,14 +186,25 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
     for run in &runs {
         let _ = run.handle.commands.send(Command::Stop);
     }
+    // Every failure is said; the first makes the exit status, as a headless run's would.
+    let mut failed = None;
     for run in runs {
-        match run.handle.thread.join() {
-            Ok(Ok(_)) => {}
-            Ok(Err(err)) => eprintln!("a training run failed: {err}"),
-            Err(_) => eprintln!("a training thread panicked"),
+        let failure = match run.handle.thread.join() {
+            Ok(Ok(_)) => continue,
+            Ok(Err(err)) => format!("a training run failed: {err}"),
+            Err(_) => "a training thread panicked".to_string(),
+        };
+        if failed.is_some() {
+            eprintln!("{failure}");
+        } else {
+            failed = Some(failure);
         }
     }
-    result
+    result?;
+    match failed {
+        Some(failure) => Err(anyhow::anyhow!(failure)),
+        None => Ok(()),
+    }
 }
 
 /// Runs stand-alone teach mode until the user quits.

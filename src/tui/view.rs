@@ -189,7 +189,13 @@ fn draw_training(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
             }
         }
         None => {
-            let note = Paragraph::new("This config runs no SAP-Net: only its baselines train.")
+            // Before a followed run's first step it is still loading its library or
+            // starting its task (a Gymnasium worker takes a second or more).
+            let note = match &dashboard.followed {
+                Some(method) => format!("{method}: loading the library and starting the task…"),
+                None => "This config runs no SAP-Net: only its baselines train.".to_string(),
+            };
+            let note = Paragraph::new(note)
                 .block(focus_block("SAP-Net graph", false))
                 .wrap(Wrap { trim: true });
             let top = match (graph.is_empty(), table.is_empty()) {

@@ -2,4 +2,6 @@
 #[allow(dead_code)]
 pub mod signal;
 #[allow(dead_code)]
+pub mod tmux;
+#[allow(dead_code)]
 pub mod tui_script;
