@@ -72,13 +72,14 @@ request = struct.Struct("<BIQ")
 tail = struct.Struct("<d??")
 ok_size = 1 + 4 * n + tail.size
 zero_tail = tail.pack(0.0, False, False)
-pack = tail.pack
 step = env.step
 reset = env.reset
 
 
 def read_exactly(count):
-    data = b""
+    data = read(0, count)
+    if len(data) == count:
+        return data
     while len(data) < count:
         chunk = read(0, count - len(data))
         if not chunk:
@@ -94,6 +95,10 @@ def error(message):
 
 
 f32 = np.dtype(np.float32)
+# The ok reply of a step, written in place: one buffer, one write, no bytes joined.
+reply = bytearray(ok_size)
+obs_end = 1 + 4 * n
+pack_into = tail.pack_into
 
 
 def observation(values):
@@ -112,7 +117,9 @@ while True:
     try:
         if op == 0x53:  # 'S': step
             obs, reward, terminated, truncated, _ = step(word)
-            write(1, b"\x00" + observation(obs) + pack(reward, terminated, truncated))
+            reply[1:obs_end] = observation(obs)
+            pack_into(reply, obs_end, reward, terminated, truncated)
+            write(1, reply)
         elif op == 0x52:  # 'R': reset, with a seed if the word is 1
             obs, _ = reset(seed=seed if word == 1 else None)
             write(1, b"\x00" + observation(obs) + zero_tail)

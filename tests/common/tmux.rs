@@ -44,9 +44,11 @@ impl Session {
         assert!(status.success());
     }
 
+    /// The pane's text, a line wrapped by the terminal joined back into one (`-J`), so a
+    /// message is found whatever the pane's width.
     pub fn screen(&self) -> String {
         let out = Command::new("tmux")
-            .args(["capture-pane", "-p", "-t", &self.0])
+            .args(["capture-pane", "-p", "-J", "-t", &self.0])
             .output()
             .expect("running tmux");
         String::from_utf8_lossy(&out.stdout).into_owned()
