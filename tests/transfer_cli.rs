@@ -237,6 +237,64 @@ fn plotting_a_directory_without_results_names_the_missing_file() {
     );
 }
 
+/// A report shipped without its run records (docs/reuse/<task>/ is one) is refused by
+/// `plot` and `pool` before anything is written: made again from no records it would be a
+/// report of no runs, written over the files it came with.
+#[test]
+fn a_report_shipped_without_its_run_records_is_refused_and_kept() {
+    let tmp = tempfile::tempdir().unwrap();
+    let shipped = tmp.path().join("acrobot");
+    std::fs::create_dir(&shipped).unwrap();
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/reuse/acrobot");
+    for file in ["summary.json", "comparison.csv", "tests.csv", "scores.csv"] {
+        std::fs::copy(docs.join(file), shipped.join(file)).unwrap();
+    }
+    let before: Vec<Vec<u8>> = ["summary.json", "comparison.csv", "tests.csv"]
+        .iter()
+        .map(|f| std::fs::read(shipped.join(f)).unwrap())
+        .collect();
+    for args in [
+        vec!["plot".into(), shipped.display().to_string()],
+        vec![
+            "pool".into(),
+            shipped.display().to_string(),
+            docs.parent()
+                .unwrap()
+                .join("cartpole")
+                .display()
+                .to_string(),
+            "--out".into(),
+            tmp.path().join("pooled").display().to_string(),
+        ],
+    ] {
+        let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+            .args(&args)
+            .output()
+            .unwrap();
+        assert_eq!(
+            output.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            stderr(&output)
+        );
+        let message = stderr(&output);
+        assert!(
+            message.contains("lists 110 runs but the folder holds none of their records"),
+            "{message}"
+        );
+    }
+    let after: Vec<Vec<u8>> = ["summary.json", "comparison.csv", "tests.csv"]
+        .iter()
+        .map(|f| std::fs::read(shipped.join(f)).unwrap())
+        .collect();
+    assert!(before == after, "a refused folder was changed");
+    assert!(!shipped.join("episodes.csv").exists());
+    assert!(
+        !tmp.path().join("pooled").exists(),
+        "no pooled folder is made"
+    );
+}
+
 #[test]
 fn a_present_library_is_reused_unchanged() {
     let tmp = tempfile::tempdir().unwrap();

@@ -23,6 +23,25 @@ pub use assemble::{assemble, Ending};
 pub use replot::{read as read_plot_data, replot};
 pub use summary::{read_header, write_json, RunKey, Status, Summary, SummaryHeader};
 
+/// Refuses a folder whose summary lists runs but which holds none of their records
+/// (`runs/`): a report shipped with its files only, as `docs/reuse/<task>/` is. Made again,
+/// or pooled, it would be a report of no runs, and `sapnet plot` would write it over the
+/// files it came with.
+pub(crate) fn require_records(dir: &Path, header: &SummaryHeader, found: usize) -> Result<()> {
+    if found == 0 && !header.listed_runs.is_empty() {
+        anyhow::bail!(
+            "{}: summary.json lists {} runs but the folder holds none of their records \
+             ({}/{}/<run>/run.json): a report shipped without them can be read (its CSV \
+             files) but not made again or pooled; use the protocol's own output folder",
+            dir.display(),
+            header.listed_runs.len(),
+            dir.display(),
+            records::RUNS
+        );
+    }
+    Ok(())
+}
+
 /// A finished results directory, read back: its config, library, runs and each run's
 /// training returns (what the comparison is computed from).
 pub struct Results {
@@ -36,6 +55,7 @@ pub struct Results {
 pub fn read_results(dir: &Path) -> Result<Results> {
     let header = read_header(dir)?;
     let folders = records::read(dir, &header.config)?;
+    require_records(dir, &header, folders.len())?;
     let rewards = assemble::rewards(&folders)?;
     Ok(Results {
         config: header.config,

@@ -72,6 +72,10 @@ pub struct SummaryHeader {
     pub wall_s: f64,
     #[serde(default)]
     pub error: Option<String>,
+    /// The runs the summary lists, counted and not read: a folder whose summary lists runs
+    /// but which holds none of their records is a report shipped without them.
+    #[serde(default, rename = "runs")]
+    pub listed_runs: Vec<serde::de::IgnoredAny>,
 }
 
 impl Summary {
