@@ -438,27 +438,30 @@ fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
     if args.evaluate {
         let evaluations = crate::sources::evaluate(&config, &cli.run.library_path())?;
         let target = config.env.gym_id();
+        // Columns as wide as their longest entry: a Gymnasium task's label with its
+        // keywords runs to 70 characters.
+        let hidden: Vec<String> = evaluations
+            .iter()
+            .map(|e| format!("{:?}", e.hidden))
+            .collect();
+        let task_width = evaluations.iter().map(|e| e.task.len()).fold(4, usize::max);
+        let hidden_width = hidden.iter().map(String::len).fold(6, usize::max);
+        let target_width = target.len().max(12);
         let mut out = std::io::stdout().lock();
         writeln!(
             out,
-            "{:<10} {:<28} {:<16} {:>10} {:>width$}",
-            "source",
-            "task",
-            "hidden",
-            "own task",
-            target,
-            width = target.len().max(12)
+            "{:<10} {:<task_width$} {:<hidden_width$} {:>10} {:>target_width$}",
+            "source", "task", "hidden", "own task", target,
         )?;
-        for e in &evaluations {
+        for (e, hidden) in evaluations.iter().zip(&hidden) {
             writeln!(
                 out,
-                "{:<10} {:<28} {:<16} {:>10} {:>width$.1}",
+                "{:<10} {:<task_width$} {:<hidden_width$} {:>10} {:>target_width$.1}",
                 e.name,
                 e.task,
-                format!("{:?}", e.hidden),
+                hidden,
                 e.own_score.map_or("-".into(), |s| format!("{s:.1}")),
                 e.target_score,
-                width = target.len().max(12)
             )?;
         }
         return Ok(());
