@@ -446,6 +446,35 @@ fn copy_library(task: &str, library: &Path) {
     }
 }
 
+/// The shipped variants library is the one its config describes (the manifest's tasks and
+/// count), and each of its sources is scored on the target through the bridge: the numbers
+/// docs/VARIANTS.md's table of sources is printed from.
+#[test]
+fn the_shipped_lunar_lander_variants_library_fits_its_config_and_is_scored_on_the_target() {
+    let python = python_or_skip!();
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    copy_library("lunarlander-variants", &library);
+    let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/variants_lunar_lander.ron");
+    let output = sapnet()
+        .args(["sources", "--evaluate", "--config"])
+        .arg(&config)
+        .arg("--library")
+        .arg(&library)
+        .env("VIRTUAL_ENV", python.parent().unwrap().parent().unwrap())
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    let table = String::from_utf8_lossy(&output.stdout);
+    let rows: Vec<&str> = table.lines().collect();
+    assert_eq!(rows.len(), 16, "a header and 15 sources:\n{table}");
+    assert!(rows[0].ends_with("LunarLander-v3"), "{table}");
+    assert!(
+        rows[13].starts_with("source-12") && rows[13].contains("LunarLander-v3(gravity=-2.0)"),
+        "{table}"
+    );
+}
+
 #[test]
 fn the_shipped_lunar_lander_comparison_runs_through_the_bridge_and_writes_every_output() {
     let python = python_or_skip!();
