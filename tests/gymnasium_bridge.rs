@@ -184,6 +184,23 @@ fn stderr(output: &Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()
 }
 
+/// `sapnet ARGS --config assets/CONFIG --library LIBRARY` in `python`'s virtualenv.
+fn on_shipped_config(python: &Path, args: &[&str], config: &str, library: &Path) -> Command {
+    let mut command = sapnet();
+    command
+        .args(args)
+        .arg("--config")
+        .arg(
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("assets")
+                .join(config),
+        )
+        .arg("--library")
+        .arg(library)
+        .env("VIRTUAL_ENV", python.parent().unwrap().parent().unwrap());
+    command
+}
+
 /// `sapnet env` on a one-line config, in `dir`.
 fn env_command(dir: &Path, config: &str, python: &Path, extra_env: &[(&str, &Path)]) -> Output {
     let path = dir.join("task.ron");
@@ -455,15 +472,14 @@ fn the_shipped_lunar_lander_variants_library_fits_its_config_and_is_scored_on_th
     let tmp = tempfile::tempdir().unwrap();
     let library = tmp.path().join("lib");
     copy_library("lunarlander-variants", &library);
-    let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/variants_lunar_lander.ron");
-    let output = sapnet()
-        .args(["sources", "--evaluate", "--config"])
-        .arg(&config)
-        .arg("--library")
-        .arg(&library)
-        .env("VIRTUAL_ENV", python.parent().unwrap().parent().unwrap())
-        .output()
-        .unwrap();
+    let output = on_shipped_config(
+        &python,
+        &["sources", "--evaluate"],
+        "variants_lunar_lander.ron",
+        &library,
+    )
+    .output()
+    .unwrap();
     assert!(output.status.success(), "{}", stderr(&output));
     let table = String::from_utf8_lossy(&output.stdout);
     let rows: Vec<&str> = table.lines().collect();
@@ -482,17 +498,16 @@ fn the_shipped_lunar_lander_comparison_runs_through_the_bridge_and_writes_every_
     let library = tmp.path().join("lib");
     copy_library("lunarlander_v3", &library);
     let out = tmp.path().join("out");
-    let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/reuse_lunar_lander.ron");
-    let output = sapnet()
-        .args(["--headless", "--quick", "--episodes", "2", "--config"])
-        .arg(&config)
-        .arg("--library")
-        .arg(&library)
-        .arg("--out")
-        .arg(&out)
-        .env("VIRTUAL_ENV", python.parent().unwrap().parent().unwrap())
-        .output()
-        .unwrap();
+    let output = on_shipped_config(
+        &python,
+        &["--headless", "--quick", "--episodes", "2"],
+        "reuse_lunar_lander.ron",
+        &library,
+    )
+    .arg("--out")
+    .arg(&out)
+    .output()
+    .unwrap();
     assert!(output.status.success(), "{}", stderr(&output));
     for file in [
         "summary.json",

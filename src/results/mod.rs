@@ -27,8 +27,8 @@ pub use summary::{read_header, write_json, RunKey, Status, Summary, SummaryHeade
 /// (`runs/`): a report shipped with its files only, as `docs/reuse/<task>/` is. Made again,
 /// or pooled, it would be a report of no runs, and `sapnet plot` would write it over the
 /// files it came with.
-pub(crate) fn require_records(dir: &Path, header: &SummaryHeader, found: usize) -> Result<()> {
-    if found == 0 && !header.listed_runs.is_empty() {
+pub(crate) fn require_records(dir: &Path, header: &SummaryHeader) -> Result<()> {
+    if !header.listed_runs.is_empty() && !records::any(dir)? {
         anyhow::bail!(
             "{}: summary.json lists {} runs but the folder holds none of their records \
              ({}/{}/<run>/run.json): a report shipped without them can be read (its CSV \
@@ -54,8 +54,8 @@ pub struct Results {
 /// Reads the results in `dir` from its summary and run records.
 pub fn read_results(dir: &Path) -> Result<Results> {
     let header = read_header(dir)?;
+    require_records(dir, &header)?;
     let folders = records::read(dir, &header.config)?;
-    require_records(dir, &header, folders.len())?;
     let rewards = assemble::rewards(&folders)?;
     Ok(Results {
         config: header.config,

@@ -177,6 +177,29 @@ pub struct RunFolder {
     pub summary: RunSummary,
 }
 
+/// Whether `out` holds a run record as [`read`] counts one (a directory of `runs/`, not a
+/// link nor a hidden partial folder, with its `run.json`), found without reading one.
+pub fn any(out: &Path) -> Result<bool> {
+    let dir = out.join(RUNS);
+    let entries = match std::fs::read_dir(&dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(false),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", dir.display())),
+    };
+    for entry in entries {
+        let entry = entry.with_context(|| format!("reading {}", dir.display()))?;
+        let hidden = entry
+            .file_name()
+            .to_str()
+            .is_none_or(|n| n.starts_with('.'));
+        let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
+        if !hidden && is_dir && std::fs::symlink_metadata(entry.path().join("run.json")).is_ok() {
+            return Ok(true);
+        }
+    }
+    Ok(false)
+}
+
 /// The finished (and stopped) runs recorded in `out`, by the protocol's order: method as
 /// `config` lists them, then run. Partial folders are not records.
 pub fn read(out: &Path, config: &Config) -> Result<Vec<RunFolder>> {
