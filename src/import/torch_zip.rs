@@ -1,0 +1,185 @@
+//! PyTorch's file format since 1.6 (`torch.save`): a zip archive `<name>/data.pkl` (the
+//! object, pickled) beside `<name>/data/<key>` (each storage's raw bytes). Read from
+//! memory, every entry bounded, nothing in the pickle run ([`super::pickle`]).
+
+use std::io::{Cursor, Read};
+
+use super::pickle::{self, StorageKind, Value};
+use super::NamedTensor;
+
+/// Pickles of state dicts are kilobytes; a bound keeps a doctored one from costing more.
+const MAX_PICKLE_BYTES: u64 = 4 << 20;
+
+/// The archive `bytes` as a zip; `what` names the file in messages.
+pub fn archive(bytes: &[u8]) -> Result<zip::ZipArchive<Cursor<&[u8]>>, String> {
+    let zip = zip::ZipArchive::new(Cursor::new(bytes))
+        .map_err(|e| format!("not a readable zip archive ({e})"))?;
+    // A reader finds an archive by its last directory: in a truncated SB3 zip that is the
+    // directory of a torch file stored inside it, which is not the file the user gave.
+    if zip.offset() != 0 {
+        return Err(format!(
+            "not a readable zip archive (the only archive found starts at byte {}: the file is \
+             truncated, or something precedes the archive)",
+            zip.offset()
+        ));
+    }
+    Ok(zip)
+}
+
+/// The bytes of entry `name`, at most `limit` of them; stored, not compressed (how
+/// `torch.save` and Python's `zipfile` write by default).
+pub fn entry(
+    zip: &mut zip::ZipArchive<Cursor<&[u8]>>,
+    name: &str,
+    limit: u64,
+) -> Result<Vec<u8>, String> {
+    let mut file = zip
+        .by_name(name)
+        .map_err(|e| format!("the archive has no readable entry {name} ({e})"))?;
+    if file.compression() != zip::CompressionMethod::Stored {
+        return Err(format!(
+            "entry {name} is compressed ({}): sapnet reads archives whose entries are stored, as \
+             torch.save and Python's zipfile write them",
+            file.compression()
+        ));
+    }
+    if file.size() > limit {
+        return Err(format!(
+            "entry {name} holds {} bytes, more than the {limit} a policy needs",
+            file.size()
+        ));
+    }
+    let mut bytes = Vec::with_capacity(file.size() as usize);
+    file.by_ref()
+        .take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("reading entry {name}: {e}"))?;
+    if bytes.len() as u64 > limit {
+        return Err(format!("entry {name} is larger than its header says"));
+    }
+    Ok(bytes)
+}
+
+/// The tensors of the state dict that `torch.save` wrote into `bytes`, in the dict's order;
+/// each storage read no further than the size its tensor gives it.
+pub fn state_dict(bytes: &[u8]) -> Result<Vec<NamedTensor>, String> {
+    let mut zip = archive(bytes)?;
+    let names: Vec<String> = zip
+        .file_names()
+        .filter_map(|n| n.ok().map(|n| n.into_owned()))
+        .collect();
+    let pickles: Vec<&String> = names.iter().filter(|n| n.ends_with("/data.pkl")).collect();
+    let pickle_name = match pickles.as_slice() {
+        [one] => (*one).clone(),
+        [] => {
+            return Err("a zip archive without a data.pkl: not a file torch.save wrote".into());
+        }
+        many => {
+            return Err(format!(
+                "the archive holds {} pickles ({}); torch.save writes one",
+                many.len(),
+                many.iter()
+                    .map(|s| s.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        }
+    };
+    let root = pickle_name.trim_end_matches("data.pkl").to_string();
+    if let Ok(order) = entry(&mut zip, &format!("{root}byteorder"), 16) {
+        if order != b"little" {
+            return Err(format!(
+                "the storages are {}-endian; sapnet reads little-endian files",
+                String::from_utf8_lossy(&order)
+            ));
+        }
+    }
+    let object = pickle::read(&entry(&mut zip, &pickle_name, MAX_PICKLE_BYTES)?)
+        .map_err(|e| format!("{pickle_name}: {e}"))?;
+    let Value::Dict(dict) = object else {
+        return Err(format!(
+            "{pickle_name} holds a pickled object that is not a state dict (a dict of tensors): \
+             save `model.state_dict()`"
+        ));
+    };
+    let dict = dict.borrow();
+    let mut tensors = Vec::with_capacity(dict.len());
+    for (key, value) in dict.iter() {
+        let Value::Str(key) = key else {
+            return Err(format!(
+                "{pickle_name}: a key of the state dict is not a string"
+            ));
+        };
+        let Value::Tensor(t) = value else {
+            return Err(format!(
+                "`{key}` is not a tensor: a state dict of a network holds only tensors (a \
+                 checkpoint holding several objects? save the network's state_dict() alone)"
+            ));
+        };
+        let dtype = match t.storage.kind {
+            StorageKind::F32 => "float32",
+            StorageKind::Other(kind) => {
+                return Err(format!(
+                    "tensor `{key}` is stored as torch.{kind}; sapnet's Q-networks are float32 \
+                     (convert with `.float()` before saving)"
+                ))
+            }
+        };
+        // Sizes come from the file: checked, so that a doctored one cannot overflow them.
+        let numel = t
+            .shape
+            .iter()
+            .try_fold(1usize, |n, d| n.checked_mul(*d))
+            .ok_or_else(|| format!("tensor `{key}` has an impossible shape {:?}", t.shape))?;
+        let storage_bytes = t.storage.numel.checked_mul(4).ok_or_else(|| {
+            format!(
+                "tensor `{key}`'s storage claims {} elements",
+                t.storage.numel
+            )
+        })?;
+        let contiguous = row_major_strides(&t.shape) == t.stride || numel <= 1;
+        if !contiguous {
+            return Err(format!(
+                "tensor `{key}` is a strided view (stride {:?} for shape {:?}); save a \
+                 contiguous copy (`.contiguous()`)",
+                t.stride, t.shape
+            ));
+        }
+        let end = t
+            .offset
+            .checked_add(numel)
+            .filter(|e| *e <= t.storage.numel);
+        if end.is_none() {
+            return Err(format!(
+                "tensor `{key}` ({} {dtype} from offset {}) runs past its storage of {}",
+                numel, t.offset, t.storage.numel
+            ));
+        }
+        let data_name = format!("{root}data/{}", t.storage.key);
+        let storage = entry(&mut zip, &data_name, storage_bytes as u64)?;
+        if storage.len() != storage_bytes {
+            return Err(format!(
+                "storage {data_name} holds {} bytes, its tensor `{key}` says {storage_bytes}",
+                storage.len(),
+            ));
+        }
+        let values = storage[4 * t.offset..4 * (t.offset + numel)]
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect();
+        tensors.push(NamedTensor {
+            name: key.to_string(),
+            shape: t.shape.clone(),
+            values,
+        });
+    }
+    Ok(tensors)
+}
+
+fn row_major_strides(shape: &[usize]) -> Vec<usize> {
+    let mut strides = vec![1; shape.len()];
+    for i in (0..shape.len().saturating_sub(1)).rev() {
+        strides[i] = strides[i + 1] * shape[i + 1];
+    }
+    strides
+}
