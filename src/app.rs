@@ -7,7 +7,7 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use anyhow::{Context, Result};
 
-use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, SweepCommand, TeachArgs};
+use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, SourcesCommand, SweepCommand, TeachArgs};
 use crate::config::{Config, MethodKind};
 use crate::experiment;
 use crate::headless::{self, OutputOptions, RunOptions};
@@ -435,6 +435,30 @@ fn dashboard_specs(specs: &[RunSpec], run: u32) -> Result<(Vec<RunSpec>, Option<
 
 fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
     let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
+    if let Some(SourcesCommand::Import(import)) = &args.command {
+        let done = crate::sources::import(
+            &config,
+            &cli.run.library_path(),
+            &import.file,
+            &import.name,
+            import.prefix.as_deref(),
+        )?;
+        let origin = &done.origin;
+        eprintln!(
+            "imported {} ({}, {}, layers `{}`) into {} as {}: {}, greedy return {:.1} on {}              (mean of {} episodes)",
+            import.file.display(),
+            origin.format.describe(),
+            origin.framework,
+            origin.prefix,
+            done.dir.display(),
+            import.name,
+            done.architecture,
+            done.score,
+            done.task,
+            done.test_episodes
+        );
+        return Ok(());
+    }
     if args.evaluate {
         let evaluations = crate::sources::evaluate(&config, &cli.run.library_path())?;
         let target = config.env.gym_id();
@@ -444,19 +468,23 @@ fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
             .iter()
             .map(|e| format!("{:?}", e.hidden))
             .collect();
+        let name_width = evaluations
+            .iter()
+            .map(|e| e.name.len())
+            .fold(10, usize::max);
         let task_width = evaluations.iter().map(|e| e.task.len()).fold(4, usize::max);
         let hidden_width = hidden.iter().map(String::len).fold(6, usize::max);
         let target_width = target.len().max(12);
         let mut out = std::io::stdout().lock();
         writeln!(
             out,
-            "{:<10} {:<task_width$} {:<hidden_width$} {:>10} {:>target_width$}",
+            "{:<name_width$} {:<task_width$} {:<hidden_width$} {:>10} {:>target_width$}",
             "source", "task", "hidden", "own task", target,
         )?;
         for (e, hidden) in evaluations.iter().zip(&hidden) {
             writeln!(
                 out,
-                "{:<10} {:<task_width$} {:<hidden_width$} {:>10} {:>target_width$.1}",
+                "{:<name_width$} {:<task_width$} {:<hidden_width$} {:>10} {:>target_width$.1}",
                 e.name,
                 e.task,
                 hidden,

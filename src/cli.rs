@@ -252,8 +252,9 @@ pub struct PoolArgs {
 }
 
 #[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct SourcesArgs {
-    /// Replace a library already on disk.
+    /// Replace a library already on disk (policies imported into it are kept).
     #[arg(long)]
     pub retrain: bool,
 
@@ -261,6 +262,35 @@ pub struct SourcesArgs {
     /// (`protocol.test_episodes` episodes) beside its score on its own task.
     #[arg(long, conflicts_with = "retrain")]
     pub evaluate: bool,
+
+    #[command(subcommand)]
+    pub command: Option<SourcesCommand>,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum SourcesCommand {
+    /// Add a Q-network trained elsewhere to the finished library of --config (default: the
+    /// embedded CartPole one) in <LIBRARY>/<task>/: a Stable-Baselines3 DQN .zip, a PyTorch
+    /// state dict (.pt, .pth, CleanRL's .cleanrl_model) or a safetensors file of linear
+    /// layers with ReLU between them. The format is told from the file; nothing in it is
+    /// run. The policy is tested on the config's source task and reused as every source.
+    Import(ImportArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct ImportArgs {
+    /// The file to import.
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+
+    /// The policy's name in the library (a plain file name, e.g. `sb3-64x64`).
+    #[arg(long, value_name = "NAME")]
+    pub name: String,
+
+    /// Which network of a state dict holding several: the prefix of its keys (`network`
+    /// for `network.0.weight`). An SB3 model's is `q_net.q_net`, its online network.
+    #[arg(long, value_name = "PREFIX")]
+    pub prefix: Option<String>,
 }
 
 #[derive(Debug, Args)]

@@ -6,7 +6,8 @@
 //!   activation and spreading. Pure maths.
 //! - [`env`](mod@env): native CartPole, MountainCar and Acrobot, with Gymnasium's dynamics
 //!   to the bit.
-//! - [`dqn`]: the DQN on candle; [`policy_store`]: policies on disk.
+//! - [`dqn`]: the DQN on candle; [`policy_store`]: policies on disk; [`import`](mod@import):
+//!   Q-networks trained elsewhere (Stable-Baselines3, PyTorch, safetensors) read as ours.
 //! - [`trainer`]: training runs on their own thread, reporting through events;
 //!   [`experiment`]: planning and scheduling a protocol's runs.
 //! - [`stats`]: interval estimates over runs' scores; [`report`]: the methods side by side
@@ -26,6 +27,7 @@ pub mod experiment;
 pub mod failpoint;
 pub mod folder_lock;
 pub mod headless;
+pub mod import;
 pub mod policy_store;
 pub mod progress;
 pub mod random_episodes;

@@ -50,6 +50,46 @@ pub struct PolicyInfo {
     /// The library policy this one went on learning from (SAP-Net's chosen policy), as
     /// `<task>/<name>`.
     pub reused: Option<String>,
+    /// The file it was imported from, for a policy trained elsewhere.
+    pub origin: Option<Origin>,
+}
+
+/// What an imported policy's file was.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Format {
+    /// `model.save` of a Stable-Baselines3 DQN.
+    Sb3Zip,
+    /// `torch.save(state_dict)`, torch's zip format.
+    TorchStateDict,
+    Safetensors,
+}
+
+impl Format {
+    /// What the format is, for messages.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Format::Sb3Zip => "a Stable-Baselines3 DQN",
+            Format::TorchStateDict => "a PyTorch state dict",
+            Format::Safetensors => "a safetensors file",
+        }
+    }
+}
+
+/// Where an imported policy came from, recorded in its metadata.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Origin {
+    /// The file's name as it was imported (its folder left out).
+    pub file: String,
+    /// SHA-256 of the file, lowercase hex.
+    pub sha256: String,
+    pub format: Format,
+    /// `Stable-Baselines3 2.9.2`, `PyTorch`, `safetensors`.
+    pub framework: String,
+    /// The prefix of the layers' keys (`q_net.q_net`, `network`, or empty).
+    pub prefix: String,
+    /// The environment steps it trained for, where the file says (SB3's `num_timesteps`).
+    pub steps: Option<u64>,
 }
 
 /// The contents of `<name>.ron`.
@@ -68,6 +108,9 @@ pub struct PolicyMetadata {
     /// See [`PolicyInfo::reused`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reused: Option<String>,
+    /// See [`PolicyInfo::origin`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub origin: Option<Origin>,
     /// The version of sapnet that wrote the files.
     pub crate_version: String,
     /// SHA-256 of the weights file, lowercase hex: ties the pair together.
@@ -189,6 +232,7 @@ fn write_pair(
         seed: info.seed,
         final_score: info.final_score,
         reused: info.reused.clone(),
+        origin: info.origin.clone(),
         crate_version: env!("CARGO_PKG_VERSION").to_string(),
         weights_sha256: sha256_hex(&weights),
     };

@@ -31,6 +31,7 @@ fn info() -> PolicyInfo {
         seed: 17,
         final_score: Some(187.4),
         reused: None,
+        origin: None,
     }
 }
 

@@ -95,6 +95,7 @@ pub fn policy_info(config: &Config, record: &RunRecord) -> PolicyInfo {
         seed: record.seed,
         final_score,
         reused,
+        origin: None,
     }
 }
 
@@ -125,6 +126,7 @@ mod tests {
             seed: 0,
             final_score: None,
             reused: None,
+            origin: None,
         };
         // A leading dot would make a hidden name, which the store refuses.
         let first = copies.add("sapnet-run0", &net, &info).unwrap();

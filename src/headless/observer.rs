@@ -171,6 +171,7 @@ impl Observer for ResultFiles {
             seed: spec.seed,
             final_score: None,
             reused: None,
+            origin: None,
         };
         let policies = self.out.join("policies");
         let name = run_name(spec.method.label(), run);

@@ -64,7 +64,8 @@ pub struct LibraryRoot {
 /// Reads the source library of `config` from `<library>/<source task>/` for reuse on the
 /// target task. The library must be whole: its manifest complete, of the config's source
 /// task and `sources.count`, every policy on disk with the hashes the manifest records and
-/// no policy beside them; every policy must fit the target task's sizes.
+/// no policy beside them; every policy must fit the target task's sizes. The policies
+/// imported into it (`sapnet sources import`) come after the planned ones.
 pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>> {
     let dir = library_dir(library, config);
     let Some(found) = manifest::read(&dir)? else {
@@ -135,10 +136,13 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
             dir.display()
         );
     }
-    if let Some(stray) = policy_files(&dir)?
-        .into_iter()
-        .find(|name| !found.policies.iter().any(|e| &e.name == name))
-    {
+    if let Some(stray) = policy_files(&dir)?.into_iter().find(|name| {
+        !found
+            .policies
+            .iter()
+            .chain(&found.imported)
+            .any(|e| &e.name == name)
+    }) {
         bail!(
             "{} holds policy {stray}, which its manifest {} does not list: remove it, or \
              retrain the library with `sapnet sources --retrain`",
@@ -149,9 +153,7 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
 
     let (observation_size, action_count) = crate::env::spaces(&config.env)?;
     let plans = plan(config);
-    let mut sources = Vec::with_capacity(found.policies.len());
-    for (entry, planned) in found.policies.iter().zip(&plans) {
-        let task = &wanted.tasks[planned.task];
+    let load = |entry: &manifest::ManifestEntry| -> Result<policy_store::StoredPolicy> {
         let stored =
             policy_store::load_for_task(&dir, &entry.name, observation_size, action_count)?;
         let metadata_path = policy_store::paths(&dir, &entry.name).1;
@@ -169,6 +171,13 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
                 manifest_path.display()
             );
         }
+        Ok(stored)
+    };
+    let mut sources = Vec::with_capacity(found.policies.len() + found.imported.len());
+    for (entry, planned) in found.policies.iter().zip(&plans) {
+        let task = &wanted.tasks[planned.task];
+        let stored = load(entry)?;
+        let metadata_path = policy_store::paths(&dir, &entry.name).1;
         if entry.name != planned.name || stored.metadata.source_task != task.env.as_recorded() {
             bail!(
                 "policy {} was trained on {}, but the config puts {} on {}; retrain the library \
@@ -184,6 +193,27 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
                 hidden: stored.metadata.architecture.hidden.clone(),
                 activation: stored.metadata.activation.clone(),
                 source_task: task.label.clone(),
+            },
+            final_score: stored.metadata.final_score,
+            net: stored.net,
+            name: entry.name.clone(),
+        });
+    }
+    // An imported policy's category is the task it was imported for, named as the config
+    // names that task.
+    for entry in &found.imported {
+        let stored = load(entry)?;
+        let recorded = &stored.metadata.source_task;
+        let label = wanted
+            .tasks
+            .iter()
+            .find(|t| &t.env.as_recorded() == recorded)
+            .map_or_else(|| recorded.label(), |t| t.label.clone());
+        sources.push(SourcePolicy {
+            description: PolicyDescription {
+                hidden: stored.metadata.architecture.hidden.clone(),
+                activation: stored.metadata.activation.clone(),
+                source_task: label,
             },
             final_score: stored.metadata.final_score,
             net: stored.net,

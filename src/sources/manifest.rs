@@ -3,7 +3,8 @@
 //! `sapnet sources` writes the manifest before it trains anything (`complete: false`), adds
 //! each policy's hashes as soon as the policy is on disk and sets `complete: true` last, so
 //! a library is usable only once whole, an interrupted training resumes where it stopped,
-//! and a run can tell a finished library from a half-written or hand-edited one.
+//! and a run can tell a finished library from a half-written or hand-edited one. Policies
+//! imported into a finished library are listed apart from the planned ones.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -27,6 +28,10 @@ pub struct Manifest {
     pub training: LibraryTraining,
     /// The policies on disk, in the plan's order.
     pub policies: Vec<ManifestEntry>,
+    /// Policies trained elsewhere and added by `sapnet sources import`, in the order they
+    /// came; kept when the library is trained again. Their seed is 0: sapnet drew none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub imported: Vec<ManifestEntry>,
     /// The version of sapnet that wrote the manifest.
     pub crate_version: String,
 }
@@ -254,6 +259,7 @@ mod tests {
                 weights_sha256: "ab".into(),
                 metadata_sha256: "cd".into(),
             }],
+            imported: Vec::new(),
             crate_version: "0".into(),
         };
         assert_eq!(read(tmp.path()).unwrap(), None);

@@ -4,6 +4,7 @@
 //!
 //! - here: what the config plans (architectures, seeds, source tasks, the folder);
 //! - [`train`]: `sapnet sources`, resumable;
+//! - [`import`](mod@import): `sapnet sources import`, a policy trained elsewhere added;
 //! - [`load`]: a library read for reuse, or trained first where allowed;
 //! - [`manifest`]: the manifest, `library.ron`.
 
@@ -19,10 +20,12 @@ use crate::env::EnvConfig;
 use crate::policy_store;
 use crate::seeds;
 
+mod import;
 mod load;
 pub mod manifest;
 mod train;
 
+pub use import::{import, Imported};
 pub use load::{ensure_library, evaluate, load_library, needs_training, Evaluation, LibraryRoot};
 pub use manifest::{LibraryTraining, Manifest, ManifestEntry};
 pub use train::train_library;

@@ -38,6 +38,11 @@ pub fn train_library(
     // One trainer per library: a second `sapnet sources` (or a run training a missing
     // library) into the same folder is refused while this one trains.
     let _lock = crate::folder_lock::FolderLock::acquire(&dir, "library training")?;
+    // Policies imported from elsewhere are not the config's to replace: they stay, listed
+    // as they were, whatever is trained again.
+    let imported = manifest::read(&dir)?
+        .map(|m| m.imported)
+        .unwrap_or_default();
     let kept = resumable(&dir, &training, &plans, retrain)?;
     crate::policy_store::remove_temporaries(&dir)
         .with_context(|| format!("removing a killed save's leftovers from {}", dir.display()))?;
@@ -45,6 +50,7 @@ pub fn train_library(
         complete: false,
         training,
         policies: kept,
+        imported,
         crate_version: env!("CARGO_PKG_VERSION").to_string(),
     };
     // Written before any policy: from here until `complete`, runs refuse the library.
@@ -88,7 +94,7 @@ pub fn train_library(
     progress.finish(true);
     // A smaller library replaces a larger one: its extra sources go before the library
     // is declared whole.
-    remove_unplanned(&dir, &plans)?;
+    remove_unplanned(&dir, &plans, &manifest.imported)?;
     manifest.complete = true;
     manifest::write(&dir, &manifest)?;
     Ok(dir)
@@ -126,18 +132,18 @@ fn train_source(
         final_score: (!returns.is_empty())
             .then(|| returns.iter().sum::<f64>() / returns.len() as f64),
         reused: None,
+        origin: None,
     };
     policy_store::save(dir, &source.name, &outcome.net, &info)
         .with_context(|| format!("writing {} to {}", source.name, dir.display()))?;
     Ok(Some(ManifestEntry::of_policy(dir, &source.name)?.0))
 }
 
-/// Removes the policies in `dir` that `plans` does not name.
-fn remove_unplanned(dir: &Path, plans: &[SourcePlan]) -> Result<()> {
-    for stale in policy_files(dir)?
-        .iter()
-        .filter(|name| !plans.iter().any(|p| &p.name == *name))
-    {
+/// Removes the policies in `dir` that neither `plans` nor `imported` name.
+fn remove_unplanned(dir: &Path, plans: &[SourcePlan], imported: &[ManifestEntry]) -> Result<()> {
+    for stale in policy_files(dir)?.iter().filter(|name| {
+        !plans.iter().any(|p| &p.name == *name) && !imported.iter().any(|e| &e.name == *name)
+    }) {
         let (weights, metadata) = policy_store::paths(dir, stale);
         for path in [metadata, weights] {
             match std::fs::remove_file(&path) {

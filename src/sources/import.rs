@@ -1,0 +1,138 @@
+//! `sapnet sources import`: a policy trained elsewhere ([`crate::import`]) added to a
+//! finished library, written as every library policy is and listed in the manifest's
+//! `imported`, so that every run, comparison, screen and sweep reuses it as a source.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+
+use super::manifest::{self, ManifestEntry};
+use super::{library_dir, policy_files, source_task};
+use crate::config::Config;
+use crate::dqn::Architecture;
+use crate::import::{self, Origin, Spaces};
+use crate::policy_store::{self, PolicyInfo, TrainingBudget};
+use crate::seeds;
+
+/// A policy added to a library.
+#[derive(Debug)]
+pub struct Imported {
+    /// The library's folder.
+    pub dir: PathBuf,
+    pub architecture: Architecture,
+    pub origin: Origin,
+    /// The task it was imported for, as labelled in results.
+    pub task: String,
+    /// Mean return of its greedy test episodes on that task.
+    pub score: f64,
+    pub test_episodes: u32,
+}
+
+/// Imports `file` as policy `name` into the library of `config` under `library`: a finished
+/// library (imported policies join a whole one, never one in training) with no policy of that
+/// name. The policy is tested greedily on the config's source task for
+/// `protocol.test_episodes` episodes, which gives its `final_score`.
+pub fn import(
+    config: &Config,
+    library: &Path,
+    file: &Path,
+    name: &str,
+    prefix: Option<&str>,
+) -> Result<Imported> {
+    let dir = library_dir(library, config);
+    if !policy_store::is_plain_name(name) || name == policy_store::RESERVED_NAME {
+        bail!(
+            "--name {name:?}: expected a plain file name for the policy (no `/`, not hidden, not \
+             {:?})",
+            policy_store::RESERVED_NAME
+        );
+    }
+    // Read and checked before the library is touched: a refused file changes nothing.
+    let task = source_task(config).clone();
+    let (observation_size, action_count) = crate::env::spaces(&task)?;
+    let spaces = Spaces {
+        observation_size,
+        action_count,
+    };
+    let foreign = import::read(file, spaces, prefix)
+        .map_err(|reason| anyhow::anyhow!("cannot import {}: {reason}", file.display()))?;
+
+    let Some(mut found) = manifest::read(&dir)? else {
+        bail!(
+            "{} holds no finished library to import into: train it first with `sapnet sources \
+             --config <FILE> --library {}` (an imported policy joins the sources a config \
+             describes)",
+            dir.display(),
+            library.display()
+        );
+    };
+    let _lock = crate::folder_lock::FolderLock::acquire(&dir, "library import")?;
+    if !found.complete {
+        bail!(
+            "the library {} is still being trained ({} of {} policies): finish it with `sapnet \
+             sources --config <FILE>` before importing",
+            dir.display(),
+            found.policies.len(),
+            found.training.count()
+        );
+    }
+    if policy_files(&dir)?.iter().any(|n| n == name)
+        || found
+            .policies
+            .iter()
+            .chain(&found.imported)
+            .any(|e| e.name == name)
+    {
+        bail!(
+            "{} already holds a policy named {name}: choose another --name",
+            dir.display()
+        );
+    }
+
+    let episodes = config.protocol.test_episodes.max(1);
+    let seed = seeds::derive(
+        config.seed,
+        &[seeds::Part::Name("import"), seeds::Part::Name(name)],
+    );
+    let mut env = crate::env::make(&task)?;
+    let returns = crate::trainer::test_greedy(&foreign.net, env.as_mut(), episodes, seed)?;
+    let score = returns.iter().sum::<f64>() / returns.len() as f64;
+    let info = PolicyInfo {
+        source_task: task.as_recorded(),
+        // sapnet trained it for nothing; the file's own budget is in `origin`.
+        training: TrainingBudget {
+            episodes: 0,
+            steps: 0,
+        },
+        seed: 0,
+        final_score: Some(score),
+        reused: None,
+        origin: Some(foreign.origin.clone()),
+    };
+    policy_store::save(&dir, name, &foreign.net, &info)
+        .with_context(|| format!("writing {name} to {}", dir.display()))?;
+    let listed = ManifestEntry::of_policy(&dir, name)
+        .map_err(anyhow::Error::from)
+        .and_then(|(entry, _)| {
+            found.imported.push(entry);
+            manifest::write(&dir, &found).map_err(anyhow::Error::from)
+        });
+    if let Err(err) = listed {
+        // Not listed, the files would make the library refuse itself: take them back.
+        let (weights, metadata) = policy_store::paths(&dir, name);
+        let _ = std::fs::remove_file(metadata);
+        let _ = std::fs::remove_file(weights);
+        return Err(err.context(format!(
+            "adding {name} to {}",
+            manifest::path(&dir).display()
+        )));
+    }
+    Ok(Imported {
+        dir,
+        architecture: foreign.net.architecture().clone(),
+        origin: foreign.origin,
+        task: task.label().trim_end().to_string(),
+        score,
+        test_episodes: episodes,
+    })
+}
