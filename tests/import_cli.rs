@@ -475,7 +475,9 @@ fn malformed_and_unrepresentable_files_are_refused_by_name_and_change_nothing() 
     let good = tmp.path().join("small.pt");
     std::fs::write(&good, torch_file(&small_network(), None)).unwrap();
     for (name, reason) in [
-        ("source-0", "already holds a policy named source-0"),
+        ("source-0", "belong to the sources a config plans"),
+        ("source-77", "belong to the sources a config plans"),
+        ("library", "plain file name"),
         ("../x", "plain file name"),
     ] {
         let output = import(tmp.path(), &good, name, &[]);
@@ -496,6 +498,13 @@ fn malformed_and_unrepresentable_files_are_refused_by_name_and_change_nothing() 
     assert!(stderr(&output).contains("--prefix"), "{}", stderr(&output));
     let output = import(tmp.path(), &both, "x", &["--prefix", "target"]);
     assert!(output.status.success(), "{}", stderr(&output));
+    let again = import(tmp.path(), &good, "x", &[]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(
+        stderr(&again).contains("already holds a policy named x"),
+        "{}",
+        stderr(&again)
+    );
 }
 
 #[test]

@@ -47,6 +47,15 @@ pub fn import(
             policy_store::RESERVED_NAME
         );
     }
+    // `source-<i>` is what a (re)trained library of more sources would plan next.
+    let planned_name = name
+        .strip_prefix("source-")
+        .is_some_and(|i| !i.is_empty() && i.bytes().all(|b| b.is_ascii_digit()));
+    if planned_name {
+        bail!(
+            "--name {name}: names source-<i> belong to the sources a config plans; choose another"
+        );
+    }
     // Read and checked before the library is touched: a refused file changes nothing.
     let task = source_task(config).clone();
     let (observation_size, action_count) = crate::env::spaces(&task)?;
