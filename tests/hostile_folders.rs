@@ -62,34 +62,43 @@ fn library(tmp: &Path) -> PathBuf {
     library
 }
 
-/// The files whose every byte the seed decides (episodes without their wall time).
+/// The files whose every byte the seed decides.
+const NUMBERS: [&str; 5] = [
+    "episodes.csv",
+    "tests.csv",
+    "comparison.csv",
+    "improvement.csv",
+    "scores.csv",
+];
+
+/// The contents of the [`NUMBERS`] files (episodes without their wall time).
 fn numbers(out: &Path) -> Vec<String> {
-    [
-        "episodes.csv",
-        "tests.csv",
-        "comparison.csv",
-        "improvement.csv",
-        "scores.csv",
-    ]
-    .iter()
-    .map(|f| {
-        let text = std::fs::read_to_string(out.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
-        if *f == "episodes.csv" {
-            text.lines()
-                .map(|l| l.rsplit_once(',').unwrap().0.to_string())
-                .collect::<Vec<_>>()
-                .join("\n")
-        } else {
-            text
-        }
-    })
-    .collect()
+    NUMBERS
+        .iter()
+        .map(|f| {
+            let text = std::fs::read_to_string(out.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+            if *f == "episodes.csv" {
+                text.lines()
+                    .map(|l| l.rsplit_once(',').unwrap().0.to_string())
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            } else {
+                text
+            }
+        })
+        .collect()
 }
 
 fn status(out: &Path) -> String {
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     summary["status"].as_str().unwrap().to_string()
+}
+
+/// The numbers of a folder whose summary says complete and that holds every file of them.
+fn whole(out: &Path) -> Option<Vec<String>> {
+    let files = NUMBERS.iter().all(|f| out.join(f).exists());
+    (files && out.join("summary.json").exists() && status(out) == "complete").then(|| numbers(out))
 }
 
 /// Item 1: the config stored in summary.json is checked as `--config` is.
@@ -486,12 +495,21 @@ fn a_kill_at_every_write_point_leaves_a_folder_that_finishes_to_the_same_numbers
         .unwrap());
     assert_eq!(numbers(&out), expected);
 
-    // --force killed while moving the old results aside, then after: each time the old
-    // results survive until new ones are whole.
-    for point in ["force-moving", "force-moved", "replaced-deleting"] {
+    // --force killed while moving the old results aside, halfway through its runs, or
+    // deleting what it replaced; then the next --force killed too, halfway through its
+    // runs: each time the results the folder held survive (in it or in .replaced/) until
+    // new ones are whole, and a third --force, or a --resume, leaves the folder as an
+    // uninterrupted --force would.
+    for point in [
+        "force-moving",
+        "force-moved",
+        "run-recorded",
+        "replaced-deleting",
+    ] {
         let out = tmp.path().join(format!("forced-{point}"));
         ok(dqn(&out, &["--seed", "3"]).output().unwrap());
         let old = numbers(&out);
+        assert_ne!(old, expected, "seed 3 gave the old results other numbers");
         let killed = dqn(&out, &["--force"])
             .env("SAPNET_KILL_AT", point)
             .output()
@@ -502,10 +520,52 @@ fn a_kill_at_every_write_point_leaves_a_folder_that_finishes_to_the_same_numbers
             .filter(|d| d.join("tests.csv").exists())
             .collect();
         assert!(!kept.is_empty(), "{point}: the old results are gone");
+        // Killed while deleting what it replaced, the first --force had its own results whole.
+        let held = if point == "replaced-deleting" {
+            &expected
+        } else {
+            &old
+        };
+        let killed = dqn(&out, &["--force"])
+            .env("SAPNET_KILL_AT", "run-recorded")
+            .output()
+            .unwrap();
+        assert!(
+            !killed.status.success(),
+            "{point}: the second --force ran whole"
+        );
+        assert!(
+            whole(&out).as_ref() == Some(held)
+                || whole(&out.join(".replaced")).as_ref() == Some(held),
+            "{point}: the second --force lost the results it was replacing"
+        );
+        let resumed = tmp.path().join(format!("resumed-{point}"));
+        assert!(Command::new("cp")
+            .arg("-a")
+            .arg(&out)
+            .arg(&resumed)
+            .status()
+            .unwrap()
+            .success());
+        ok(sapnet()
+            .args(["--headless", "--resume", "--out"])
+            .arg(&resumed)
+            .output()
+            .unwrap());
         ok(dqn(&out, &["--force"]).output().unwrap());
-        assert_eq!(numbers(&out), expected, "{point}");
-        assert!(!out.join(".replaced").exists(), "{point}");
-        assert_ne!(old, expected, "seed 3 gave the old results other numbers");
+        for dir in [&out, &resumed] {
+            assert_eq!(
+                whole(dir).as_ref(),
+                Some(&expected),
+                "{point}: {}",
+                dir.display()
+            );
+            assert!(
+                !dir.join(".replaced").exists(),
+                "{point}: {}",
+                dir.display()
+            );
+        }
     }
 
     // A killed merge leaves the previous merge, never a part that looks finished.

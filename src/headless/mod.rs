@@ -130,6 +130,7 @@ pub fn resume(
         );
     }
     let _lock = crate::folder_lock::FolderLock::acquire(dir, "a resume")?;
+    output::finish_replacement(dir)?;
     let mut header = results::read_header(dir)?;
     if let Some(runs) = runs {
         let had = header.config.protocol.runs;
@@ -163,13 +164,15 @@ pub fn resume(
         trace: header.trace,
         ..options.clone()
     };
-    protocol(
+    let summary = protocol(
         &header.config,
         dir,
         &options,
         Some(header.library.as_deref()),
         commands,
-    )
+    )?;
+    output::finish_replacement(dir)?;
+    Ok(summary)
 }
 
 /// The protocol into `out`. `resumed` is `None` for a new protocol, else the library the
