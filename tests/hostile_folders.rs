@@ -832,6 +832,127 @@ fn a_signal_stops_a_long_round_of_updates_within_seconds() {
     );
 }
 
+/// A protocol of `dqn` into `tmp/name`, killed once its first run is recorded (the other
+/// is left partial); returns the folder and the recorded run's folder.
+fn killed_after_one_run(tmp: &Path, name: &str) -> (PathBuf, PathBuf) {
+    let out = tmp.join(name);
+    let killed = dqn(&out, &[])
+        .env("SAPNET_KILL_AT", "run-recorded")
+        .output()
+        .unwrap();
+    assert!(!killed.status.success());
+    let recorded: Vec<PathBuf> = std::fs::read_dir(out.join("runs"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.join("run.json").exists())
+        .collect();
+    assert_eq!(recorded.len(), 1, "{recorded:?}");
+    (out, recorded[0].clone())
+}
+
+fn resume(out: &Path) -> Output {
+    sapnet()
+        .args(["--headless", "--resume", "--out"])
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+/// The README's Reliability section: run records are read only from the results folder's
+/// own directories — a `runs/` or a run's folder planted as a link is refused before a
+/// resume reads or trains anything — and only where their method and run put them; a
+/// non-UTF-8 `--out` is refused.
+#[test]
+fn run_records_are_read_only_from_their_own_places() {
+    let tmp = tempfile::tempdir().unwrap();
+    let listing = |dir: &Path| {
+        let mut names: Vec<_> = std::fs::read_dir(dir)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name())
+            .collect();
+        names.sort();
+        names
+    };
+
+    // runs/ as a link to elsewhere, which holds a record and partial ones (which a resume
+    // deletes from its own runs/).
+    let (out, _) = killed_after_one_run(tmp.path(), "runs-link");
+    let elsewhere = tmp.path().join("elsewhere");
+    std::fs::rename(out.join("runs"), &elsewhere).unwrap();
+    std::fs::create_dir(elsewhere.join(".dqn-16-run9.partial")).unwrap();
+    symlink(&elsewhere, out.join("runs")).unwrap();
+    let (before, summary) = (
+        listing(&elsewhere),
+        std::fs::read(out.join("summary.json")).unwrap(),
+    );
+    let output = resume(&out);
+    assert_eq!(
+        listing(&elsewhere),
+        before,
+        "a resume deleted outside its folder"
+    );
+    assert_eq!(
+        std::fs::read(out.join("summary.json")).unwrap(),
+        summary,
+        "a resume went ahead"
+    );
+    refused(output, "runs: a symbolic link where the run records belong");
+
+    // A run's folder as a link.
+    let (out, run) = killed_after_one_run(tmp.path(), "run-link");
+    let moved = tmp.path().join("elsewhere-run");
+    std::fs::rename(&run, &moved).unwrap();
+    symlink(&moved, &run).unwrap();
+    let summary = std::fs::read(out.join("summary.json")).unwrap();
+    refused(resume(&out), "a symbolic link among the run records");
+    assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), summary);
+
+    // A record moved to the other run's place, or past the protocol's runs.
+    let (out, run) = killed_after_one_run(tmp.path(), "misplaced");
+    let name = run.file_name().unwrap().to_str().unwrap();
+    let other = run.with_file_name(if name.ends_with("run0") {
+        "dqn-16-run1"
+    } else {
+        "dqn-16-run0"
+    });
+    std::fs::rename(&run, &other).unwrap();
+    refused(resume(&out), "belongs in");
+    std::fs::rename(&other, &run).unwrap();
+    let record = run.join("run.json");
+    let original = std::fs::read_to_string(&record).unwrap();
+    let mut json: serde_json::Value = serde_json::from_str(&original).unwrap();
+    json["run"] = 7.into();
+    std::fs::write(&record, json.to_string()).unwrap();
+    let past = run.with_file_name("dqn-16-run7");
+    std::fs::rename(&run, &past).unwrap();
+    refused(resume(&out), "(runs 0 to 1 of this protocol)");
+    std::fs::rename(&past, &run).unwrap();
+    std::fs::write(&record, original).unwrap();
+    // Back in place, it resumes; fewer runs than it holds are said in one sentence.
+    let fewer = sapnet()
+        .args(["--headless", "--resume", "--runs", "1", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    refused(
+        fewer,
+        "--runs 1 would drop runs (--resume --runs can only extend it)",
+    );
+    ok(resume(&out));
+    assert_eq!(status(&out), "complete");
+
+    // A non-UTF-8 --out.
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let bad = tmp.path().join(OsStr::from_bytes(b"o\xff"));
+    let output = dqn(&bad, &[]).output().unwrap();
+    assert!(stderr(&output).contains("--out"), "{}", stderr(&output));
+    refused(output, "expected a UTF-8 path");
+    assert!(!bad.exists());
+}
+
 /// Item 14: a path results cannot record is refused before training; a fraction or a
 /// negative count is said as such.
 #[test]

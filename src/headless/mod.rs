@@ -136,7 +136,8 @@ pub fn resume(
         let had = header.config.protocol.runs;
         if runs < had {
             bail!(
-                "{} holds a protocol of {had} runs per method: --runs {runs} would drop runs                  (--resume --runs can only extend it)",
+                "{} holds a protocol of {had} runs per method: --runs {runs} would drop runs \
+                 (--resume --runs can only extend it)",
                 dir.display()
             );
         }
@@ -160,6 +161,9 @@ pub fn resume(
         ),
         Some(_) => {}
     }
+    // Checked before anything is built or trained: a link planted among the records (or
+    // as `runs/` itself), or a record out of its place, ends the resume before it trains.
+    records::read(dir, &header.config)?;
     let options = RunOptions {
         trace: header.trace,
         ..options.clone()
