@@ -368,6 +368,17 @@ fn wait_within(child: &mut Child, limit: Duration, what: &str) -> ExitStatus {
     }
 }
 
+/// `command`'s output, which must come within `limit` (see [`wait_within`]).
+fn output_within(command: &mut Command, limit: Duration, what: &str) -> Output {
+    let mut child = command
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_within(&mut child, limit, what);
+    child.wait_with_output().unwrap()
+}
+
 /// Items 5 and 6: a second process into a live folder or cell is refused, naming the
 /// first; the first finishes whole.
 #[test]
@@ -662,9 +673,84 @@ fn fifos_and_devices_are_refused_at_once() {
     std::fs::remove_file(&manifest).unwrap();
     std::fs::rename(tmp.path().join("library.ron"), &manifest).unwrap();
     let weights = library.join("cartpole/source-0.safetensors");
+    let saved = tmp.path().join("saved");
+    std::fs::copy(&weights, &saved).unwrap();
     std::fs::remove_file(&weights).unwrap();
     symlink("/dev/zero", &weights).unwrap();
     refused(run("o2"), "source-0.safetensors");
+    std::fs::remove_file(&weights).unwrap();
+
+    // A policy's weights or metadata as a FIFO: refused at once, named (an open() that
+    // blocked would never return: the child is given seconds).
+    for name in ["source-0.safetensors", "source-0.ron"] {
+        let file = library.join("cartpole").join(name);
+        let aside = tmp.path().join(format!("aside-{name}"));
+        if file.exists() {
+            std::fs::rename(&file, &aside).unwrap();
+        } else {
+            std::fs::copy(&saved, &aside).unwrap();
+        }
+        assert!(Command::new("mkfifo")
+            .arg(&file)
+            .status()
+            .unwrap()
+            .success());
+        let output = output_within(
+            sapnet()
+                .args(["--headless", "--config"])
+                .arg(configs("tiny_transfer.ron"))
+                .arg("--library")
+                .arg(&library)
+                .arg("--out")
+                .arg(tmp.path().join(format!("fifo-{name}"))),
+            Duration::from_secs(20),
+            name,
+        );
+        assert!(stderr(&output).contains(name), "{}", stderr(&output));
+        refused(output, "a FIFO, not a regular file");
+        std::fs::remove_file(&file).unwrap();
+        std::fs::rename(&aside, &file).unwrap();
+    }
+}
+
+/// Item 10: a regular weights file past its bound (the architecture's size plus 1 MiB) is
+/// refused before it is read, with the file and the bound named.
+#[test]
+fn oversized_weights_are_refused_with_their_bound() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = library(tmp.path());
+    let weights = library.join("cartpole/source-0.safetensors");
+    let mut bytes = std::fs::read(&weights).unwrap();
+    let original = bytes.len() as u64;
+    bytes.resize(bytes.len() + (3 << 20), 0);
+    std::fs::write(&weights, &bytes).unwrap();
+    assert!(std::fs::symlink_metadata(&weights).unwrap().is_file());
+    let output = sapnet()
+        .args(["--headless", "--config"])
+        .arg(configs("tiny_transfer.ron"))
+        .arg("--library")
+        .arg(&library)
+        .arg("--out")
+        .arg(tmp.path().join("o"))
+        .output()
+        .unwrap();
+    let said = stderr(&output);
+    assert!(said.contains("source-0.safetensors"), "{said}");
+    let says = format!("{} bytes, more than the ", bytes.len());
+    refused(output, &says);
+    let bound: u64 = said
+        .split(&says)
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        original < bound && bound <= original + (1 << 20),
+        "bound {bound}"
+    );
 }
 
 /// Item 11: NaN weights and a NaN score are refused where Inf is.
