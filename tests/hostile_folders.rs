@@ -322,7 +322,8 @@ fn a_sweep_cannot_choose_where_a_library_is_trained_and_linked_metadata_is_refus
     // A policy's metadata as a link to a secret: refused as a link, the secret unread.
     let library = library(tmp.path());
     let secret = tmp.path().join("secret.txt");
-    std::fs::write(&secret, "TOP-SECRET").unwrap();
+    // Read as metadata, its first word would be quoted as the token found.
+    std::fs::write(&secret, "SECRET_TOKEN=hunter2\n").unwrap();
     let metadata = library.join("cartpole/source-0.ron");
     std::fs::remove_file(&metadata).unwrap();
     symlink(&secret, &metadata).unwrap();
@@ -335,6 +336,11 @@ fn a_sweep_cannot_choose_where_a_library_is_trained_and_linked_metadata_is_refus
         .arg(tmp.path().join("o"))
         .output()
         .unwrap();
+    let said = stderr(&output);
+    assert!(
+        !said.contains("SECRET_TOKEN") && !said.contains("hunter2"),
+        "the linked file was quoted: {said}"
+    );
     refused(output, "symbolic link");
 }
 
