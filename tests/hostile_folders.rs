@@ -385,6 +385,21 @@ fn output_within(command: &mut Command, limit: Duration, what: &str) -> Output {
     child.wait_with_output().unwrap()
 }
 
+/// Cell `id` of `sweep` made `episodes` long (seconds at 300), planned as the sweep's own:
+/// the manifest's hash of the cell is made to match.
+fn lengthen_cell(sweep: &Path, id: usize, episodes: u32) {
+    let cell = sweep.join(format!("cells/{id:04}.ron"));
+    let text = std::fs::read_to_string(&cell)
+        .unwrap()
+        .replace("episodes: 5,", &format!("episodes: {episodes},"));
+    let old_hash = sapnet::policy_store::sha256_hex(&std::fs::read(&cell).unwrap());
+    std::fs::write(&cell, &text).unwrap();
+    let hash = sapnet::policy_store::sha256_hex(text.as_bytes());
+    let manifest = std::fs::read_to_string(sweep.join("sweep.ron")).unwrap();
+    assert!(manifest.contains(&old_hash));
+    std::fs::write(sweep.join("sweep.ron"), manifest.replace(&old_hash, &hash)).unwrap();
+}
+
 /// Items 5 and 6: a second process into a live folder or cell is refused, naming the
 /// first; the first finishes whole.
 #[test]
@@ -425,24 +440,7 @@ fn a_second_process_into_a_live_folder_or_cell_is_refused() {
     // Two `sweep run --cell 0` at once.
     let sweep = tmp.path().join("sweep");
     plan_sweep(tmp.path(), &sweep);
-    let cell = sweep.join("cells/0000.ron");
-    let text = std::fs::read_to_string(&cell)
-        .unwrap()
-        .replace("episodes: 5,", "episodes: 300,");
-    std::fs::write(&cell, &text).unwrap();
-    // The manifest hashes the cell: plan the edited one as the sweep's own.
-    let manifest = std::fs::read_to_string(sweep.join("sweep.ron")).unwrap();
-    let old = manifest
-        .lines()
-        .find(|l| l.contains("config_sha256"))
-        .unwrap()
-        .to_string();
-    let hash = sapnet::policy_store::sha256_hex(text.as_bytes());
-    std::fs::write(
-        sweep.join("sweep.ron"),
-        manifest.replacen(&old, &format!("            config_sha256: \"{hash}\","), 1),
-    )
-    .unwrap();
+    lengthen_cell(&sweep, 0, 300);
     let mut first = sapnet()
         .args(["sweep", "run"])
         .arg(&sweep)
@@ -464,6 +462,93 @@ fn a_second_process_into_a_live_folder_or_cell_is_refused() {
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(done.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["runs"].as_array().unwrap().len(), 2);
+}
+
+/// Sends `signal` (`-STOP`, `-CONT`, …) to process `pid`.
+fn signal(pid: &str, signal: &str) {
+    assert!(Command::new("kill")
+        .args([signal, pid])
+        .status()
+        .unwrap()
+        .success());
+}
+
+/// Item 5: a cell is marked done only when every run it should hold is there (a record
+/// lost while the cell runs, as a second process used to delete them, leaves it not done);
+/// and an orphan of a killed `sweep run --all` keeps its cell when the sweep is run again.
+#[test]
+fn a_cell_is_done_only_with_all_its_runs_and_an_orphan_keeps_its_cell() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = tmp.path().join("sweep");
+    plan_sweep(tmp.path(), &sweep);
+    // A tenth of a second or more per run; stopped (SIGSTOP) where the test acts.
+    lengthen_cell(&sweep, 0, 3000);
+    let partial = sweep.join("results/.0000.partial");
+    let mut cell = sapnet()
+        .args(["sweep", "run"])
+        .arg(&sweep)
+        .args(["--cell", "0", "--jobs", "1"])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Run 0 recorded, run 1 training (one job: one run after the other).
+    let first = partial.join("runs/dqn-16-run0");
+    wait_for(&first.join("run.json"));
+    let pid = cell.id().to_string();
+    signal(&pid, "-STOP");
+    assert!(
+        !partial.join("runs/dqn-16-run1").exists(),
+        "run 1 ended before the test could stop the cell"
+    );
+    std::fs::remove_dir_all(&first).unwrap();
+    signal(&pid, "-CONT");
+    assert!(!cell.wait().unwrap().success());
+    assert!(
+        !sweep.join("results/0000").exists(),
+        "marked done without run 0"
+    );
+    let note = std::fs::read_to_string(sweep.join("failed/0000.txt")).unwrap();
+    assert!(note.contains("1 of its 2 runs finished"), "{note}");
+
+    // `sweep run --all` killed (-9) while its child runs cell 0: the child, stopped to
+    // outlast the rerun, is an orphan holding its cell.
+    let mut all = sapnet()
+        .args(["sweep", "run"])
+        .arg(&sweep)
+        .args(["--all", "--jobs", "1"])
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    wait_for(&partial.join("summary.json"));
+    let holder = std::fs::read_to_string(sweep.join("results/.0000.lock")).unwrap();
+    let orphan = holder
+        .strip_prefix("running as PID ")
+        .and_then(|h| h.split(' ').next())
+        .unwrap_or_else(|| panic!("{holder}"))
+        .to_string();
+    signal(&orphan, "-STOP");
+    all.kill().unwrap();
+    all.wait().unwrap();
+    let rerun = sapnet()
+        .args(["sweep", "run"])
+        .arg(&sweep)
+        .args(["--all", "--jobs", "1"])
+        .output();
+    signal(&orphan, "-CONT");
+    let rerun = rerun.unwrap();
+    assert!(!rerun.status.success(), "{}", stderr(&rerun));
+    let log = std::fs::read_to_string(sweep.join("logs/0000.err")).unwrap();
+    assert!(log.contains(&format!("running as PID {orphan}")), "{log}");
+    assert_eq!(status(&sweep.join("results/0001")), "complete");
+    // The orphan finishes its cell whole.
+    wait_for(&sweep.join("results/0000/summary.json"));
+    let done = sweep.join("results/0000");
+    assert_eq!(status(&done), "complete");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(done.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["runs"].as_array().unwrap().len(), 2);
+    let episodes = std::fs::read_to_string(done.join("episodes.csv")).unwrap();
+    assert_eq!(episodes.lines().count(), 1 + 2 * 3000);
 }
 
 /// Items 7, 8 and 9: killed at each point where it writes, a protocol is resumable or
