@@ -130,12 +130,14 @@ pub fn resume(
         );
     }
     let _lock = crate::folder_lock::FolderLock::acquire(dir, "a resume")?;
+    output::finish_replacement(dir)?;
     let mut header = results::read_header(dir)?;
     if let Some(runs) = runs {
         let had = header.config.protocol.runs;
         if runs < had {
             bail!(
-                "{} holds a protocol of {had} runs per method: --runs {runs} would drop runs                  (--resume --runs can only extend it)",
+                "{} holds a protocol of {had} runs per method: --runs {runs} would drop runs \
+                 (--resume --runs can only extend it)",
                 dir.display()
             );
         }
@@ -159,17 +161,22 @@ pub fn resume(
         ),
         Some(_) => {}
     }
+    // Checked before anything is built or trained: a link planted among the records (or
+    // as `runs/` itself), or a record out of its place, ends the resume before it trains.
+    records::read(dir, &header.config)?;
     let options = RunOptions {
         trace: header.trace,
         ..options.clone()
     };
-    protocol(
+    let summary = protocol(
         &header.config,
         dir,
         &options,
         Some(header.library.as_deref()),
         commands,
-    )
+    )?;
+    output::finish_replacement(dir)?;
+    Ok(summary)
 }
 
 /// The protocol into `out`. `resumed` is `None` for a new protocol, else the library the

@@ -117,6 +117,17 @@ pub(super) fn open_output(output: &OutputOptions) -> Result<(FolderLock, Option<
     Ok((lock, Some(replaced)))
 }
 
+/// What a killed `--force` left, finished before and after a `--resume`: the resumed
+/// protocol is that `--force`'s replacement, so once it is complete the results it
+/// replaces go, as they would have.
+pub(super) fn finish_replacement(dir: &Path) -> Result<()> {
+    let replaced = dir.join(REPLACED);
+    if std::fs::symlink_metadata(&replaced).is_ok() {
+        finish_interrupted_replacement(dir, &replaced)?;
+    }
+    Ok(())
+}
+
 /// An earlier `--force` was killed. Killed while moving the old results aside (no
 /// [`MOVED`] mark), they are put back; killed after deleting them had begun — the new
 /// results complete — the rest of `.replaced` goes. Otherwise `.replaced` holds the old

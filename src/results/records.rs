@@ -171,6 +171,27 @@ impl RunWriter {
     }
 }
 
+/// `out/runs`, if there: a real directory. `O_NOFOLLOW` guards only a path's last
+/// component, so a `runs` planted as a link would have every record read, and partial
+/// ones deleted, wherever it points.
+fn runs_dir(out: &Path) -> Result<Option<PathBuf>> {
+    let dir = out.join(RUNS);
+    match std::fs::symlink_metadata(&dir) {
+        Ok(m) if m.is_dir() => Ok(Some(dir)),
+        Ok(m) if m.file_type().is_symlink() => bail!(
+            "{}: a symbolic link where the run records belong: a results folder's records are \
+             its own directories, never links to elsewhere",
+            dir.display()
+        ),
+        Ok(_) => bail!(
+            "{}: a file where the run records' directory belongs",
+            dir.display()
+        ),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(e).with_context(|| format!("reading {}", dir.display())),
+    }
+}
+
 /// A run's record on disk.
 pub struct RunFolder {
     pub dir: PathBuf,
@@ -180,12 +201,10 @@ pub struct RunFolder {
 /// Whether `out` holds a run record as [`read`] counts one (a directory of `runs/`, not a
 /// link nor a hidden partial folder, with its `run.json`), found without reading one.
 pub fn any(out: &Path) -> Result<bool> {
-    let dir = out.join(RUNS);
-    let entries = match std::fs::read_dir(&dir) {
-        Ok(entries) => entries,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(false),
-        Err(e) => return Err(e).with_context(|| format!("reading {}", dir.display())),
+    let Some(dir) = runs_dir(out)? else {
+        return Ok(false);
     };
+    let entries = std::fs::read_dir(&dir).with_context(|| format!("reading {}", dir.display()))?;
     for entry in entries {
         let entry = entry.with_context(|| format!("reading {}", dir.display()))?;
         let hidden = entry
@@ -203,12 +222,10 @@ pub fn any(out: &Path) -> Result<bool> {
 /// The finished (and stopped) runs recorded in `out`, by the protocol's order: method as
 /// `config` lists them, then run. Partial folders are not records.
 pub fn read(out: &Path, config: &Config) -> Result<Vec<RunFolder>> {
-    let dir = out.join(RUNS);
-    let entries = match std::fs::read_dir(&dir) {
-        Ok(entries) => entries,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(e).with_context(|| format!("reading {}", dir.display())),
+    let Some(dir) = runs_dir(out)? else {
+        return Ok(Vec::new());
     };
+    let entries = std::fs::read_dir(&dir).with_context(|| format!("reading {}", dir.display()))?;
     let ids: BTreeMap<String, MethodId> = experiment::method_ids(config)
         .into_iter()
         .map(|id| (id.label().to_string(), id))
@@ -310,8 +327,7 @@ pub fn clear_unfinished(out: &Path, finished: &[RunFolder]) -> Result<()> {
             )
         })?;
     }
-    let dir = out.join(RUNS);
-    if let Ok(entries) = std::fs::read_dir(&dir) {
+    if let Some(entries) = runs_dir(out)?.and_then(|dir| std::fs::read_dir(dir).ok()) {
         for entry in entries.flatten() {
             let path = entry.path();
             let partial = path
