@@ -200,10 +200,15 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     }
     let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
     if !cli.run.headless {
-        if cli.run.out.is_some() || cli.run.force || cli.run.jobs.is_some() || cli.run.trace {
+        if cli.run.out.is_some()
+            || cli.run.force
+            || cli.run.jobs.is_some()
+            || cli.run.trace
+            || cli.run.add_to_library
+        {
             anyhow::bail!(
-                "--out, --force, --jobs and --trace are for --headless runs: the dashboard \
-                 writes no files (its teach mode, `t`, steps the spreading by hand)"
+                "--out, --force, --jobs, --trace and --add-to-library are for --headless runs: \
+                 the dashboard writes no files (its teach mode, `t`, steps the spreading by hand)"
             );
         }
         return run_dashboard(cli, &config);
@@ -269,7 +274,7 @@ fn run_options(cli: &Cli) -> RunOptions {
         }),
         library: cli.run.library_root(),
         trace: cli.run.trace,
-        copy_chosen: true,
+        copy_chosen: cli.run.add_to_library,
     }
 }
 

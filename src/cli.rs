@@ -32,6 +32,12 @@ pub struct RunArgs {
     #[arg(long)]
     pub headless: bool,
 
+    /// With --headless: also add each run's chosen policy, fine-tuned, to the library as
+    /// <LIBRARY>/<task>/chosen/<out dir>-<method>-run<r> (Algorithm 3's last step). Without
+    /// it a run writes only under --out (its policies/ holds the same files).
+    #[arg(long)]
+    pub add_to_library: bool,
+
     /// Run seed, overriding the config's `seed`: the same seed and config give the same
     /// numbers on the same machine.
     #[arg(long, value_name = "N", global = true)]
@@ -124,6 +130,7 @@ impl RunArgs {
         [
             ("--config", self.config.is_some()),
             ("--headless", self.headless),
+            ("--add-to-library", self.add_to_library),
             ("--seed", self.seed.is_some()),
             ("--out", self.out.is_some()),
             ("--force", self.force),

@@ -240,11 +240,17 @@ fn a_diverging_run_stops_with_an_error_and_keeps_its_last_good_weights() {
 
 #[test]
 fn output_flags_without_headless_are_refused_before_the_dashboard_opens() {
-    for flag in [&["--out", "somewhere"][..], &["--trace"]] {
+    for flag in [
+        &["--out", "somewhere"][..],
+        &["--trace"],
+        &["--add-to-library"],
+    ] {
         let output = sapnet(flag);
         assert_eq!(output.status.code(), Some(2));
         assert!(
-            stderr(&output).contains("--out, --force, --jobs and --trace are for --headless runs"),
+            stderr(&output).contains(
+                "--out, --force, --jobs, --trace and --add-to-library are for --headless runs"
+            ),
             "{}",
             stderr(&output)
         );

@@ -174,7 +174,7 @@ fn planted_links_are_replaced_not_followed() {
     std::fs::create_dir(&elsewhere).unwrap();
     symlink(&elsewhere, library.join("cartpole/chosen")).unwrap();
     let run = ok(sapnet()
-        .args(["--headless", "--config"])
+        .args(["--headless", "--add-to-library", "--config"])
         .arg(configs("tiny_transfer.ron"))
         .arg("--library")
         .arg(&library)

@@ -575,6 +575,8 @@ fn a_shipped_library_with_two_imported_sources_runs_quick_and_lists_them() {
         "{table}"
     );
 
+    // A run's results go under --out only: the library it read is left as it was.
+    let before = tree(tmp.path());
     let out = tmp.path().join("out");
     let run = sapnet(&[
         "--headless",
@@ -601,6 +603,27 @@ fn a_shipped_library_with_two_imported_sources_runs_quick_and_lists_them() {
     let activations = std::fs::read_to_string(out.join("activations.csv")).unwrap();
     let header = activations.lines().next().unwrap();
     assert!(header.contains("A_sb3,A_cleanrl,P_source-0"), "{header}");
+    let mut after = tree(tmp.path());
+    after.retain(|path, _| !path.starts_with("out"));
+    assert_eq!(after, before, "the run changed its input library");
+}
+
+/// Every file under `dir` (a lock file left out), by relative path, with its bytes.
+fn tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    let mut files = BTreeMap::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(folder) = todo.pop() {
+        for entry in std::fs::read_dir(&folder).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                todo.push(path);
+            } else if !path.ends_with(".sapnet.lock") {
+                let bytes = std::fs::read(&path).unwrap();
+                files.insert(path.strip_prefix(dir).unwrap().to_path_buf(), bytes);
+            }
+        }
+    }
+    files
 }
 
 #[test]
