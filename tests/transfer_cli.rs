@@ -85,6 +85,7 @@ fn a_missing_library_is_trained_then_every_result_is_written() {
             "--jobs",
             "2",
             "--train-library",
+            "--add-to-library",
         ],
         &library,
         &out,
