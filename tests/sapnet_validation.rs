@@ -212,7 +212,13 @@ fn an_activated_coefficient_that_could_overflow_the_activations_is_refused() {
         )
     };
     assert!(with(most).is_ok());
-    assert!(with(-most).is_ok());
+    // 𝒜 ≤ 0 would never credit a good step (Algorithm 3), whatever its size.
+    for coefficient in [-most, -0.5, 0.0, -0.0] {
+        assert!(
+            matches!(with(coefficient), Err(SapNetError::BadParameter { ref name, .. }) if name == "coefficient"),
+            "{coefficient}"
+        );
+    }
     let err = with(most * 1.001).unwrap_err();
     assert!(
         matches!(err, SapNetError::ActivationOverflow { most: m, .. } if m == most),

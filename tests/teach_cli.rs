@@ -168,6 +168,27 @@ fn a_coefficient_that_would_overflow_is_refused_at_its_field() {
     assert!(output.stdout.is_empty());
 }
 
+/// Issue 27: a lesson with 𝒜 ≤ 0 was accepted (activations went negative) while the
+/// training config refuses it; now both refuse it at the field.
+#[test]
+fn a_coefficient_of_zero_or_less_is_refused_at_its_field() {
+    let tmp = tempfile::tempdir().unwrap();
+    for value in ["-0.5", "0.0"] {
+        let lesson = tmp.path().join("lesson.ron");
+        let text = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/teach_fig2.ron"),
+        )
+        .unwrap()
+        .replace("coefficient: 1.0", &format!("coefficient: {value}"));
+        std::fs::write(&lesson, text).unwrap();
+        let output = sapnet(&["teach", "--headless", "--config", lesson.to_str().unwrap()]);
+        assert_eq!(output.status.code(), Some(2), "{value}");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains("field `coefficient`"), "{stderr}");
+        assert!(stderr.contains("> 0"), "{stderr}");
+    }
+}
+
 /// Issue 15: a training config given to teach was refused as "Unexpected field `env` in
 /// TeachConfig"; it is now told what teach reads.
 #[test]

@@ -81,8 +81,8 @@ impl Default for SapNetParams {
 }
 
 impl SapNetParams {
-    /// Checks what the types cannot: T_ω and τ finite and > 0 (a walk must be able to
-    /// stop, a softmax must be defined), 𝒜, δ and every ω_c finite, bucket widths ≥ 1, and
+    /// Checks what the types cannot: T_ω, τ and 𝒜 finite and > 0 (a walk must be able to
+    /// stop, a softmax must be defined, a good step must be credited), δ and every ω_c finite, bucket widths ≥ 1, and
     /// every edge eq. 5 can produce heavier than 0.
     pub fn validate(&self) -> Result<(), SapNetError> {
         let bad = |name: &str, value: f64, expected| SapNetError::BadParameter {
@@ -106,7 +106,15 @@ impl SapNetParams {
         };
         positive("threshold", self.threshold)?;
         positive("temperature", self.temperature)?;
-        finite("coefficient", self.coefficient)?;
+        // A negative transition activates with 0 (Algorithm 3): 𝒜 ≤ 0 would never credit a
+        // good step, and activations would fall below the ones nothing ever activated.
+        if !(self.coefficient > 0.0 && self.coefficient.is_finite()) {
+            return Err(bad(
+                "coefficient",
+                self.coefficient,
+                "a finite number > 0 (𝒜 activates a policy after a positive transition)",
+            ));
+        }
         finite("delta", self.delta)?;
         for (c, weighted) in self.prototypes.iter().enumerate() {
             finite(&format!("prototypes[{c}].omega"), weighted.omega)?;

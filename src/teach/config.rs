@@ -137,7 +137,15 @@ impl TeachConfig {
     pub fn lesson(&self) -> Result<Lesson, String> {
         let n = self.count()?;
         let params = self.params();
-        params.validate().map_err(|e| e.to_string())?;
+        params.validate().map_err(|e| match e {
+            // Worded as the training config words a field.
+            SapNetError::BadParameter {
+                name,
+                value,
+                expected,
+            } => format!("field `{name}`: expected {expected}, got {value}"),
+            other => other.to_string(),
+        })?;
         let graph = if self.descriptions.is_empty() {
             self.no_category_fields()?;
             Graph::from_edges(n, self.edges.iter().copied()).map_err(in_field("edges"))?

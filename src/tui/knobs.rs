@@ -228,6 +228,19 @@ mod tests {
         assert_eq!(down.params().temperature, 0.5);
     }
 
+    /// 𝒜 ≤ 0 is refused as the training config refuses it: 1 → 0.5, then no further.
+    #[test]
+    fn the_coefficient_stops_above_zero() {
+        let net = Knob::Coefficient.turn(&fig2(), None, false).unwrap();
+        assert_eq!(net.params().coefficient, 0.5);
+        let refused = Knob::Coefficient.turn(&net, None, false).unwrap_err();
+        let message = refusal(&refused, &[]);
+        assert!(
+            message.contains("coefficient") && message.contains("> 0"),
+            "{message}"
+        );
+    }
+
     #[test]
     fn ten_steps_of_a_tenth_read_as_a_whole_number() {
         let mut net = fig2();
