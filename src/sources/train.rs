@@ -43,6 +43,18 @@ pub fn train_library(
     let imported = manifest::read(&dir)?
         .map(|m| m.imported)
         .unwrap_or_default();
+    if let Some(found) = manifest::read(&dir)?.filter(|m| m.complete && m.training == training) {
+        if !retrain {
+            // Asked for what is there: a notice, not an error.
+            eprintln!(
+                "{} already holds the {} policies this config describes: nothing to train \
+                 (--retrain trains them again)",
+                dir.display(),
+                found.policies.len()
+            );
+            return Ok(dir);
+        }
+    }
     let kept = resumable(&dir, &training, &plans, retrain)?;
     crate::policy_store::remove_temporaries(&dir)
         .with_context(|| format!("removing a killed save's leftovers from {}", dir.display()))?;
@@ -185,14 +197,6 @@ fn resumable(
 ) -> Result<Vec<ManifestEntry>> {
     match manifest::read(dir)? {
         Some(found) if &found.training == training => {
-            if found.complete && !retrain {
-                bail!(
-                    "{} already holds the {} policies this config describes; pass --retrain to \
-                     train them again",
-                    dir.display(),
-                    found.policies.len()
-                );
-            }
             if found.complete {
                 return Ok(Vec::new());
             }
