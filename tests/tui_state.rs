@@ -355,3 +355,59 @@ fn a_method_that_picks_by_rule_never_shows_a_lock_in() {
     d.on_event(tui_script::probabilities_at(ucb1, 102_244, probabilities));
     assert_eq!(d.sapnet.as_ref().unwrap().locked, None);
 }
+
+/// Issue 27: plain `sapnet` showed "P(source-6) > 0.99 since step" 645, 640 or 624 from
+/// launch to launch, where the headless run of the same seeds records 623: the screen dated
+/// the lock-in from the first frame that noticed it. It now shows the trainer's figure.
+/// Run 0 of the embedded config's SAP-Net, on the shipped library, streamed as the
+/// dashboard streams it and folded into its state, against the run's own record and the
+/// same run streamed as headless mode streams it.
+#[test]
+fn the_dashboard_shows_the_lock_in_step_the_headless_run_records() {
+    use sapnet::trainer::{Event, StreamOptions};
+    let config = sapnet::config::Config::from_ron(sapnet::assets::CARTPOLE, "embedded").unwrap();
+    let library = sapnet::sources::LibraryRoot {
+        path: std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("saved_policies"),
+        train_if_missing: false,
+    };
+    let (_stop, stop) = std::sync::mpsc::channel();
+    let plan = sapnet::experiment::plan(&config, &library, 2, &stop).unwrap();
+    let mut spec = plan
+        .specs
+        .into_iter()
+        .find(|s| s.run == 0 && s.method.label() == "sapnet")
+        .unwrap();
+    // Lock-in comes within the first few hundred steps; 40 episodes are past it.
+    spec.episodes = 40;
+    let run = |stream: StreamOptions, dashboard: &mut Dashboard| {
+        let mut spec = spec.clone();
+        spec.stream = stream;
+        let (events, received) = std::sync::mpsc::channel();
+        let handle = sapnet::trainer::spawn(spec, events).unwrap();
+        let mut record = None;
+        for event in received {
+            if let Event::RunEnded(r) = &event {
+                record = Some(r.clone());
+            }
+            dashboard.on_event(event);
+        }
+        handle.thread.join().unwrap().unwrap();
+        record.expect("the run ends")
+    };
+    let mut live = Dashboard::new("CartPole-v1");
+    let shown = run(StreamOptions::live(), &mut live);
+    let headless = run(
+        StreamOptions::episodes(),
+        &mut Dashboard::new("CartPole-v1"),
+    );
+    let step = headless
+        .lock_in_step
+        .expect("SAP-Net locks in within 40 episodes");
+    assert_eq!(shown.lock_in_step, Some(step));
+    let (_, since) = live.sapnet.as_ref().unwrap().locked.expect("shown locked");
+    assert_eq!(since, step);
+    assert_eq!(
+        shown.chosen.map(|c| c.name),
+        headless.chosen.map(|c| c.name)
+    );
+}

@@ -210,6 +210,18 @@ pub struct ActivationSnapshot {
     /// Positive and negative transitions of each policy (eq. 7), since the run started.
     pub positive: Vec<u64>,
     pub negative: Vec<u64>,
+    /// The run's lock-in so far, as its record will give it (`lock_in_step`): the first
+    /// step at which one source's probability exceeded [`super::LOCK_IN`], and which. A
+    /// screen shows this figure, not the step of the first frame that noticed it.
+    pub lock_in: Option<LockIn>,
+}
+
+/// The first step at which `source`'s probability of being picked exceeded
+/// [`super::LOCK_IN`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LockIn {
+    pub source: usize,
+    pub step: u64,
 }
 
 /// Every `spread` call of one activation (eq. 8–11), in the order they were made.

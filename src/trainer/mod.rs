@@ -13,8 +13,8 @@ use std::sync::mpsc::{self, Sender};
 use std::thread::{self, JoinHandle};
 
 pub use events::{
-    ActivationSnapshot, ChosenPolicy, Command, Deposit, EpisodeRecord, Event, MethodId, RunRecord,
-    SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
+    ActivationSnapshot, ChosenPolicy, Command, Deposit, EpisodeRecord, Event, LockIn, MethodId,
+    RunRecord, SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
 };
 pub use run::{selector, test_greedy, train, RunSpec, SourcePolicy, LOCK_IN};
 

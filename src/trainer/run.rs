@@ -30,7 +30,7 @@ use rand::SeedableRng;
 
 use super::control::{Control, Next};
 use super::events::{
-    ActivationSnapshot, ChosenPolicy, Command, EpisodeRecord, Event, MethodId, RunRecord,
+    ActivationSnapshot, ChosenPolicy, Command, EpisodeRecord, Event, LockIn, MethodId, RunRecord,
     SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
 };
 use super::{Divergence, RunOutcome, TrainerError};
@@ -317,7 +317,12 @@ pub fn train(
     };
     let step_budget = spec.max_steps.unwrap_or(u64::MAX);
     let snapshots = n > 0;
-    let snapshot = |selector: &dyn Selector, tally: &Tally, step: u64, episode: u32| {
+    let mut lock_in: Option<LockIn> = None;
+    let snapshot = |selector: &dyn Selector,
+                    tally: &Tally,
+                    step: u64,
+                    episode: u32,
+                    lock_in: Option<LockIn>| {
         let view = selector.view();
         Event::Activations(ActivationSnapshot {
             run: spec.run,
@@ -330,6 +335,7 @@ pub fn train(
             selections: tally.run.clone(),
             positive: view.positive,
             negative: view.negative,
+            lock_in,
         })
     };
     let send_traces = |selector: &mut dyn Selector, step: u64| {
@@ -438,6 +444,15 @@ pub fn train(
                     && selector.top_probability().is_some_and(|p| p > LOCK_IN)
                 {
                     record.lock_in_step = Some(steps);
+                    // Once per run: which source it was, for the live view.
+                    let probabilities = selector.view().probabilities;
+                    lock_in = probabilities
+                        .iter()
+                        .position(|&p| p > LOCK_IN)
+                        .map(|source| LockIn {
+                            source,
+                            step: steps,
+                        });
                 }
             }
             if spec.stream.steps {
@@ -460,7 +475,7 @@ pub fn train(
                         && steps.is_multiple_of(16)
                         && last_snapshot.elapsed() >= spec.stream.snapshot_interval))
             {
-                let _ = events.send(snapshot(selector.as_ref(), &tally, steps, episode));
+                let _ = events.send(snapshot(selector.as_ref(), &tally, steps, episode, lock_in));
                 last_snapshot = Instant::now();
             }
             reward += step.reward;
@@ -481,7 +496,7 @@ pub fn train(
         });
         send_traces(selector.as_mut(), steps);
         if snapshots {
-            let _ = events.send(snapshot(selector.as_ref(), &tally, steps, episode));
+            let _ = events.send(snapshot(selector.as_ref(), &tally, steps, episode, lock_in));
         }
         let shown = match learning {
             Learning::ActingSource => &learners.agents[last_source],

@@ -463,10 +463,14 @@ impl Dashboard {
                 .iter()
                 .position(|&p| p > LOCK_IN)
                 .filter(|_| snapshot.method.kind.picks_by_probability());
-            view.locked = match (top, view.locked) {
-                (Some(i), Some((held, since))) if i == held => Some((held, since)),
-                (Some(i), _) => Some((i, snapshot.step)),
-                (None, _) => None,
+            // The trainer dates the first lock-in at its step (the headless results' figure);
+            // a frame sees it only when it is drawn. A later one, after the first let go, is
+            // dated from the first snapshot that shows it.
+            view.locked = match (top, view.locked, snapshot.lock_in) {
+                (Some(i), _, Some(first)) if first.source == i => Some((i, first.step)),
+                (Some(i), Some((held, since)), _) if i == held => Some((held, since)),
+                (Some(i), _, _) => Some((i, snapshot.step)),
+                (None, _, _) => None,
             };
         }
         self.step = self.step.max(snapshot.step);

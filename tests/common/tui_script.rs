@@ -128,6 +128,7 @@ pub fn episodes(episodes: u32) -> Vec<Event> {
             selections: selections.clone(),
             positive: positive.clone(),
             negative: negative.clone(),
+            lock_in: None,
         }));
         events.push(episode_end("sapnet", episode, f64::from(length)));
         // The baseline's ~10-step episodes run ahead of SAP-Net's, as they do live.
@@ -192,5 +193,6 @@ pub fn probabilities_at(method: MethodId, step: u64, probabilities: Vec<f64>) ->
         selections: vec![0; n],
         positive: vec![0; n],
         negative: vec![0; n],
+        lock_in: None,
     })
 }
