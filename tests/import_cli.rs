@@ -50,18 +50,19 @@ fn tiny_library(dir: &Path) -> PathBuf {
     dir.join("cartpole")
 }
 
+/// `sapnet sources import FILE --name NAME` into the tiny library under `library`.
 fn import(library: &Path, file: &Path, name: &str, extra: &[&str]) -> Output {
+    import_for(&tiny_config(), library, file, name, extra)
+}
+
+/// The same into the library of `config`.
+fn import_for(config: &str, library: &Path, file: &Path, name: &str, extra: &[&str]) -> Output {
+    let file = file.to_str().unwrap();
+    let library = library.to_str().unwrap();
     let mut args = vec![
-        "sources",
-        "import",
-        file.to_str().unwrap(),
-        "--name",
-        name,
-        "--config",
+        "sources", "import", file, "--name", name, "--config", config,
     ];
-    let config = tiny_config();
-    args.push(&config);
-    args.extend(["--library", library.to_str().unwrap()]);
+    args.extend(["--library", library]);
     args.extend(extra);
     sapnet(&args)
 }
@@ -544,18 +545,7 @@ fn a_shipped_library_with_two_imported_sources_runs_quick_and_lists_them() {
         ("sb3_cartpole.zip", "sb3"),
         ("cleanrl_cartpole.cleanrl_model", "cleanrl"),
     ] {
-        let file = fixture(file);
-        let output = sapnet(&[
-            "sources",
-            "import",
-            file.to_str().unwrap(),
-            "--name",
-            name,
-            "--config",
-            config,
-            "--library",
-            library,
-        ]);
+        let output = import_for(config, tmp.path(), &fixture(file), name, &[]);
         assert!(output.status.success(), "{}", stderr(&output));
     }
 
