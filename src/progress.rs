@@ -2,7 +2,8 @@
 //! progress; otherwise (logs, CI) a plain line every few seconds, so scripted runs stay
 //! readable. Both count in the unit that bounds the runs (episodes, or steps under a step
 //! budget) and estimate what is left from the rate of the last minute, not from the start:
-//! episodes lengthen as policies learn.
+//! episodes lengthen as policies learn. Bars take the terminal's width (`wide_bar`), so a
+//! line fits 80 columns instead of wrapping mid-number.
 
 use std::collections::{BTreeMap, VecDeque};
 use std::io::IsTerminal;
@@ -70,7 +71,7 @@ impl Progress {
             let multi = MultiProgress::with_draw_target(ProgressDrawTarget::stderr());
             let total = multi.add(ProgressBar::new(planned));
             total.set_style(style(&format!(
-                "{{prefix:>20}} [{{bar:30}}] {{pos}}/{{len}} {}, {{elapsed}} {{msg}}",
+                "{{prefix:>20}} [{{wide_bar}}] {{pos}}/{{len}} {}, {{elapsed}} elapsed{{msg}}",
                 unit.name()
             )));
             total.set_prefix("protocol");
@@ -97,7 +98,7 @@ impl Progress {
             Some(multi) => {
                 let bar = multi.add(ProgressBar::new(planned));
                 bar.set_style(style(&format!(
-                    "{{prefix:>20}} [{{bar:30}}] {{pos}}/{{len}} {}, {{msg}}",
+                    "{{prefix:>20}} [{{wide_bar}}] {{pos}}/{{len}} {}, {{msg}}",
                     self.unit.name()
                 )));
                 bar.set_prefix(label);
@@ -150,7 +151,7 @@ impl Progress {
                 ));
                 bar.set_position(run.done);
                 total.set_position(self.done);
-                total.set_message(eta.map_or(String::new(), |e| format!("{} left", clock(e))));
+                total.set_message(eta.map_or(String::new(), |e| format!(", {} left", clock(e))));
             }
             _ if self.last_line.elapsed() >= PLAIN_INTERVAL => {
                 self.last_line = Instant::now();

@@ -133,3 +133,33 @@ fn closing_the_terminal_ends_the_dashboard() {
         std::thread::sleep(Duration::from_millis(100));
     }
 }
+
+/// Issue 27: at 80 columns the progress bars wrapped mid-number, and "12s 40s left" did not
+/// say which figure was elapsed. The bars now take the terminal's width.
+#[test]
+fn headless_progress_fits_80_columns_and_says_what_is_elapsed() {
+    if Command::new("tmux").arg("-V").output().is_err() {
+        eprintln!("tmux is not installed: the progress test is skipped (.ci/run installs it)");
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let library = Path::new(env!("CARGO_MANIFEST_DIR")).join("saved_policies");
+    let command = format!(
+        "{} --headless --quick --library {} --out {}; echo SAPNET-EXITED $?; sleep 60",
+        env!("CARGO_BIN_EXE_sapnet"),
+        library.display(),
+        tmp.path().join("quick").display(),
+    );
+    let session = Session::start(80, 24, &command);
+    session.wait_for(&["SAPNET-EXITED 0"]);
+    let rows = session.rows();
+    let bar = rows
+        .iter()
+        .find(|r| r.trim_start().starts_with("protocol ["))
+        .unwrap_or_else(|| panic!("no protocol bar on the screen:\n{}", rows.join("\n")));
+    assert!(
+        bar.contains("episodes, ") && bar.contains(" elapsed"),
+        "{bar}"
+    );
+    assert!(bar.chars().count() <= 80, "{bar}");
+}

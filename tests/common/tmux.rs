@@ -54,6 +54,20 @@ impl Session {
         String::from_utf8_lossy(&out.stdout).into_owned()
     }
 
+    /// The pane's rows as the terminal shows them, its scrollback first, a wrapped line as
+    /// two rows.
+    #[allow(dead_code)] // not every test binary that includes this module reads rows
+    pub fn rows(&self) -> Vec<String> {
+        let out = Command::new("tmux")
+            .args(["capture-pane", "-p", "-S", "-", "-t", &self.0])
+            .output()
+            .expect("running tmux");
+        String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .map(str::to_string)
+            .collect()
+    }
+
     /// Waits until every one of `needles` is on the screen.
     pub fn wait_for(&self, needles: &[&str]) -> String {
         let deadline = Instant::now() + Duration::from_secs(120);
