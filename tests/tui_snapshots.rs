@@ -341,6 +341,12 @@ fn the_zoomed_table_shows_each_policys_activation_over_time() {
     let screen = format!("{}", terminal.backend());
     assert!(screen.contains("A per episode"), "{screen}");
     insta::assert_snapshot!("dashboard_zoomed_table_120x40", terminal.backend());
+    // Issue 27: at 80 columns the zoomed table showed no sparkline; it now gives up the
+    // hidden layers and the +/− counts for it.
+    let terminal = draw_dashboard(&d, (80, 24));
+    let screen = format!("{}", terminal.backend());
+    assert!(screen.contains("A per episode"), "{screen}");
+    insta::assert_snapshot!("dashboard_zoomed_table_80x24", terminal.backend());
 }
 
 /// `--compare DIR`: a finished protocol's mean and its 95% interval under the live curves of the same
@@ -595,5 +601,38 @@ fn the_status_figures_keep_apart_from_the_keys() {
                 .expect("the keys");
             assert!(line[..keys].ends_with("  "), "{line}");
         }
+    }
+}
+
+/// Issue 27: `+` at full speed, `-` at the slowest and leaving teach mode (training stays
+/// paused) said nothing; the status line now says it, at 80×24 and at 120×40, until the
+/// next key.
+#[test]
+fn a_key_that_does_nothing_or_leaves_training_paused_says_so() {
+    let mut d = dashboard();
+    for size in [(80, 24), (120, 40)] {
+        for _ in 0..=sapnet::tui::dashboard::SPEEDS.len() {
+            d.on_key(key('+'));
+        }
+        let line = status_line(&draw_dashboard(&d, size));
+        assert!(line.contains("already at full speed"), "{line}");
+        for _ in 0..sapnet::tui::dashboard::SPEEDS.len() {
+            d.on_key(key('-'));
+        }
+        let line = status_line(&draw_dashboard(&d, size));
+        assert!(line.contains("already at the slowest speed"), "{line}");
+        d.on_key(key('v'));
+        let line = status_line(&draw_dashboard(&d, size));
+        assert!(!line.contains("already"), "the next key clears it: {line}");
+        d.on_key(key('t'));
+        d.on_key(key('t'));
+        let line = status_line(&draw_dashboard(&d, size));
+        assert!(line.contains("PAUSED"), "{line}");
+        assert!(
+            line.contains("training is still paused: space resumes it"),
+            "{line}"
+        );
+        d.on_key(key(' '));
+        d.on_key(key('v'));
     }
 }

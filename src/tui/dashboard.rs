@@ -268,6 +268,9 @@ pub struct Dashboard {
     /// A finished protocol's bands (`--compare DIR`), one per method, drawn under the live
     /// curves of the same methods.
     pub reference: Vec<Band>,
+    /// Why the last key did nothing, or what it left (training still paused after teach
+    /// mode): shown in the status line in place of the keys until the next key.
+    pub notice: Option<&'static str>,
 }
 
 impl Dashboard {
@@ -288,6 +291,7 @@ impl Dashboard {
             episode_return: (0, 0.0),
             steps_per_second: None,
             speedometer: VecDeque::new(),
+            notice: None,
             teach: None,
             followed: None,
             reference: Vec::new(),
@@ -520,6 +524,7 @@ impl Dashboard {
         if ctrl_c || key.code == KeyCode::Char('q') {
             return Action::Quit;
         }
+        self.notice = None;
         if self.help {
             // Any key closes the help overlay.
             self.help = false;
@@ -546,8 +551,16 @@ impl Dashboard {
             },
             KeyCode::Char('n') if self.mode == Mode::Paused => Action::Send(Command::Step),
             KeyCode::Char('m') => Action::FollowNext,
-            KeyCode::Char('+') | KeyCode::Char('=') => self.set_speed(self.speed.saturating_sub(1)),
-            KeyCode::Char('-') => self.set_speed((self.speed + 1).min(SPEEDS.len() - 1)),
+            KeyCode::Char('+') | KeyCode::Char('=') if self.speed == 0 => {
+                self.notice = Some("already at full speed");
+                Action::None
+            }
+            KeyCode::Char('-') if self.speed == SPEEDS.len() - 1 => {
+                self.notice = Some("already at the slowest speed");
+                Action::None
+            }
+            KeyCode::Char('+') | KeyCode::Char('=') => self.set_speed(self.speed - 1),
+            KeyCode::Char('-') => self.set_speed(self.speed + 1),
             KeyCode::Tab => {
                 self.focus = match self.focus {
                     Focus::Table => Focus::Graph,
@@ -668,6 +681,7 @@ impl Dashboard {
                     // training resumes from its own on space.
                     self.teach = None;
                     self.mode = Mode::Paused;
+                    self.notice = Some("training is still paused: space resumes it");
                 }
                 KeyCode::Char('?') => self.help = true,
                 _ => {}

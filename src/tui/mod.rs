@@ -178,7 +178,9 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
                         leads: true,
                     });
                 }
-                Action::FollowNext => {}
+                Action::FollowNext => {
+                    dashboard.notice = Some("m: only one method reuses the library here");
+                }
             }
         }
     })();

@@ -292,6 +292,12 @@ pub fn policy_rows(area: Rect, dashboard: &Dashboard) -> RowWindow {
     RowWindow::new(total, room, std::iter::once(dashboard.cursor).chain(acting))
 }
 
+/// The policy table's width with every column but the history, borders and spacing
+/// included, and with the fewest; the narrowest history worth drawing.
+const FULL_TABLE_WIDTH: u16 = 72;
+const COMPACT_TABLE_WIDTH: u16 = 43;
+const MIN_HISTORY_WIDTH: u16 = 10;
+
 fn draw_policy_table(
     frame: &mut Frame,
     area: Rect,
@@ -317,8 +323,11 @@ fn draw_policy_table(
     };
     let top = graph_view::highest(view.net.activations().iter().copied());
     // Columns give way from the right of the wish list as the panel narrows: the graph
-    // already shows categories, the counts matter least.
-    let full = area.width >= 72;
+    // already shows categories, the counts matter least. Zoomed (`z`), the scores over
+    // time come before them: at 80 columns the table keeps the sparkline (as README
+    // says `z` does) and gives up the hidden layers and the +/− counts.
+    let full = area.width >= FULL_TABLE_WIDTH
+        && !(dashboard.zoom && area.width < FULL_TABLE_WIDTH + 1 + MIN_HISTORY_WIDTH);
     // A library over several tasks shows each source's task where one task shows the
     // number of hidden layers.
     let tasks = view
@@ -327,8 +336,15 @@ fn draw_policy_table(
         .any(|p| p.description.source_task != view.policies[0].description.source_task);
     let bar_width = 8;
     // Each policy's score over the last episodes, on one scale for all (the highest in the
-    // window), where the panel is wide enough: zoomed (`z`) or on a wide terminal.
-    let history = area.width >= 90;
+    // window), zoomed (`z`) or on a wide terminal, as many of the last episodes as fit.
+    let used = if full {
+        FULL_TABLE_WIDTH
+    } else {
+        COMPACT_TABLE_WIDTH
+    };
+    let history_width = usize::from(area.width.saturating_sub(used + 1)).min(HISTORY);
+    let history = (area.width >= 90 || dashboard.zoom) && history_width >= MIN_HISTORY_WIDTH.into();
+    let skipped = view.history.len().saturating_sub(history_width);
     let history_top = graph_view::highest(view.history.iter().flatten().copied());
     let rows = view.policies[window.rows()]
         .iter()
@@ -365,7 +381,7 @@ fn draw_policy_table(
             }
             if history {
                 cells.push(Cell::from(sparkline(
-                    view.history.iter().map(|scores| scores[i]),
+                    view.history.iter().skip(skipped).map(|scores| scores[i]),
                     history_top,
                 )));
             }
@@ -410,7 +426,7 @@ fn draw_policy_table(
     };
     if history {
         header.push("A per episode");
-        widths.push(Constraint::Length(HISTORY as u16));
+        widths.push(Constraint::Length(history_width as u16));
     }
     let mut marker = window.marker().unwrap_or_default();
     if let Some(acting) = view.acting.filter(|i| !window.rows().contains(i)) {
@@ -661,6 +677,8 @@ fn draw_status(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Them
         .collect();
     let hints = if failure.is_some() {
         "q quit"
+    } else if let Some(notice) = dashboard.notice {
+        notice
     } else if area.width < 100 {
         "? keys · q quit"
     } else if finished && dashboard.mode != Mode::Teach {
