@@ -213,12 +213,14 @@ pub enum SweepCommand {
     },
     /// Train the source libraries the cells reuse, once, before the cells run.
     Prepare {
+        /// The sweep's folder (`sweep plan --out`).
         #[arg(value_name = "SWEEP")]
         sweep: PathBuf,
     },
     /// Run one cell (`--cell K`, else $SLURM_ARRAY_TASK_ID or $JOB_COMPLETION_INDEX) into
     /// SWEEP/results/NNNN, or with `--all` every cell not done, `--jobs` cells at a time.
     Run {
+        /// The sweep's folder (`sweep plan --out`).
         #[arg(value_name = "SWEEP")]
         sweep: PathBuf,
         /// The cell to run (its number, as in SWEEP/cells/NNNN.ron).
@@ -230,12 +232,14 @@ pub enum SweepCommand {
     },
     /// Which cells are done, running, failed (with the error's last line) or missing.
     Status {
+        /// The sweep's folder (`sweep plan --out`).
         #[arg(value_name = "SWEEP")]
         sweep: PathBuf,
     },
     /// Merge the finished cells into SWEEP/merged/: a comparison per axis value,
     /// episodes.csv in long format, plots.
     Merge {
+        /// The sweep's folder (`sweep plan --out`).
         #[arg(value_name = "SWEEP")]
         sweep: PathBuf,
     },
