@@ -196,11 +196,11 @@ impl Machine {
                     self.push(Value::Int(i64::from(v)), 0).map_err(fail)?;
                 }
                 b'M' => {
-                    let v = u16::from_le_bytes(take(2, &mut at)?.try_into().unwrap());
+                    let v = u16::from_le_bytes(fixed(take(2, &mut at)?)?);
                     self.push(Value::Int(i64::from(v)), 0).map_err(fail)?;
                 }
                 b'J' => {
-                    let v = i32::from_le_bytes(take(4, &mut at)?.try_into().unwrap());
+                    let v = i32::from_le_bytes(fixed(take(4, &mut at)?)?);
                     self.push(Value::Int(i64::from(v)), 0).map_err(fail)?;
                 }
                 0x8a => {
@@ -220,13 +220,13 @@ impl Machine {
                         .map_err(fail)?;
                 }
                 b'G' => {
-                    let v = f64::from_be_bytes(take(8, &mut at)?.try_into().unwrap());
+                    let v = f64::from_be_bytes(fixed(take(8, &mut at)?)?);
                     self.push(Value::Float(v), 0).map_err(fail)?;
                 }
                 b'X' | 0x8c | b'U' | b'T' => {
                     // BINUNICODE (u32), SHORT_BINUNICODE (u8), SHORT_BINSTRING, BINSTRING
                     let n = if matches!(op, b'X' | b'T') {
-                        u32::from_le_bytes(take(4, &mut at)?.try_into().unwrap()) as usize
+                        u32::from_le_bytes(fixed(take(4, &mut at)?)?) as usize
                     } else {
                         usize::from(take(1, &mut at)?[0])
                     };
@@ -253,7 +253,7 @@ impl Machine {
                     self.memo_put(id).map_err(fail)?;
                 }
                 b'r' => {
-                    let id = u32::from_le_bytes(take(4, &mut at)?.try_into().unwrap());
+                    let id = u32::from_le_bytes(fixed(take(4, &mut at)?)?);
                     self.memo_put(id).map_err(fail)?;
                 }
                 0x94 => {
@@ -264,7 +264,7 @@ impl Machine {
                     let id = if op == b'h' {
                         u32::from(take(1, &mut at)?[0])
                     } else {
-                        u32::from_le_bytes(take(4, &mut at)?.try_into().unwrap())
+                        u32::from_le_bytes(fixed(take(4, &mut at)?)?)
                     };
                     let entry = self
                         .memo
@@ -414,6 +414,13 @@ impl Machine {
         self.memo.insert(id, top);
         Ok(())
     }
+}
+
+/// The `N` bytes `take(N)` returned, as an array.
+fn fixed<const N: usize>(bytes: &[u8]) -> Result<[u8; N], String> {
+    bytes
+        .try_into()
+        .map_err(|_| format!("expected {N} bytes, got {}", bytes.len()))
 }
 
 /// A `GLOBAL`'s line of text.
