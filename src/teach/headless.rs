@@ -107,9 +107,11 @@ fn write_trace(
     names: &[String],
     width: usize,
 ) -> std::io::Result<()> {
+    // As wide as the last call's number: a long walk makes hundreds of thousands.
+    let calls = trace.len().to_string().len().max(5);
     writeln!(
         out,
-        "{:>5}  {:<width$}  {:<width$}  {:>2}  {:>8}  {:>10}  {:>10}",
+        "{:>calls$}  {:<width$}  {:<width$}  {:>2}  {:>8}  {:>10}  {:>10}",
         "call", "from", "to", "h", "Ω", "η", "ΔA"
     )?;
     for (n, s) in trace.iter().enumerate() {
@@ -120,7 +122,7 @@ fn write_trace(
         };
         writeln!(
             out,
-            "{:>5}  {:<width$}  {:<width$}  {:>2}  {:>8.4}  {:>10.6}  {delta}",
+            "{:>calls$}  {:<width$}  {:<width$}  {:>2}  {:>8.4}  {:>10.6}  {delta}",
             n + 1,
             names[s.from],
             names[s.to],
@@ -130,4 +132,43 @@ fn write_trace(
         )?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 27: past 99,999 calls the numbers pushed the row's columns right of the
+    /// header's; the column now widens with the last number.
+    #[test]
+    fn the_call_column_keeps_its_alignment_past_100000_calls() {
+        let step = TraceStep {
+            from: 0,
+            to: 1,
+            h: 1,
+            omega: 0.95,
+            eta: 0.5,
+            delta: 0.526316,
+            stopped: false,
+        };
+        let names = ["a".to_string(), "b".to_string()];
+        for calls in [3, 123_456] {
+            let mut out = Vec::new();
+            write_trace(&mut out, &vec![step; calls], &names, 4).unwrap();
+            let text = String::from_utf8(out).unwrap();
+            let mut lines = text.lines();
+            let from = lines.next().unwrap().find("from").unwrap();
+            for row in lines {
+                assert_eq!(
+                    row.find("  a ").map(|i| i + 2),
+                    Some(from),
+                    "{calls} calls: {row}"
+                );
+            }
+            assert_eq!(
+                text.lines().last().unwrap().split_whitespace().next(),
+                Some(calls.to_string().as_str())
+            );
+        }
+    }
 }
