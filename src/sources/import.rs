@@ -66,7 +66,7 @@ pub fn import(
     let foreign = import::read(file, spaces, prefix)
         .map_err(|reason| anyhow::anyhow!("cannot import {}: {reason}", file.display()))?;
 
-    let Some(mut found) = manifest::read(&dir)? else {
+    if manifest::read(&dir)?.is_none() {
         bail!(
             "{} holds no finished library to import into: train it first with `sapnet sources \
              --config <FILE> --library {}` (an imported policy joins the sources a config \
@@ -74,8 +74,11 @@ pub fn import(
             dir.display(),
             library.display()
         );
-    };
+    }
+    // Read again under the lock: a training or another import may have written it since.
     let _lock = crate::folder_lock::FolderLock::acquire(&dir, "library import")?;
+    let mut found = manifest::read(&dir)?
+        .ok_or_else(|| anyhow::anyhow!("{}'s manifest went away", dir.display()))?;
     if !found.complete {
         bail!(
             "the library {} is still being trained ({} of {} policies): finish it with `sapnet \
