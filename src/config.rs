@@ -731,26 +731,10 @@ impl Config {
         if let Some(sources) = &self.sources.dqn {
             check_dqn(sources, "sources.dqn")?;
         }
-        self.sapnet.validate().map_err(|e| match e {
-            // Worded as every other field of the config is.
-            crate::sapnet::SapNetError::BadParameter {
-                name,
-                value,
-                expected,
-            } => format!(
-                "field `sapnet.{name}`: expected {expected}, got {}",
-                value.shown()
-            ),
-            e => format!("section `sapnet`: {e}"),
+        // 𝒜 > 0 among them: SAP-Net's own parameters refuse what the net cannot run on.
+        self.sapnet.validate().map_err(|e| {
+            sapnet_field(&e, "sapnet.").unwrap_or_else(|| format!("section `sapnet`: {e}"))
         })?;
-        // A negative transition activates with 0 (Algorithm 3): 𝒜 ≤ 0 would never credit a
-        // good step, and no selection could follow learning.
-        check(
-            self.sapnet.coefficient > 0.0,
-            "sapnet.coefficient",
-            "a finite number > 0 (𝒜 activates a policy after a positive transition)",
-            self.sapnet.coefficient,
-        )?;
         let src = &self.sources;
         check(
             (1..=MAX_SOURCES).contains(&src.count),
@@ -885,6 +869,22 @@ fn check(ok: bool, field: &str, expected: &str, got: impl Shown) -> Result<(), S
 
 /// A value as an error message shows it: numbers in their shortest form (`1e308`, not 309
 /// digits).
+/// A bad SAP-Net parameter worded as every field of a config is (`field `sapnet.delta`:
+/// expected …, got …`), `prefix` naming where the parameters sit; `None` for other errors.
+pub fn sapnet_field(error: &crate::sapnet::SapNetError, prefix: &str) -> Option<String> {
+    match error {
+        crate::sapnet::SapNetError::BadParameter {
+            name,
+            value,
+            expected,
+        } => Some(format!(
+            "field `{prefix}{name}`: expected {expected}, got {}",
+            value.shown()
+        )),
+        _ => None,
+    }
+}
+
 pub trait Shown {
     fn shown(&self) -> String;
 }

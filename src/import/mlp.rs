@@ -8,13 +8,22 @@ use std::collections::BTreeMap;
 use super::{NamedTensor, Spaces};
 use crate::dqn::Architecture;
 
-/// The layers of the network in `tensors` under `prefix` (`None`: the one prefix they have),
-/// as sapnet's architecture and its parameters in [`Architecture::parameter_shapes`] order.
+/// A network read from named tensors.
+#[derive(Debug)]
+pub struct Network {
+    pub architecture: Architecture,
+    /// In [`Architecture::parameter_shapes`] order.
+    pub parameters: Vec<Vec<f32>>,
+    /// The prefix of the keys it was read from (`network`, or empty for bare keys).
+    pub prefix: String,
+}
+
+/// The layers of the network in `tensors` under `prefix` (`None`: the one prefix they have).
 pub fn network(
     tensors: &[NamedTensor],
     prefix: Option<&str>,
     task: Spaces,
-) -> Result<(Architecture, Vec<Vec<f32>>), String> {
+) -> Result<Network, String> {
     if tensors.is_empty() {
         return Err("it holds no tensors".into());
     }
@@ -36,14 +45,14 @@ pub fn network(
             .entry(index)
             .or_default()[usize::from(part == "bias")] = Some(t);
     }
-    let chosen = match prefix {
-        Some(p) => layers.remove(p).ok_or_else(|| {
+    let (prefix, chosen) = match prefix {
+        Some(p) => layers.remove_entry(p).ok_or_else(|| {
             format!(
                 "no layers under the prefix `{p}`; it has {}",
                 prefixes(layers.keys())
             )
         })?,
-        None if layers.len() == 1 => layers.into_values().next().unwrap_or_default(),
+        None if layers.len() == 1 => layers.pop_first().expect("one prefix"),
         None => {
             return Err(format!(
                 "it holds more than one network ({}): name the one to import with --prefix",
@@ -116,7 +125,11 @@ pub fn network(
     }
     let architecture = Architecture::new(task.observation_size, &sizes[1..], actions);
     architecture.validate().map_err(|e| e.to_string())?;
-    Ok((architecture, parameters))
+    Ok(Network {
+        architecture,
+        parameters,
+        prefix,
+    })
 }
 
 /// `(prefix, index, "weight" | "bias")` of a linear layer's key.
@@ -192,9 +205,10 @@ mod tests {
             t("network.2.bias", &[16]),
             t("network.4.bias", &[2]),
         ];
-        let (arch, params) = network(&tensors, None, CARTPOLE).unwrap();
-        assert_eq!(arch, Architecture::new(4, &[24, 16], 2));
-        let lengths: Vec<usize> = params.iter().map(Vec::len).collect();
+        let read = network(&tensors, None, CARTPOLE).unwrap();
+        assert_eq!(read.architecture, Architecture::new(4, &[24, 16], 2));
+        assert_eq!(read.prefix, "network");
+        let lengths: Vec<usize> = read.parameters.iter().map(Vec::len).collect();
         assert_eq!(lengths, [96, 24, 384, 16, 32, 2]);
     }
 
@@ -202,7 +216,7 @@ mod tests {
     fn bare_sequential_keys_and_a_chosen_prefix() {
         let bare = [t("0.weight", &[2, 4]), t("0.bias", &[2])];
         assert_eq!(
-            network(&bare, None, CARTPOLE).unwrap().0,
+            network(&bare, None, CARTPOLE).unwrap().architecture,
             Architecture::new(4, &[], 2)
         );
         let two = [

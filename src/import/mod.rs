@@ -58,12 +58,13 @@ pub fn read(path: &Path, task: Spaces, prefix: Option<&str>) -> Result<Foreign, 
             }
         })?;
     let (format, tensors, framework, steps) = if bytes.starts_with(b"PK\x03\x04") {
-        if sb3::is_sb3(&bytes) {
+        let mut zip = torch_zip::archive(&bytes)?;
+        if sb3::is_sb3(&zip) {
             refuse_normalisation(path)?;
-            let model = sb3::read(&bytes, task)?;
+            let model = sb3::read(&mut zip, task)?;
             (Format::Sb3Zip, model.tensors, model.framework, model.steps)
         } else {
-            let tensors = torch_zip::state_dict(&bytes)?;
+            let tensors = torch_zip::state_dict_in(&mut zip)?;
             (Format::TorchStateDict, tensors, "PyTorch".into(), None)
         }
     } else if bytes.starts_with(b"\x80") {
@@ -95,9 +96,9 @@ pub fn read(path: &Path, task: Spaces, prefix: Option<&str>) -> Result<Foreign, 
             .collect(),
         _ => tensors,
     };
-    let (architecture, parameters) = mlp::network(&chosen, prefix, task)?;
-    let used_prefix = prefix.map_or_else(|| common_prefix(&chosen), str::to_string);
-    let net = build(architecture, parameters)?;
+    let network = mlp::network(&chosen, prefix, task)?;
+    let used_prefix = network.prefix.clone();
+    let net = build(network.architecture, network.parameters)?;
     Ok(Foreign {
         net,
         origin: Origin {
@@ -176,15 +177,6 @@ fn safetensors(bytes: &[u8]) -> Result<Option<Vec<NamedTensor>>, String> {
         })
         .collect::<Result<_, _>>()
         .map(Some)
-}
-
-/// The prefix the chosen layers' keys share (`network` of `network.0.weight`).
-fn common_prefix(tensors: &[NamedTensor]) -> String {
-    tensors
-        .first()
-        .and_then(|t| t.name.rsplitn(3, '.').nth(2))
-        .unwrap_or("")
-        .to_string()
 }
 
 fn build(architecture: Architecture, parameters: Vec<Vec<f32>>) -> Result<QNet, String> {

@@ -20,17 +20,16 @@ pub struct Sb3Model {
     pub steps: Option<u64>,
 }
 
-/// Reads the SB3 DQN in `bytes` (a zip with `data` and `policy.pth`), refusing what a
+/// Reads the SB3 DQN in `zip` (with `data` and `policy.pth`), refusing what a
 /// plain ReLU Q-network cannot be: another algorithm's policy, another activation, a
 /// feature extractor with weights, other spaces than a flat box and a discrete set.
-pub fn read(bytes: &[u8], task: Spaces) -> Result<Sb3Model, String> {
-    let mut zip = torch_zip::archive(bytes)?;
-    let data = torch_zip::entry(&mut zip, "data", 16 << 20)?;
+pub fn read(zip: &mut torch_zip::Archive, task: Spaces) -> Result<Sb3Model, String> {
+    let data = torch_zip::entry(zip, "data", 16 << 20)?;
     let data: serde_json::Value = serde_json::from_slice(&data)
         .map_err(|e| format!("its `data` entry is not the JSON SB3 writes ({e})"))?;
     check_policy(&data)?;
     check_spaces(&data, task)?;
-    let policy = torch_zip::entry(&mut zip, "policy.pth", bytes.len() as u64)?;
+    let policy = torch_zip::entry(zip, "policy.pth", super::MAX_FILE_BYTES)?;
     let tensors = torch_zip::state_dict(&policy).map_err(|e| format!("policy.pth: {e}"))?;
     if let Some(extractor) = tensors
         .iter()
@@ -42,7 +41,7 @@ pub fn read(bytes: &[u8], task: Spaces) -> Result<Sb3Model, String> {
             extractor.name
         ));
     }
-    let framework = torch_zip::entry(&mut zip, "system_info.txt", 64 << 10)
+    let framework = torch_zip::entry(zip, "system_info.txt", 64 << 10)
         .ok()
         .and_then(|text| {
             String::from_utf8_lossy(&text)
@@ -141,11 +140,8 @@ fn check_spaces(data: &serde_json::Value, task: Spaces) -> Result<(), String> {
     }
 }
 
-/// Whether `bytes` is an SB3 zip: a zip with `data` and `policy.pth`.
-pub fn is_sb3(bytes: &[u8]) -> bool {
-    let Ok(zip) = torch_zip::archive(bytes) else {
-        return false;
-    };
+/// Whether `zip` is an SB3 model: it holds `data` and `policy.pth`.
+pub fn is_sb3(zip: &torch_zip::Archive) -> bool {
     let names: Vec<String> = zip
         .file_names()
         .filter_map(|n| n.ok().map(|n| n.into_owned()))

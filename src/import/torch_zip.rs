@@ -10,8 +10,11 @@ use super::NamedTensor;
 /// Pickles of state dicts are kilobytes; a bound keeps a doctored one from costing more.
 const MAX_PICKLE_BYTES: u64 = 4 << 20;
 
-/// The archive `bytes` as a zip; `what` names the file in messages.
-pub fn archive(bytes: &[u8]) -> Result<zip::ZipArchive<Cursor<&[u8]>>, String> {
+/// A zip archive read from memory.
+pub type Archive<'a> = zip::ZipArchive<Cursor<&'a [u8]>>;
+
+/// The archive `bytes` as a zip.
+pub fn archive(bytes: &[u8]) -> Result<Archive<'_>, String> {
     let zip = zip::ZipArchive::new(Cursor::new(bytes))
         .map_err(|e| format!("not a readable zip archive ({e})"))?;
     // A reader finds an archive by its last directory: in a truncated SB3 zip that is the
@@ -28,11 +31,7 @@ pub fn archive(bytes: &[u8]) -> Result<zip::ZipArchive<Cursor<&[u8]>>, String> {
 
 /// The bytes of entry `name`, at most `limit` of them; stored, not compressed (how
 /// `torch.save` and Python's `zipfile` write by default).
-pub fn entry(
-    zip: &mut zip::ZipArchive<Cursor<&[u8]>>,
-    name: &str,
-    limit: u64,
-) -> Result<Vec<u8>, String> {
+pub fn entry(zip: &mut Archive, name: &str, limit: u64) -> Result<Vec<u8>, String> {
     let mut file = zip
         .by_name(name)
         .map_err(|e| format!("the archive has no readable entry {name} ({e})"))?;
@@ -63,7 +62,11 @@ pub fn entry(
 /// The tensors of the state dict that `torch.save` wrote into `bytes`, in the dict's order;
 /// each storage read no further than the size its tensor gives it.
 pub fn state_dict(bytes: &[u8]) -> Result<Vec<NamedTensor>, String> {
-    let mut zip = archive(bytes)?;
+    state_dict_in(&mut archive(bytes)?)
+}
+
+/// [`state_dict`] of an archive already open.
+pub fn state_dict_in(zip: &mut Archive) -> Result<Vec<NamedTensor>, String> {
     let names: Vec<String> = zip
         .file_names()
         .filter_map(|n| n.ok().map(|n| n.into_owned()))
@@ -86,7 +89,7 @@ pub fn state_dict(bytes: &[u8]) -> Result<Vec<NamedTensor>, String> {
         }
     };
     let root = pickle_name.trim_end_matches("data.pkl").to_string();
-    if let Ok(order) = entry(&mut zip, &format!("{root}byteorder"), 16) {
+    if let Ok(order) = entry(zip, &format!("{root}byteorder"), 16) {
         if order != b"little" {
             return Err(format!(
                 "the storages are {}-endian; sapnet reads little-endian files",
@@ -94,7 +97,7 @@ pub fn state_dict(bytes: &[u8]) -> Result<Vec<NamedTensor>, String> {
             ));
         }
     }
-    let object = pickle::read(&entry(&mut zip, &pickle_name, MAX_PICKLE_BYTES)?)
+    let object = pickle::read(&entry(zip, &pickle_name, MAX_PICKLE_BYTES)?)
         .map_err(|e| format!("{pickle_name}: {e}"))?;
     let Value::Dict(dict) = object else {
         return Err(format!(
@@ -156,7 +159,7 @@ pub fn state_dict(bytes: &[u8]) -> Result<Vec<NamedTensor>, String> {
             ));
         }
         let data_name = format!("{root}data/{}", t.storage.key);
-        let storage = entry(&mut zip, &data_name, storage_bytes as u64)?;
+        let storage = entry(zip, &data_name, storage_bytes as u64)?;
         if storage.len() != storage_bytes {
             return Err(format!(
                 "storage {data_name} holds {} bytes, its tensor `{key}` says {storage_bytes}",

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::config::{parse_ron, ConfigError};
+use crate::config::{parse_ron, sapnet_field, ConfigError};
 use crate::sapnet::{
     BaseGraph, Graph, Paths, PolicyDescription, Prototype, SapNet, SapNetError, SapNetParams,
     WeightedPrototype,
@@ -137,15 +137,9 @@ impl TeachConfig {
     pub fn lesson(&self) -> Result<Lesson, String> {
         let n = self.count()?;
         let params = self.params();
-        params.validate().map_err(|e| match e {
-            // Worded as the training config words a field.
-            SapNetError::BadParameter {
-                name,
-                value,
-                expected,
-            } => format!("field `{name}`: expected {expected}, got {value}"),
-            other => other.to_string(),
-        })?;
+        params
+            .validate()
+            .map_err(|e| sapnet_field(&e, "").unwrap_or_else(|| e.to_string()))?;
         let graph = if self.descriptions.is_empty() {
             self.no_category_fields()?;
             Graph::from_edges(n, self.edges.iter().copied()).map_err(in_field("edges"))?
@@ -160,7 +154,7 @@ impl TeachConfig {
                 format!("fields `edges` and `threshold`: {e}")
             }
             SapNetError::ActivationOverflow { .. } => in_field("coefficient")(e),
-            SapNetError::BadParameter { ref name, .. } => format!("field `{name}`: {e}"),
+            SapNetError::BadParameter { .. } => sapnet_field(&e, "").unwrap_or_default(),
             other => in_field("initial")(other),
         })?;
         let names = if self.names.is_empty() {
@@ -316,7 +310,7 @@ mod tests {
         let e = lesson("(policies: 2, threshold: 0.0)").unwrap_err();
         assert_eq!(
             e,
-            "config test.ron: field `threshold`: expected a finite number > 0, got 0"
+            "config test.ron: field `threshold`: expected a finite number > 0, got 0.0"
         );
     }
 }
