@@ -617,10 +617,12 @@ fn the_python_side_killed_under_the_dashboard_is_said_and_the_terminal_restored(
         .unwrap();
     assert!(status.success(), "no Gymnasium worker under the dashboard");
     session.wait_for(&["FAILED"]);
-    // The screen is read every 200 ms and the machine may be busy: a bound with room, a
-    // hang would take the test's 120 s.
+    // How soon a dead worker fails a run is the headless test's bound; here, with tmux
+    // polled every 200 ms beside the other bridge tests' Gymnasium workers on a busy CI
+    // machine (it once took 5.2 s there), a bound only tells a hang from a slow screen.
+    eprintln!("the failure showed {:?} after the kill", killed.elapsed());
     assert!(
-        killed.elapsed() < Duration::from_secs(3),
+        killed.elapsed() < Duration::from_secs(30),
         "the failure took {:?} to show",
         killed.elapsed()
     );
