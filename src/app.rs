@@ -89,20 +89,21 @@ fn refuse_non_utf8_paths(cli: &Cli) -> Result<()> {
 /// A flag the subcommand would ignore is refused: `sapnet env --library DIR` reads no
 /// library, and saying nothing would let the user believe it did.
 fn refuse_unread_flags(cli: &Cli, command: &Command) -> Result<()> {
-    let (name, reads): (&str, &[&str]) = match command {
-        Command::Env(_) => ("env", &["--config", "--seed"]),
-        Command::Teach(_) => ("teach", &["--config"]),
-        Command::Sources(_) => ("sources", &["--config", "--seed", "--library"]),
-        Command::Plot(_) => ("plot", &[]),
-        Command::Pool(_) => ("pool", &[]),
+    let name = match command {
+        Command::Env(_) => "env",
+        Command::Teach(_) => "teach",
+        Command::Sources(_) => "sources",
+        Command::Plot(_) => "plot",
+        Command::Pool(_) => "pool",
         Command::Sweep(args) => match args.command {
-            SweepCommand::Plan { .. } => ("sweep plan", &["--config", "--library"]),
-            SweepCommand::Run { .. } => ("sweep run", &["--jobs"]),
-            SweepCommand::Prepare { .. } => ("sweep prepare", &["--library"]),
-            SweepCommand::Status { .. } => ("sweep status", &[]),
-            SweepCommand::Merge { .. } => ("sweep merge", &[]),
+            SweepCommand::Plan { .. } => "sweep plan",
+            SweepCommand::Run { .. } => "sweep run",
+            SweepCommand::Prepare { .. } => "sweep prepare",
+            SweepCommand::Status { .. } => "sweep status",
+            SweepCommand::Merge { .. } => "sweep merge",
         },
     };
+    let reads = crate::cli::SubcommandFlags::of(name).reads;
     let unread: Vec<&str> = cli
         .run
         .given()

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// SAP-Net: reuse a library of DQN policies by spreading activation over a policy graph.
 ///
@@ -118,6 +118,146 @@ pub struct RunArgs {
     /// training was interrupted), as the default library is.
     #[arg(long)]
     pub train_library: bool,
+}
+
+/// The run's flags that each subcommand reads (a subcommand refuses the others), and what
+/// its `--config` is. `--config`, `--seed`, `--jobs` and `--library` are clap globals so that
+/// they may come before or after the subcommand; each subcommand's `--help` lists only the
+/// ones it reads.
+pub struct SubcommandFlags {
+    /// As the user types it: `teach`, `sweep plan`.
+    pub name: &'static str,
+    pub reads: &'static [&'static str],
+    /// `--config`'s help for this subcommand, when it reads one.
+    pub config: Option<&'static str>,
+    /// `--library`'s, where the run's text does not fit.
+    pub library: Option<&'static str>,
+}
+
+/// Every subcommand's flags, as [`SubcommandFlags`] says.
+pub const SUBCOMMANDS: &[SubcommandFlags] = &[
+    SubcommandFlags {
+        name: "env",
+        reads: &["--config", "--seed"],
+        config: Some("RON config whose target task (`env`) is run. Default: the embedded CartPole config"),
+        library: None,
+    },
+    SubcommandFlags {
+        name: "teach",
+        reads: &["--config"],
+        config: Some("A lesson file (assets/teach_*.ron). Default: the paper's Fig. 2"),
+        library: None,
+    },
+    SubcommandFlags {
+        name: "sources",
+        reads: &["--config", "--seed", "--library"],
+        config: Some("RON config whose `sources` section describes the library. Default: the embedded CartPole config"),
+        library: None,
+    },
+    SubcommandFlags {
+        name: "plot",
+        reads: &[],
+        config: None,
+        library: None,
+    },
+    SubcommandFlags {
+        name: "pool",
+        reads: &[],
+        config: None,
+        library: None,
+    },
+    SubcommandFlags {
+        name: "sweep plan",
+        reads: &["--config", "--library"],
+        config: Some("A RON config that replaces the grid's base config"),
+        library: Some("The library root the cells reuse, read-only (`sweep prepare` trains what is missing). Default: saved_policies"),
+    },
+    SubcommandFlags {
+        name: "sweep prepare",
+        reads: &["--library"],
+        config: None,
+        library: Some("The library root the cells reuse, as sweep.ron names it: a library that needs training is trained only when named here (a sweep folder may come from elsewhere)"),
+    },
+    SubcommandFlags {
+        name: "sweep run",
+        reads: &["--jobs"],
+        config: None,
+        library: None,
+    },
+    SubcommandFlags {
+        name: "sweep status",
+        reads: &[],
+        config: None,
+        library: None,
+    },
+    SubcommandFlags {
+        name: "sweep merge",
+        reads: &[],
+        config: None,
+        library: None,
+    },
+];
+
+impl SubcommandFlags {
+    /// The entry of the subcommand named `name` (`sweep run`).
+    pub fn of(name: &str) -> &'static Self {
+        SUBCOMMANDS
+            .iter()
+            .find(|s| s.name == name)
+            .expect("every subcommand has an entry")
+    }
+}
+
+/// The command line's parser: [`Cli`], with each subcommand's help showing only the global
+/// flags it reads, and its own words for `--config`.
+pub fn command() -> clap::Command {
+    let command = Cli::command();
+    let globals: Vec<clap::Arg> = command
+        .get_arguments()
+        .filter(|a| a.is_global_set())
+        .cloned()
+        .collect();
+    // A subcommand that has an argument of a global's id keeps it (clap copies the globals
+    // into subcommands only where they are absent), and its value still reaches the
+    // top-level `Cli`: each subcommand gets its own copy, hidden where it is not read.
+    SUBCOMMANDS.iter().fold(command, |command, flags| {
+        let path: Vec<&str> = flags.name.split(' ').collect();
+        mut_path(command, &path, &|sub| {
+            globals.iter().fold(sub, |sub, global| {
+                let id = global.get_id().as_str();
+                let mut arg = global.clone();
+                if !flags.reads.contains(&format!("--{id}").as_str()) {
+                    arg = arg.hide(true);
+                } else if let Some(help) = match id {
+                    "config" => flags.config,
+                    "library" => flags.library,
+                    _ => None,
+                } {
+                    arg = arg.help(help);
+                }
+                sub.arg(arg)
+            })
+        })
+    })
+}
+
+/// `change` applied to the subcommand at `path` of `command`.
+fn mut_path(
+    command: clap::Command,
+    path: &[&str],
+    change: &dyn Fn(clap::Command) -> clap::Command,
+) -> clap::Command {
+    match path {
+        [] => change(command),
+        [first, rest @ ..] => command.mut_subcommand(*first, |sub| mut_path(sub, rest, change)),
+    }
+}
+
+/// The command line of this process, parsed by [`command`]; exits as clap does on bad input
+/// or `--help`.
+pub fn parse() -> Cli {
+    let matches = command().get_matches();
+    Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
 }
 
 /// The library root when `--library` is not given.

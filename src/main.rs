@@ -1,9 +1,5 @@
 use std::process::ExitCode;
 
-use clap::Parser;
-
-use sapnet::cli::Cli;
-
 // candle allocates a buffer for every tensor op (loading, saving, the reference forward);
 // mimalloc more than halved a DQN update against glibc's malloc while candle ran it.
 #[global_allocator]
@@ -15,7 +11,7 @@ fn main() -> ExitCode {
     if std::env::var_os("RAYON_NUM_THREADS").is_none() {
         std::env::set_var("RAYON_NUM_THREADS", "1");
     }
-    let cli = Cli::parse();
+    let cli = sapnet::cli::parse();
     // A kernel path the CPU lacks (or a typo) is said before anything runs.
     if let Err(message) = sapnet::dqn::kernels::Isa::from_env() {
         eprintln!("error: {message}");

@@ -456,3 +456,40 @@ fn flags_a_subcommand_would_ignore_are_refused() {
         );
     }
 }
+
+/// `sapnet teach --help` listed --seed, --jobs and --library, which teach then refused, and
+/// described --config as the CartPole config: each subcommand's help lists the global flags
+/// it reads, and only those, with its own words for --config.
+#[test]
+fn each_subcommands_help_lists_the_flags_it_reads() {
+    for flags in sapnet::cli::SUBCOMMANDS {
+        let mut args: Vec<&str> = flags.name.split(' ').collect();
+        args.push("--help");
+        let output = sapnet(&args);
+        assert_eq!(output.status.code(), Some(0), "{args:?}");
+        let help = String::from_utf8_lossy(&output.stdout).into_owned();
+        for global in ["--config", "--seed", "--jobs", "--library"] {
+            assert_eq!(
+                help.contains(&format!("{global} <")),
+                flags.reads.contains(&global),
+                "`sapnet {}` reads {:?}; its help:\n{help}",
+                flags.name,
+                flags.reads
+            );
+        }
+        if let Some(text) = flags.config {
+            assert!(help.contains(text), "{help}");
+        }
+    }
+    let teach = String::from_utf8_lossy(&sapnet(&["teach", "--help"]).stdout).into_owned();
+    assert!(teach.contains("A lesson file"), "{teach}");
+    assert!(!teach.contains("CartPole"), "{teach}");
+    // A global still works before the subcommand as after it.
+    for args in [
+        &["--seed", "3", "env", "--episodes", "1"][..],
+        &["env", "--seed", "3", "--episodes", "1"],
+    ] {
+        let output = sapnet(args);
+        assert!(output.status.success(), "{args:?}: {}", stderr(&output));
+    }
+}
