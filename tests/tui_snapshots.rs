@@ -50,6 +50,49 @@ fn dashboard_running() {
     }
 }
 
+/// The reward chart's legend is its title: at 80×24 (where ratatui's legend box was hidden)
+/// and at 120×40 (where it covered the newest episodes) each curve is named with its own
+/// symbol without colour, and in its colour with a line before it in colour.
+#[test]
+fn the_reward_chart_names_its_curves_in_its_title_at_every_size() {
+    let d = dashboard();
+    for size in SIZES {
+        for (theme, sapnet, dqn) in [
+            (Theme::plain(), "• sapnet 111.5", "█ dqn[100] 9.9"),
+            (Theme { color: true }, "━ sapnet 111.5", "━ dqn[100] 9.9"),
+        ] {
+            let mut terminal = Terminal::new(TestBackend::new(size.0, size.1)).unwrap();
+            terminal
+                .draw(|f| view::draw_dashboard(f, &d, theme))
+                .unwrap();
+            let buffer = terminal.backend().buffer().clone();
+            let title = (0..buffer.area.height)
+                .map(|y| {
+                    (0..buffer.area.width)
+                        .map(|x| buffer[(x, y)].symbol().to_string())
+                        .collect::<String>()
+                })
+                .find(|row| row.contains("MA10"))
+                .expect("the chart's title");
+            assert!(
+                title.contains(sapnet) && title.contains(dqn),
+                "{size:?}: {title}"
+            );
+            if theme.color {
+                let y = (0..buffer.area.height)
+                    .find(|&y| (0..buffer.area.width).any(|x| buffer[(x, y)].symbol() == "━"))
+                    .unwrap();
+                let colours: Vec<_> = (0..buffer.area.width)
+                    .filter(|&x| buffer[(x, y)].symbol() == "━")
+                    .map(|x| buffer[(x, y)].fg)
+                    .collect();
+                assert_eq!(colours.len(), 2, "{title}");
+                assert_ne!(colours[0], colours[1], "each name in its curve's colour");
+            }
+        }
+    }
+}
+
 #[test]
 fn dashboard_after_the_run_names_the_chosen_policy_and_its_tests() {
     let mut d = dashboard();
@@ -327,6 +370,15 @@ fn teach_edits_restart_the_walk_and_show_the_difference() {
         terminal
             .draw(|f| teach_view::draw(f, &teach, false, Theme::plain()))
             .unwrap();
+        // The call's and the edit's last lines, which 80×24 once cut off.
+        let screen: String = format!("{}", terminal.backend())
+            .lines()
+            .map(|l| l.trim_matches(|c| c == '"' || c == '│').trim().to_string())
+            .collect::<Vec<_>>()
+            .join(" ");
+        for last in ["pending", "P(π1) −0.075"] {
+            assert!(screen.contains(last), "{w}x{h} lost {last:?}:\n{screen}");
+        }
         insta::assert_snapshot!(format!("teach_edit_{w}x{h}"), terminal.backend());
     }
 }
@@ -370,7 +422,10 @@ fn a_finished_protocol_is_drawn_as_bands_under_the_live_curves() {
     ];
     let terminal = draw_dashboard(&d, (120, 40));
     let screen = format!("{}", terminal.backend());
-    assert!(screen.contains("sapnet mean, 95% CI, 3 runs"), "{screen}");
+    assert!(
+        screen.contains("dim: --compare's mean and 95% CI · sapnet 3 runs · dqn[100] 3 runs"),
+        "{screen}"
+    );
     assert!(
         !screen.contains("ucb1"),
         "a method not on screen has no band: {screen}"

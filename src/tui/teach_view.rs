@@ -98,20 +98,37 @@ struct Panels {
     trace: Rect,
 }
 
-/// Teach mode's panels in `area`, for a net of `n` policies.
-fn panels(area: Rect, n: usize) -> Panels {
+/// Teach mode's panels in `area`: the call's and the edit's panels as tall as their
+/// wrapped text (at 80 columns both wrap to more lines than fixed heights held), the graph
+/// and the trace taking what is left.
+fn panels(area: Rect, teach: &Teach) -> Panels {
+    let n = teach.net().len();
     let [left, right] =
         Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)]).areas(area);
-    // Below 100 columns the call's lines wrap: give them the rows.
-    let call_rows = if area.width < 100 { 11 } else { 9 };
-    let [graph, call] =
-        Layout::vertical([Constraint::Min(8), Constraint::Length(call_rows)]).areas(left);
+    let rows = |paragraph: Paragraph, width: u16| {
+        u16::try_from(paragraph.line_count(width.saturating_sub(2))).unwrap_or(u16::MAX)
+    };
+    let call_rows = rows(call_paragraph(teach, Theme::plain()), left.width)
+        .clamp(9, left.height.saturating_sub(GRAPH_MIN_ROWS));
+    let [graph, call] = Layout::vertical([
+        Constraint::Min(GRAPH_MIN_ROWS),
+        Constraint::Length(call_rows),
+    ])
+    .areas(left);
     let short = area.height < 30;
+    let values_rows = (n as u16 + 3).min(right.height / 3);
+    let stack_rows = if short { 5 } else { 7 };
+    let edit_rows = rows(edits_paragraph(teach, Theme::plain()), right.width).clamp(
+        6,
+        right
+            .height
+            .saturating_sub(values_rows + stack_rows + TRACE_MIN_ROWS),
+    );
     let [values, stack, edits, trace] = Layout::vertical([
-        Constraint::Length((n as u16 + 3).min(right.height / 3)),
-        Constraint::Length(if short { 5 } else { 7 }),
-        Constraint::Length(6),
-        Constraint::Min(3),
+        Constraint::Length(values_rows),
+        Constraint::Length(stack_rows),
+        Constraint::Length(edit_rows),
+        Constraint::Min(TRACE_MIN_ROWS),
     ])
     .areas(right);
     Panels {
@@ -124,11 +141,15 @@ fn panels(area: Rect, n: usize) -> Panels {
     }
 }
 
+/// Rows the graph keeps however long the call's text, and the trace however long the edit's.
+const GRAPH_MIN_ROWS: u16 = 8;
+const TRACE_MIN_ROWS: u16 = 3;
+
 /// The policy under the cell `(column, row)` of teach mode's panels drawn in `area`: a node
 /// of the graph, or a row of the activations table.
 pub fn policy_at(area: Rect, teach: &Teach, column: u16, row: u16) -> Option<usize> {
     let n = teach.net().len();
-    let panels = panels(area, n);
+    let panels = panels(area, teach);
     let at = Position::new(column, row);
     if panels.graph.contains(at) {
         let positions = graph_view::positions(n, teach.groups());
@@ -170,7 +191,7 @@ pub fn click(teach: &mut Teach, screen: Rect, column: u16, row: u16) {
 
 /// Teach mode's panels, in the dashboard or on their own.
 pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
-    let panels = panels(area, teach.net().len());
+    let panels = panels(area, teach);
 
     let walk = teach.walk();
     let next = walk.as_ref().and_then(|w| w.pending.last().copied());
@@ -201,15 +222,15 @@ pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         theme,
     );
 
-    draw_call(frame, panels.call, teach, theme);
-    draw_edits(frame, panels.edits, teach, theme);
+    frame.render_widget(call_paragraph(teach, theme), panels.call);
+    frame.render_widget(edits_paragraph(teach, theme), panels.edits);
     draw_values(frame, panels.values, teach, theme);
     draw_stack(frame, panels.stack, teach, theme);
     draw_trace(frame, panels.trace, teach, theme);
 }
 
 /// The call about to be made, with eq. 10's test, beside the one just made.
-fn draw_call(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+fn call_paragraph(teach: &Teach, theme: Theme) -> Paragraph<'static> {
     let walk = teach.walk();
     let names = teach.names();
     let next = walk.as_ref().and_then(|w| w.pending.last().copied());
@@ -285,12 +306,9 @@ fn draw_call(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
             w.trace.len()
         ))),
     }
-    frame.render_widget(
-        Paragraph::new(lines)
-            .wrap(Wrap { trim: false })
-            .block(Block::bordered().title(Span::styled(" the call ", theme.title()))),
-        area,
-    );
+    Paragraph::new(lines)
+        .wrap(Wrap { trim: false })
+        .block(Block::bordered().title(Span::styled(" the call ", theme.title())))
 }
 
 /// The recursion's stack: pending calls, the next on top.
@@ -537,7 +555,7 @@ fn signed(x: f64, decimals: usize) -> String {
 }
 
 /// The knobs (`1`…`5`, the chosen one marked), and the last edit's effect or the notice.
-fn draw_edits(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+fn edits_paragraph(teach: &Teach, theme: Theme) -> Paragraph<'static> {
     let names = teach.names();
     let edge = teach.selected_edge();
     let mut knobs = Vec::new();
@@ -562,15 +580,12 @@ fn draw_edits(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     } else if let Some(report) = teach.last_edit() {
         lines.push(Line::from(edit_summary(report, names)));
     }
-    frame.render_widget(
-        Paragraph::new(lines)
-            .wrap(Wrap { trim: false })
-            .block(Block::bordered().title(Span::styled(
-                " edit (1–5 choose, +/− turn, e edge) ",
-                theme.title(),
-            ))),
-        area,
-    );
+    Paragraph::new(lines)
+        .wrap(Wrap { trim: false })
+        .block(Block::bordered().title(Span::styled(
+            " edit (1–5 choose, +/− turn, e edge) ",
+            theme.title(),
+        )))
 }
 
 /// `T_ω 1 → 0.9: π1's walk 21 → 9 calls, restarted · at its end A moved most at π0

@@ -482,14 +482,68 @@ pub(super) fn probability_bar(p: f64, width: usize) -> String {
     )
 }
 
+/// The chart's legend is its title: one coloured name per curve, with the symbol its
+/// curve is drawn with, so it names the curves in colour and without, at any width, and
+/// covers no data (ratatui's legend box sat on the newest episodes at 120+ columns and was
+/// hidden below). Long titles drop words before values.
+fn rewards_title<'a>(runs: &[RunView], x_max: f64, width: u16, theme: Theme) -> Line<'a> {
+    let entry = |i: usize, run: &RunView, value: bool| {
+        let (_, symbol) = theme.series_marker(i);
+        let symbol = if symbol.is_empty() { "━ " } else { symbol };
+        let mut text = format!("{symbol}{}", run.method);
+        if let (true, Some(ma)) = (value, run.curve.last_average()) {
+            text.push_str(&format!(" {ma:.1}"));
+        }
+        if f64::from(run.episode) > x_max {
+            text.push_str(&format!(" (ep {})", run.episode));
+        }
+        Span::styled(text, theme.series(i))
+    };
+    let fits = |line: &Line| line.width() + 2 <= usize::from(width);
+    let mut line = Line::default();
+    for (head, values) in [
+        (" episode return, MA10 · ", true),
+        (" MA10 · ", true),
+        (" MA10 · ", false),
+    ] {
+        let mut spans = vec![Span::styled(head, theme.title())];
+        for (i, run) in runs.iter().enumerate() {
+            if i > 0 {
+                spans.push(Span::styled(" · ", theme.title()));
+            }
+            spans.push(entry(i, run, values || i == 0));
+        }
+        spans.push(Span::raw(" "));
+        line = Line::from(spans);
+        if fits(&line) {
+            break;
+        }
+    }
+    line
+}
+
+/// What the dim curves are, under the chart: a finished protocol's mean and the ends of
+/// its 95% interval, per method, over its runs.
+fn bands_caption<'a>(bands: &[&Band], theme: Theme) -> Option<Line<'a>> {
+    if bands.is_empty() {
+        return None;
+    }
+    let per_method: Vec<String> = bands
+        .iter()
+        .map(|b| format!("{} {} runs", b.label, b.runs))
+        .collect();
+    Some(Line::styled(
+        format!(
+            " dim: --compare's mean and 95% CI · {} ",
+            per_method.join(" · ")
+        ),
+        theme.dim(),
+    ))
+}
+
 /// The episode axis follows the first (leading) run, so that its curve fills the chart
 /// however far ahead a baseline of short episodes has raced; the others are drawn over the
 /// same episodes, and the title says where they are.
-/// A finished protocol's band as the legend names it.
-fn band_name(band: &Band) -> String {
-    format!("{} mean, 95% CI, {} runs", band.label, band.runs)
-}
-
 fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], reference: &[Band], theme: Theme) {
     let x_max = runs
         .first()
@@ -522,26 +576,9 @@ fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], reference: &[Ba
     } else {
         (0.0, 1.0)
     };
-    // Without colour each curve has its own marker, shown before its legend name. The
-    // names are padded to one width: ratatui's legend does not clear its box, and a
-    // shorter name would leave the curves' dots showing through beside it.
-    let names: Vec<String> = runs
-        .iter()
-        .enumerate()
-        .map(|(i, run)| {
-            let (_, symbol) = theme.series_marker(i);
-            format!("{symbol}{} MA10", run.method)
-        })
-        .collect();
-    let width = names
-        .iter()
-        .map(|n| n.chars().count())
-        .chain(reference.iter().map(|b| band_name(b).chars().count()))
-        .max()
-        .unwrap_or(0);
     let mut datasets = Vec::new();
-    // The bands first, so the live curves draw over them: the mean a dim line named in
-    // the legend, its 95% interval's ends as dim dots.
+    // The bands first, so the live curves draw over them: the mean a dim line, its 95%
+    // interval's ends as dim dots.
     for (band, [low, mean, high]) in bands.iter().zip(&band_points) {
         let i = runs
             .iter()
@@ -558,15 +595,15 @@ fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], reference: &[Ba
         }
         datasets.push(
             Dataset::default()
-                .name(format!("{:width$}", band_name(band)))
                 .marker(Marker::Braille)
                 .graph_type(GraphType::Line)
                 .style(theme.series(i).add_modifier(Modifier::DIM))
                 .data(mean),
         );
     }
-    for (i, (run, name)) in runs.iter().zip(names).enumerate() {
+    for (i, run) in runs.iter().enumerate() {
         if i == 0 {
+            // The leading run's returns themselves, dim dots under its moving average.
             datasets.push(
                 Dataset::default()
                     .marker(Marker::Braille)
@@ -577,26 +614,18 @@ fn draw_rewards(frame: &mut Frame, area: Rect, runs: &[RunView], reference: &[Ba
         }
         datasets.push(
             Dataset::default()
-                .name(format!("{name:width$}"))
                 .marker(theme.series_marker(i).0)
                 .graph_type(GraphType::Line)
                 .style(theme.series(i))
                 .data(&run.curve.average),
         );
     }
-    let mut title = match runs.first().and_then(|r| r.curve.last_average()) {
-        Some(ma) => format!(" episode reward · {} MA10 {ma:.1} ", runs[0].method),
-        None => " episode reward ".to_string(),
-    };
-    for run in runs.iter().skip(1).filter(|r| f64::from(r.episode) > x_max) {
-        title.push_str(&format!("· {} ep {} ", run.method, run.episode));
-    }
-    if title.chars().count() + 2 > usize::from(area.width) {
-        title = title.replacen("episode reward", "reward", 1);
+    let mut block = Block::bordered().title(rewards_title(runs, x_max, area.width, theme));
+    if let Some(caption) = bands_caption(&bands, theme) {
+        block = block.title_bottom(caption);
     }
     let chart = Chart::new(datasets)
-        .hidden_legend_constraints((Constraint::Ratio(1, 2), Constraint::Ratio(1, 2)))
-        .block(Block::bordered().title(Span::styled(title, theme.title())))
+        .block(block)
         .x_axis(
             Axis::default()
                 .bounds([0.0, x_max])
