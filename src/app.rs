@@ -321,11 +321,35 @@ fn report(summary: &results::Summary, dir: &Path) -> Result<()> {
 
 /// The comparison table of a protocol, on stdout.
 fn print_comparison(summary: &results::Summary) -> Result<()> {
-    if summary.comparison.is_empty() {
+    let mut table = if summary.comparison.is_empty() {
+        String::new()
+    } else {
+        report::comparison::table(&summary.comparison, report::Units::Returns)
+    };
+    let stopped: Vec<String> = summary
+        .runs
+        .iter()
+        .filter(|r| r.record.stopped)
+        .map(|r| {
+            format!(
+                "{} run {} at episode {}/{}",
+                r.record.method.label(),
+                r.record.run,
+                r.record.episodes,
+                summary.config.protocol.episodes
+            )
+        })
+        .collect();
+    if !stopped.is_empty() {
+        table.push_str(&format!(
+            "not in the table, stopped before their end: {}\n",
+            stopped.join(", ")
+        ));
+    }
+    if table.is_empty() {
         return Ok(());
     }
     let mut out = std::io::stdout().lock();
-    let table = report::comparison::table(&summary.comparison, report::Units::Returns);
     write!(out, "{table}")
         .and_then(|()| out.flush())
         .context("writing to stdout")

@@ -68,6 +68,19 @@ fn a_signalled_headless_run_writes_what_it_did_and_exits_128_plus_the_signal() {
                 > 3
         );
         assert!(out.join("learning_curve.png").exists());
+        // The closing table scores finished runs only and names the stopped one apart.
+        let plot = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+            .arg("plot")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let table = String::from_utf8_lossy(&plot.stdout);
+        let episodes = summary["runs"][0]["episodes"].as_u64().unwrap();
+        assert_eq!(
+            table.trim(),
+            format!("not in the table, stopped before their end: dqn[8] run 0 at episode {episodes}/1000000"),
+            "{signal}"
+        );
     }
 }
 

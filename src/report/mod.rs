@@ -204,13 +204,15 @@ impl Report {
     }
 }
 
-/// Each run of method `label` on `task`, with its scores.
+/// Each finished run of method `label` on `task`, with its scores. A run stopped before its
+/// end is left out: its mean return is over fewer episodes and it has no test, so beside
+/// finished runs it would be a different measurement (the closing table lists it apart).
 fn run_scores<'a>(task: &TaskRuns<'a>, label: &str) -> Vec<(&'a RunSummary, RunScores)> {
     let thresholds = task.config.protocol.thresholds(&task.config.env);
     let window = task.config.protocol.moving_average;
     task.runs
         .iter()
-        .filter(|r| r.record.method.label() == label)
+        .filter(|r| r.record.method.label() == label && !r.record.stopped)
         .map(|r| {
             let returns = task
                 .rewards
