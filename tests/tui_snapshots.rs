@@ -511,7 +511,12 @@ fn the_policy_table_scrolls_to_the_picked_row_at_the_smallest_size() {
     insta::assert_snapshot!("dashboard_scrolled_80x24", terminal.backend());
     // A click on the row that reads source-1 picks source-1.
     let (column, row) = cell_of(&terminal, "source-1 ", 31).expect("source-1's row");
-    d.on_click(column, row, ratatui::layout::Rect::new(0, 0, 80, 24));
+    sapnet::tui::click(
+        &mut d,
+        ratatui::layout::Rect::new(0, 0, 80, 24),
+        column,
+        row,
+    );
     assert_eq!(d.cursor, 1);
 }
 
@@ -543,7 +548,12 @@ fn live_teach_keeps_the_picked_policy_in_view_at_the_smallest_size() {
     insta::assert_snapshot!("live_teach_source_9_80x24", terminal.backend());
     // A click on the row that reads source-7 picks it.
     let (column, row) = cell_of(&terminal, "source-7 ", 37).expect("source-7's row");
-    d.on_click(column, row, ratatui::layout::Rect::new(0, 0, 80, 24));
+    sapnet::tui::click(
+        &mut d,
+        ratatui::layout::Rect::new(0, 0, 80, 24),
+        column,
+        row,
+    );
     assert_eq!(d.teach.as_ref().unwrap().cursor(), 7);
 }
 

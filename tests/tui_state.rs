@@ -11,7 +11,7 @@ use sapnet::teach::config::TeachConfig;
 use sapnet::trainer::Command;
 use sapnet::tui::dashboard::{Action, Dashboard, Focus, Mode, CURVE_POINTS, SPEEDS};
 use sapnet::tui::teach::Teach;
-use sapnet::tui::{graph_view, teach_view, view};
+use sapnet::tui::{graph_layout, teach_view, view};
 
 fn key(c: char) -> KeyEvent {
     KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
@@ -119,7 +119,7 @@ fn in_the_graph_arrows_move_to_the_nearest_node_that_way() {
     let mut d = scripted(1);
     d.on_key(KeyEvent::new(KeyCode::Tab, KeyModifiers::NONE));
     let view = d.sapnet.as_ref().unwrap();
-    let positions = graph_view::positions(view.policies.len(), Some(&view.categories()));
+    let positions = graph_layout::positions(view.policies.len(), Some(&view.categories()));
     let start = d.cursor;
     d.on_key(key('j'));
     let below = d.cursor;
@@ -144,23 +144,23 @@ fn z_enlarges_the_focused_panel_and_a_click_picks_a_row_or_a_node() {
     let screen = Rect::new(0, 0, 120, 40);
     let layout = view::training_layout(screen, d.zoomed());
     // The third row of the table (below its border and header).
-    d.on_click(layout.table.x + 3, layout.table.y + 4, screen);
+    sapnet::tui::click(&mut d, screen, layout.table.x + 3, layout.table.y + 4);
     assert_eq!((d.cursor, d.focus), (2, Focus::Table));
     // A click on a node of the graph picks it and focuses the graph.
     let view_state = d.sapnet.as_ref().unwrap();
     let positions =
-        graph_view::positions(view_state.policies.len(), Some(&view_state.categories()));
+        graph_layout::positions(view_state.policies.len(), Some(&view_state.categories()));
     let target = 7;
     let cell = (0..layout.graph.width)
         .flat_map(|c| (0..layout.graph.height).map(move |r| (c, r)))
         .map(|(c, r)| (layout.graph.x + c, layout.graph.y + r))
         .find(|&(c, r)| {
-            graph_view::canvas_point(layout.graph, c, r)
-                .and_then(|p| graph_view::node_at(&positions, p, 0.25))
+            graph_layout::canvas_point(layout.graph, c, r)
+                .and_then(|p| graph_layout::node_at(&positions, p, 0.25))
                 == Some(target)
         })
         .expect("a cell over the node");
-    d.on_click(cell.0, cell.1, screen);
+    sapnet::tui::click(&mut d, screen, cell.0, cell.1);
     assert_eq!((d.cursor, d.focus), (target, Focus::Graph));
 
     d.on_key(key('z'));
@@ -221,26 +221,30 @@ fn in_teach_mode_a_click_picks_a_node_or_a_row() {
         assert!(!nodes.is_empty() && !rows.is_empty(), "policy {target}");
         // A row is one line of the table.
         assert!(rows.iter().all(|&(_, r)| r == rows[0].1));
-        d.on_click(nodes[0].0, nodes[0].1, screen);
+        sapnet::tui::click(&mut d, screen, nodes[0].0, nodes[0].1);
         assert_eq!(d.teach.as_ref().unwrap().cursor(), target);
-        d.on_click(rows[0].0, rows[0].1, screen);
+        sapnet::tui::click(&mut d, screen, rows[0].0, rows[0].1);
         assert_eq!(d.teach.as_ref().unwrap().cursor(), target);
     }
     // The status line, and the trace panel's corner, pick nothing.
-    d.on_click(5, 39, screen);
-    d.on_click(119, 38, screen);
+    sapnet::tui::click(&mut d, screen, 5, 39);
+    sapnet::tui::click(&mut d, screen, 119, 38);
     assert_eq!(d.teach.as_ref().unwrap().cursor(), 0);
 
     // Stand-alone teach mode: Fig. 2 on a small terminal.
     let lesson = TeachConfig::load(None).unwrap();
-    let mut teach = Teach::new(lesson.names, lesson.net);
+    let teach = Teach::new(lesson.names, lesson.net);
     let screen = Rect::new(0, 0, 80, 24);
     let (_, rows) = cells_over(Rect::new(0, 0, 80, 23), &teach, 3);
-    teach_view::click(&mut teach, screen, rows[0].0, rows[0].1);
-    assert_eq!(teach.cursor(), 3);
-    // Below the size the screen needs, a click does nothing.
-    teach_view::click(&mut teach, Rect::new(0, 0, 60, 20), 1, 1);
-    assert_eq!(teach.cursor(), 3);
+    assert_eq!(
+        teach_view::clicked(&teach, screen, rows[0].0, rows[0].1),
+        Some(3)
+    );
+    // Below the size the screen needs, a click lands on nothing.
+    assert_eq!(
+        teach_view::clicked(&teach, Rect::new(0, 0, 60, 20), 1, 1),
+        None
+    );
 }
 
 #[test]

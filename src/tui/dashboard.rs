@@ -10,7 +10,6 @@ use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
-use ratatui::layout::{Position, Rect};
 
 use crate::config::MethodKind;
 use crate::sapnet::{PolicyDescription, Prototype, SapNet};
@@ -18,7 +17,7 @@ use crate::trainer::{
     ActivationSnapshot, Command, Event, MethodId, RunRecord, StepRecord, LOCK_IN,
 };
 
-use super::graph_view;
+use super::graph_layout;
 use super::knobs::Knob;
 use super::reference::Band;
 use super::teach::Teach;
@@ -184,7 +183,7 @@ impl SapNetView {
             .is_some_and(|p| p.prototype == Prototype::SourceTask);
         let mut names: Vec<String> = Vec::new();
         for policy in &self.policies {
-            let task = super::graph_view::short_task(&policy.description.source_task);
+            let task = super::labels::short_task(&policy.description.source_task);
             if !names.iter().any(|n| n == task) {
                 names.push(task.to_string());
             }
@@ -232,6 +231,17 @@ impl RunView {
             failed: None,
         }
     }
+}
+
+/// What a left click landed on, as the view that drew the screen tells it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Clicked {
+    /// The policy table, on a policy's row or elsewhere in the panel.
+    Table(Option<usize>),
+    /// The graph, on a policy's node or between them.
+    Graph(Option<usize>),
+    /// A policy of teach mode's panels.
+    Teach(usize),
 }
 
 /// Everything the dashboard draws.
@@ -596,8 +606,9 @@ impl Dashboard {
         match (&self.sapnet, self.focus) {
             (Some(view), Focus::Graph) => {
                 let positions =
-                    graph_view::positions(view.policies.len(), Some(&view.categories()));
-                if let Some(next) = graph_view::nearest_ahead(&positions, self.cursor, direction) {
+                    graph_layout::positions(view.policies.len(), Some(&view.categories()));
+                if let Some(next) = graph_layout::nearest_ahead(&positions, self.cursor, direction)
+                {
                     self.cursor = next;
                 }
             }
@@ -606,41 +617,26 @@ impl Dashboard {
         Action::None
     }
 
-    /// A left click at `(column, row)` of a screen of `area`: on a node or a table row it
-    /// picks that policy and focuses its panel.
-    pub fn on_click(&mut self, column: u16, row: u16, area: Rect) {
+    /// A left click, found by the view under the mouse ([`super::click`]): picks the
+    /// policy clicked, if any, and focuses its panel.
+    pub fn on_click(&mut self, clicked: Clicked) {
         if self.help {
             return;
         }
-        if self.mode == Mode::Teach {
-            if let Some(teach) = &mut self.teach {
-                super::teach_view::click(teach, area, column, row);
+        match clicked {
+            Clicked::Teach(i) => {
+                if let Some(teach) = &mut self.teach {
+                    teach.pick(i);
+                }
             }
-            return;
-        }
-        let Some(view) = &self.sapnet else {
-            return;
-        };
-        let layout = super::view::training_layout(area, self.zoomed());
-        let inside = |r: Rect| r.contains(Position::new(column, row));
-        if inside(layout.table) {
-            // The rows as drawn, below the border and the header row.
-            let window = super::view::policy_rows(layout.table, self);
-            if let Some(i) = row
-                .checked_sub(layout.table.y + 2)
-                .and_then(|line| window.row_at(usize::from(line)))
-            {
-                self.cursor = i;
+            Clicked::Table(row) => {
+                self.cursor = row.unwrap_or(self.cursor);
+                self.focus = Focus::Table;
             }
-            self.focus = Focus::Table;
-        } else if inside(layout.graph) {
-            let positions = graph_view::positions(view.policies.len(), Some(&view.categories()));
-            if let Some(i) = graph_view::canvas_point(layout.graph, column, row)
-                .and_then(|point| graph_view::node_at(&positions, point, graph_view::CLICK_REACH))
-            {
-                self.cursor = i;
+            Clicked::Graph(node) => {
+                self.cursor = node.unwrap_or(self.cursor);
+                self.focus = Focus::Graph;
             }
-            self.focus = Focus::Graph;
         }
     }
 

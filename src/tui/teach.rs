@@ -7,8 +7,8 @@
 //! [`Teach::advance`], so a walk of millions of calls leaves the screen and the keys
 //! responsive.
 
-use super::graph_view;
 use super::knobs::{refusal, walk_end, EditReport, Knob};
+use super::labels;
 use crate::sapnet::{Call, SapNet, SpreadState, Spreader, TraceStep};
 
 /// Calls `r` makes between two frames: a few milliseconds' worth.
@@ -82,7 +82,7 @@ pub struct WalkView<'a> {
 impl Teach {
     pub fn new(names: Vec<String>, net: SapNet) -> Self {
         let initial = net.activations().to_vec();
-        let (names, descriptions) = match graph_view::distinct_labels(&names) {
+        let (names, descriptions) = match labels::distinct_labels(&names) {
             Some(_) => (names, None),
             None => (
                 (0..names.len()).map(|i| format!("π{i}")).collect(),

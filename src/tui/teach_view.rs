@@ -7,8 +7,10 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Cell, Paragraph, Row, Table, Wrap};
 use ratatui::Frame;
 
+use super::graph_layout;
 use super::graph_view::{self, node_style, Scene};
 use super::knobs::{EditReport, Knob};
+use super::labels;
 use super::row_window::RowWindow;
 use super::teach::Teach;
 use super::theme::Theme;
@@ -152,9 +154,9 @@ pub fn policy_at(area: Rect, teach: &Teach, column: u16, row: u16) -> Option<usi
     let panels = panels(area, teach);
     let at = Position::new(column, row);
     if panels.graph.contains(at) {
-        let positions = graph_view::positions(n, teach.groups());
-        return graph_view::canvas_point(panels.graph, column, row)
-            .and_then(|point| graph_view::node_at(&positions, point, graph_view::CLICK_REACH));
+        let positions = graph_layout::positions(n, teach.groups());
+        return graph_layout::canvas_point(panels.graph, column, row)
+            .and_then(|point| graph_layout::node_at(&positions, point, graph_layout::CLICK_REACH));
     }
     if panels.values.contains(at) && row < panels.values.bottom() - 1 {
         // The rows as drawn, below the border and the header row.
@@ -176,17 +178,15 @@ fn values_rows(area: Rect, teach: &Teach) -> RowWindow {
     )
 }
 
-/// A left click at `(column, row)` of a `screen` showing teach mode (its panels above the
-/// status line, in the dashboard or on their own): picks the policy under it, if any.
-pub fn click(teach: &mut Teach, screen: Rect, column: u16, row: u16) {
+/// The policy a left click at `(column, row)` of a `screen` showing teach mode (its panels
+/// above the status line, in the dashboard or on their own) lands on, if any.
+pub fn clicked(teach: &Teach, screen: Rect, column: u16, row: u16) -> Option<usize> {
     if screen.width < MIN_WIDTH || screen.height < MIN_HEIGHT {
-        return;
+        return None;
     }
     let [main, _status] =
         Layout::vertical([Constraint::Min(0), Constraint::Length(1)]).areas(screen);
-    if let Some(i) = policy_at(main, teach, column, row) {
-        teach.pick(i);
-    }
+    policy_at(main, teach, column, row)
 }
 
 /// Teach mode's panels, in the dashboard or on their own.
@@ -372,7 +372,7 @@ fn draw_trace(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     let names = if name_width(names, 4, usize::MAX) <= room {
         names
     } else {
-        short = graph_view::labels(names);
+        short = labels::labels(names);
         short.as_slice()
     };
     let name_width = name_width(names, 4, usize::MAX);

@@ -1,7 +1,7 @@
 //! Drawing the dashboard and teach mode: pure functions of the state, so the snapshot
 //! tests draw exactly what a user sees.
 
-use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::layout::{Constraint, Layout, Position, Rect};
 use ratatui::style::Modifier;
 use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
@@ -10,8 +10,10 @@ use ratatui::widgets::{
 };
 use ratatui::Frame;
 
-use super::dashboard::{Dashboard, Focus, Mode, RunView, SapNetView, HISTORY, SPEEDS};
+use super::dashboard::{Clicked, Dashboard, Focus, Mode, RunView, SapNetView, HISTORY, SPEEDS};
+use super::graph_layout;
 use super::graph_view::{self, node_style, Scene};
+use super::labels;
 use super::reference::Band;
 use super::row_window::RowWindow;
 use super::step_line::step_line;
@@ -76,6 +78,33 @@ pub struct TrainingLayout {
     pub rewards: Rect,
     pub loss: Rect,
     pub step: Rect,
+}
+
+/// What a left click at `(column, row)` of a screen of `area` showing `dashboard` lands
+/// on, found in the rectangles the screen was drawn in.
+pub fn clicked(dashboard: &Dashboard, area: Rect, column: u16, row: u16) -> Option<Clicked> {
+    if dashboard.mode == Mode::Teach {
+        let teach = dashboard.teach.as_ref()?;
+        return super::teach_view::clicked(teach, area, column, row).map(Clicked::Teach);
+    }
+    let view = dashboard.sapnet.as_ref()?;
+    let layout = training_layout(area, dashboard.zoomed());
+    let inside = |r: Rect| r.contains(Position::new(column, row));
+    if inside(layout.table) {
+        // The rows as drawn, below the border and the header row.
+        let window = policy_rows(layout.table, dashboard);
+        let policy = row
+            .checked_sub(layout.table.y + 2)
+            .and_then(|line| window.row_at(usize::from(line)));
+        return Some(Clicked::Table(policy));
+    }
+    if inside(layout.graph) {
+        let positions = graph_layout::positions(view.policies.len(), Some(&view.categories()));
+        let node = graph_layout::canvas_point(layout.graph, column, row)
+            .and_then(|point| graph_layout::node_at(&positions, point, graph_layout::CLICK_REACH));
+        return Some(Clicked::Graph(node));
+    }
+    None
 }
 
 /// The panels of the training view on a terminal of `area` (the status bar included).
@@ -360,7 +389,7 @@ fn draw_policy_table(
             if full {
                 cells.push(Cell::from(format!("{:?}", p.description.hidden)));
                 cells.push(Cell::from(if tasks {
-                    graph_view::short_task(&p.description.source_task).to_string()
+                    labels::short_task(&p.description.source_task).to_string()
                 } else {
                     p.description.hidden.len().to_string()
                 }));
