@@ -282,6 +282,7 @@ mod tests {
             loss: 0.0,
             previous_statistic_loss: before,
             statistic_loss: after,
+            td: None,
         }
     }
 

@@ -109,6 +109,7 @@ pub fn episodes(episodes: u32) -> Vec<Event> {
                 loss: 0.05,
                 previous_statistic_loss: 0.0421,
                 statistic_loss: 0.0417,
+                td: None,
             }),
             judgment: Some(true),
             deposit: Some(Deposit {
