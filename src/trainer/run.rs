@@ -331,6 +331,8 @@ pub fn train(
         chosen: None,
         source_steps: Vec::new(),
         lock_in_step: None,
+        positive: Vec::new(),
+        negative: Vec::new(),
         test_returns: Vec::new(),
         stopped: false,
         wall_s: 0.0,
@@ -557,6 +559,8 @@ pub fn train(
     record.steps = steps;
     record.updates = learners.updates();
     record.source_steps = tally.run.clone();
+    let view = selector.view();
+    (record.positive, record.negative) = (view.positive, view.negative);
     let net = match selector.chosen() {
         Some(chosen) => {
             let view = selector.view();

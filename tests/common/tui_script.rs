@@ -173,6 +173,8 @@ pub fn sapnet_end(episodes: u32) -> Event {
         }),
         source_steps: Vec::new(),
         lock_in_step: None,
+        positive: Vec::new(),
+        negative: Vec::new(),
         test_returns: vec![500.0, 500.0, 487.0, 500.0, 500.0],
         stopped: false,
         wall_s: 12.5,
