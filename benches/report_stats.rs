@@ -44,6 +44,8 @@ fn protocol(runs: u32) -> Protocol {
                 chosen: None,
                 source_steps: vec![1; 10],
                 lock_in_step: Some(600),
+                positive: Vec::new(),
+                negative: Vec::new(),
                 test_returns: (0..5).map(|_| rng.random_range(0.0..500.0)).collect(),
                 stopped: false,
                 wall_s: 0.0,

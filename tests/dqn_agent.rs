@@ -387,3 +387,68 @@ fn trains_on_cartpole_through_env_make() {
     assert_eq!(agent.steps(), 2000);
     assert!(agent.statistic_loss().is_finite() && agent.statistic_loss() > 0.0);
 }
+
+/// The TD error's change (`SapNetWith(judgment: TdChange)`), by hand on a net whose
+/// weights are written out: one input, one hidden unit, two actions, every weight 1 but
+/// the second head's 2, biases 0, so Q(s) = [relu(s), 2·relu(s)].
+#[test]
+fn the_td_error_of_the_latest_transition_is_measured_before_and_after_the_round() {
+    use candle_core::{Device, Tensor};
+    let net = || {
+        let t = |v: &[f32], shape: &[usize]| Tensor::from_slice(v, shape, &Device::Cpu).unwrap();
+        QNet::from_parameters(
+            Architecture::new(1, &[1], 2),
+            vec![
+                t(&[1.0], &[1, 1]),
+                t(&[0.0], &[1]),
+                t(&[1.0, 2.0], &[2, 1]),
+                t(&[0.0, 0.0], &[2]),
+            ],
+        )
+        .unwrap()
+    };
+    let config = DqnConfig {
+        replay_start_size: 1,
+        ..DqnConfig::default()
+    };
+    let replay_of = |terminated| {
+        let mut replay = ReplayBuffer::new(10, 1);
+        replay.push(Transition {
+            obs: &[1.0],
+            action: 0,
+            reward: 0.5,
+            next_obs: &[2.0],
+            terminated,
+            truncated: false,
+        });
+        replay
+    };
+    let observe = |measure: bool, terminated: bool| {
+        let mut agent = DqnAgent::new(net(), &config).unwrap();
+        agent.measure_td_error(measure);
+        let mut rng = StdRng::seed_from_u64(0);
+        let report = agent
+            .observe(&replay_of(terminated), &mut rng)
+            .unwrap()
+            .unwrap();
+        (report, flat(agent.online()))
+    };
+    let (report, weights) = observe(true, false);
+    let td = report.td.expect("measured when asked");
+    // Before: y = r + γ·max Q_target(s' = 2) = 0.5 + 0.99·4 = 4.46; Q_online(1, 0) = 1.
+    assert!((td.before - 3.46).abs() < 1e-6, "{td:?}");
+    // The batch is 32 copies of the one transition; |Q − y| > 1, so the Huber loss's
+    // gradient on Q(1, 0) is −1 in all, and on W1, b1, W2[0], b2[0] each −1 (W2[1], b2[1]
+    // 0). Chainer's Adam, first step: m = 0.1·g, v = 0.001·g², α_t = 1e-3·√0.001/0.1, so
+    // each of the four moves by α_t·m/(√v + 1e-3) = 1e-3·0.0316228/0.0326228 = 9.693466e-4.
+    // After: Q(1, 0) = 1.000969·(1.000969 + 0.000969) + 0.000969 = 1.003879; the target
+    // net is unchanged, δ = 4.46 − 1.003879 = 3.456121.
+    assert!((td.after - 3.456_120_7).abs() < 1e-5, "{td:?}");
+    // Measuring changes nothing of the update.
+    let (unmeasured, same_weights) = observe(false, false);
+    assert_eq!(unmeasured.td, None);
+    assert_eq!((unmeasured.loss, same_weights), (report.loss, weights));
+    // At a terminal state y = r: δ = 0.5 − 1 = −0.5 before the round.
+    let (report, _) = observe(true, true);
+    assert!((report.td.unwrap().before + 0.5).abs() < 1e-6);
+}

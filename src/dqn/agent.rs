@@ -5,7 +5,7 @@ use rand::Rng;
 use super::backprop::Workspace;
 use super::kernels::Isa;
 use super::scratch::{with_scratch, UpdateWork};
-use super::{td_huber_loss, Adam, Batch, DqnError, EpsilonGreedy, QNet, ReplayBuffer};
+use super::{td_huber_loss, Adam, Batch, DqnError, EpsilonGreedy, QNet, ReplayBuffer, Transition};
 use crate::config::DqnConfig;
 
 /// What one round of learning did, for SAP-Net's judgment `T_a = E_{t+1} − E_t` (eq. 7).
@@ -17,6 +17,20 @@ pub struct UpdateReport {
     pub previous_statistic_loss: f64,
     /// The statistic loss `E_{t+1}` after it.
     pub statistic_loss: f64,
+    /// The TD error of the transition stored last, before and after the round, when the
+    /// learner was asked to measure it ([`DqnAgent::measure_td_error`]).
+    pub td: Option<TdError>,
+}
+
+/// The TD error `δ = r + γ·(1 − done)·max_a' Q_target(s', a') − Q_online(s, a)` of one
+/// transition, with the online net just before a round of updates and just after it (the
+/// same target net: a target copy happens before the round). `done` is the update's own:
+/// terminated, or truncated under `truncation_as_terminal`. In f32 as the update's targets,
+/// reported as f64.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TdError {
+    pub before: f64,
+    pub after: f64,
 }
 
 impl UpdateReport {
@@ -41,6 +55,8 @@ pub struct DqnAgent {
     /// `E`, ChainerRL's `average_loss`: an exponential moving average of the loss from 0.
     statistic_loss: f64,
     last_loss: Option<f64>,
+    /// Whether each report carries the TD error of the latest transition ([`TdError`]).
+    measure_td: bool,
     /// Reused between updates.
     batch: Batch,
     targets: Vec<f32>,
@@ -59,6 +75,7 @@ impl DqnAgent {
             updates: 0,
             statistic_loss: 0.0,
             last_loss: None,
+            measure_td: false,
             batch: Batch::new(),
             targets: Vec::new(),
         })
@@ -69,6 +86,18 @@ impl DqnAgent {
         let actions = self.online.architecture().action_count;
         self.explorer
             .choose(self.steps, actions, rng, || self.online.greedy_action(obs))
+    }
+
+    /// From now on, every [`UpdateReport`] carries the [`TdError`] of the transition stored
+    /// last in the replay buffer: three forward passes of one observation per round (the
+    /// target net once, the online net before and after), so it is off unless asked for.
+    pub fn measure_td_error(&mut self, on: bool) {
+        self.measure_td = on;
+    }
+
+    /// `max_a Q_online(obs, a)`: the online net's value estimate of `obs`.
+    pub fn value(&self, obs: &[f32]) -> Result<f64, DqnError> {
+        self.online.max_q(obs).map(f64::from)
     }
 
     /// The greedy action, for testing a policy.
@@ -99,6 +128,14 @@ impl DqnAgent {
             return Ok(None);
         }
         let previous_statistic_loss = self.statistic_loss;
+        let td_target = match (self.measure_td, replay.latest()) {
+            (true, Some(t)) => Some((self.td_target(&t)?, t)),
+            _ => None,
+        };
+        let td_before = match &td_target {
+            Some((y, t)) => Some(self.td_error(*y, t)?),
+            None => None,
+        };
         let mut loss = 0.0;
         for k in 0..self.config.gradient_steps {
             // A round of many updates (gradient_steps up to 10,000) hears a signal between
@@ -112,11 +149,37 @@ impl DqnAgent {
             self.batch = batch;
             loss = result?;
         }
+        let td = match (td_target, td_before) {
+            (Some((y, t)), Some(before)) => Some(TdError {
+                before,
+                after: self.td_error(y, &t)?,
+            }),
+            _ => None,
+        };
         Ok(Some(UpdateReport {
             loss,
             previous_statistic_loss,
             statistic_loss: self.statistic_loss,
+            td,
         }))
+    }
+
+    /// `y = r + γ·(1 − done)·max_a' Q_target(s', a')` of one transition, as
+    /// [`compute_td_targets`](Self::compute_td_targets) computes it for a batch.
+    fn td_target(&self, t: &Transition<'_>) -> Result<f32, DqnError> {
+        let terminal = t.terminated || (self.config.truncation_as_terminal && t.truncated);
+        let bootstrap = if terminal {
+            0.0
+        } else {
+            self.config.gamma as f32 * self.target.max_q(t.next_obs)?
+        };
+        Ok(t.reward as f32 + bootstrap)
+    }
+
+    /// `δ = y − Q_online(s, a)` with the online net as it is now.
+    fn td_error(&self, y: f32, t: &Transition<'_>) -> Result<f64, DqnError> {
+        let q = self.online.q_values(t.obs)?[t.action];
+        Ok(f64::from(y - q))
     }
 
     /// One gradient update on `batch`; returns the loss and folds it into the statistic loss.

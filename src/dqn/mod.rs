@@ -18,7 +18,7 @@ mod qnet;
 mod replay;
 mod scratch;
 
-pub use agent::{DqnAgent, UpdateReport};
+pub use agent::{DqnAgent, TdError, UpdateReport};
 pub use backprop::Gradients;
 pub use error::DqnError;
 pub use exploration::EpsilonGreedy;

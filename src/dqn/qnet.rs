@@ -244,6 +244,11 @@ impl QNet {
         self.with_q_values(obs, <[f32]>::to_vec)
     }
 
+    /// The highest Q-value of one observation, folded as the update's TD targets fold a row.
+    pub fn max_q(&self, obs: &[f32]) -> Result<f32, DqnError> {
+        self.with_q_values(obs, |q| q.iter().copied().fold(f32::MIN, f32::max))
+    }
+
     /// The action of highest Q-value; ties go to the lowest index, as `argmax` does.
     pub fn greedy_action(&self, obs: &[f32]) -> Result<usize, DqnError> {
         self.with_q_values(obs, argmax)

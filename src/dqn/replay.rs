@@ -110,6 +110,11 @@ impl ReplayBuffer {
         }
     }
 
+    /// The transition stored last, if any.
+    pub fn latest(&self) -> Option<Transition<'_>> {
+        (!self.is_empty()).then(|| self.get((self.next + self.capacity - 1) % self.capacity))
+    }
+
     /// Fills `batch` with `size` transitions drawn uniformly with replacement, reusing its
     /// memory.
     ///
@@ -225,6 +230,17 @@ mod tests {
             next_obs: obs,
             terminated: i.is_multiple_of(3),
             truncated: i.is_multiple_of(5),
+        }
+    }
+
+    #[test]
+    fn the_latest_transition_is_the_last_pushed_before_and_after_wrapping() {
+        let mut buffer = ReplayBuffer::new(3, 1);
+        assert!(buffer.latest().is_none());
+        for i in 0..7 {
+            let obs = [i as f32];
+            buffer.push(transition(&obs, i));
+            assert_eq!(buffer.latest().unwrap().reward, i as f64, "after {i}");
         }
     }
 

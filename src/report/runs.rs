@@ -110,6 +110,8 @@ mod tests {
             chosen: None,
             source_steps: Vec::new(),
             lock_in_step: None,
+            positive: Vec::new(),
+            negative: Vec::new(),
             test_returns: vec![10.0, 20.0],
             stopped: false,
             wall_s: 0.0,

@@ -82,6 +82,8 @@ mod tests {
             chosen: None,
             source_steps: vec![],
             lock_in_step: None,
+            positive: Vec::new(),
+            negative: Vec::new(),
             test_returns: tests,
             stopped: false,
             wall_s: 0.0,

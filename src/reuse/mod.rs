@@ -5,7 +5,9 @@
 //! - *who acts* at this step ([`Selector::act`]): a source ε-greedily, a source greedily
 //!   (π-reuse), or a learner that is not a source;
 //! - *what feedback* it takes: each update's report from the source that acted
-//!   ([`Selector::on_update`]), each step's end, each episode's end and return;
+//!   ([`Selector::on_update`]), each step's end, each episode's end and return; and, when
+//!   it asks for them ([`Selector::needs`]), each acting step's reward with the source's
+//!   value estimate, and the TD error in the update's report;
 //! - *what to show*: a score per source and the probability of picking it
 //!   ([`Selector::view`]).
 //!
@@ -75,6 +77,19 @@ pub struct EpisodeEnd {
     pub discounted_return: f64,
 }
 
+/// What a selector asks the run to measure beyond what every method hears, each costing a
+/// forward pass or a few: off by default, so that other methods' runs do neither.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Needs {
+    /// Every [`UpdateReport`] carries the TD error of the step's transition before and
+    /// after the round ([`crate::dqn::TdError`]).
+    pub td_error: bool,
+    /// [`Selector::on_acted`] hears every acting step with the source's value estimate,
+    /// and [`Selector::on_truncated`] the sources' values where a time limit cut an
+    /// episode.
+    pub values: bool,
+}
+
 /// One activation of a policy, with every `spread` call it made (eq. 8–11).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Activation {
@@ -90,7 +105,8 @@ pub struct SelectorView {
     pub scores: Vec<f64>,
     /// The probability that each source is picked at the next choice.
     pub probabilities: Vec<f64>,
-    /// Judgments per source (eq. 7 for SAP-Net), for methods that judge.
+    /// Judgments per source (eq. 7 for SAP-Net), for methods that judge, counted when they
+    /// are made: a judgment deferred to the episode's end counts then.
     pub positive: Vec<u64>,
     pub negative: Vec<u64>,
 }
@@ -111,11 +127,29 @@ pub trait Selector: Send + fmt::Debug {
     /// Who chooses the action of the next step (after the warm-up).
     fn act(&mut self, rng: &mut StdRng) -> Actor;
 
+    /// What the run must measure for this selector.
+    fn needs(&self) -> Needs {
+        Needs::default()
+    }
+
     /// The report of the update `source` just made on its step
-    /// ([`Learning::ActingSource`] only); returns the judgment it made of it, if it judged.
+    /// ([`Learning::ActingSource`] only); returns the judgment it made of it, if it made
+    /// one now (`None` also when the judgment waits for the episode's end).
     fn on_update(&mut self, _source: usize, _report: &UpdateReport) -> Option<bool> {
         None
     }
+
+    /// A step (after the warm-up) that `source` acted, before its update: its reward, and
+    /// `value` = `max_a Q_i(s_t, a)` of the source's online network on the observation it
+    /// acted on. Called only when [`needs`](Self::needs) asks for values.
+    fn on_acted(&mut self, _source: usize, _reward: f64, _value: f64) {}
+
+    /// The episode in progress was cut by its time limit with its last state still
+    /// bootstrapped (Gymnasium semantics, not `truncation_as_terminal`): `values[j]` =
+    /// `max_a Q_j(s_{T+1}, a)` of every source's online network on the state it was cut
+    /// at. Called before [`on_episode_end`](Self::on_episode_end), only when
+    /// [`needs`](Self::needs) asks for values.
+    fn on_truncated(&mut self, _values: &[f64]) {}
 
     /// A step (after the warm-up) is over: time-driven changes go here.
     fn on_step(&mut self) {}
@@ -162,6 +196,8 @@ pub struct Library<'a> {
     pub descriptions: &'a [PolicyDescription],
     /// Mean greedy return each source scored when it was trained, if tested.
     pub scores: &'a [Option<f64>],
+    /// The DQN's discount γ.
+    pub gamma: f64,
     /// The target task's possible returns per episode, (lowest, highest).
     pub return_range: (f64, f64),
     /// The same for discounted returns, with the DQN's γ.
@@ -188,11 +224,13 @@ pub fn build(
             library.descriptions,
             sapnet.clone(),
             &sapnet::SapNetKnobs::default(),
+            library.gamma,
         )?),
         Method::SapNetWith(knobs) => Box::new(sapnet::SapNetSelector::new(
             library.descriptions,
             sapnet.clone(),
             knobs,
+            library.gamma,
         )?),
         Method::Random => Box::new(random::Random::per_step(library.descriptions.len())),
         Method::RandomPerEpisode => {

@@ -1,20 +1,25 @@
 //! SAP-Net as a selector: eq. 6 picks the source that acts, eq. 7 judges its update,
 //! eq. 8–11 activate and spread (Algorithm 3). With [`SapNetKnobs::default`] this is the
-//! paper; the knobs are variants beyond it: a temperature schedule, a judgment over
-//! episodes or over k updates, and activation decay.
+//! paper; the knobs are variants beyond it: a temperature schedule, judgments by other
+//! signals or over other spans than eq. 7's (episodes, k updates, the TD error, the
+//! advantage, eq. 7 confirmed by the return), and activation decay.
 
 use rand::rngs::StdRng;
 use serde::{Deserialize, Serialize};
 
 use super::schedule::Schedule;
-use super::{Activation, Actor, Deposit, EpisodeEnd, Learning, Selector, SelectorView};
+use super::{Activation, Actor, Deposit, EpisodeEnd, Learning, Needs, Selector, SelectorView};
 use crate::dqn::UpdateReport;
 use crate::sapnet::{self, PolicyDescription, SapNet, SapNetError, SapNetParams, TraceStep};
 
-/// When a source's learning is judged positive or negative.
+/// When a source's learning is judged positive or negative, and by what. Each positive
+/// judgment of π_i is one `activate(i, 𝒜)` (eq. 8–11); a negative one only counts. The
+/// paper names the first; the others are its future work ("indices other than the loss",
+/// per episode or every k steps).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Judgment {
-    /// After every update: `T_a = E_{t+1} − E_t ≤ 0` (eq. 7, the paper).
+    /// After every update of π_i: `T_a = E_{t+1} − E_t ≤ 0` (eq. 7, the paper), E the
+    /// statistic loss `E ← 0.99·E + 0.01·loss`.
     Step,
     /// Once per episode, for each source that acted in it: positive when the episode's
     /// return is at least the mean return of the earlier episodes that source acted in (the
@@ -22,6 +27,26 @@ pub enum Judgment {
     Episode,
     /// After every k updates of a source: eq. 7 over the k updates, `E_{t+k} − E_t ≤ 0`.
     KSteps(u32),
+    /// After every update of π_i, the TD error's change instead of E's: for the step's
+    /// transition (s, a, r, s', done),
+    /// `δ = r + γ·(1 − done)·max_a' Q_target(s', a') − Q_online(s, a)` with π_i's online
+    /// net just before its round of updates (δ_before) and just after (δ_after), the same
+    /// target net; positive when `|δ_after| ≤ |δ_before|`. `done` is the update's own
+    /// (terminated, or truncated under `truncation_as_terminal`).
+    TdChange,
+    /// At the episode's end, one judgment per step t acted by a source, in step order:
+    /// `A_t = G_t − V_i(s_t) ≥ 0` positive, with `V_i(s_t) = max_a Q_i(s_t, a)` of the
+    /// acting source's online net when it acted (before its update) and the return-to-go
+    /// `G_t = Σ_{k=t}^{T} γ^{k−t}·r_k + γ^{T+1−t}·V_i(s_{T+1})`, the last term only when a
+    /// time limit cut the episode (and `truncation_as_terminal` is off), V_i(s_{T+1}) from
+    /// π_i's online net at the episode's end. An episode cut by the run's step budget
+    /// never ends: its steps are never judged.
+    Advantage,
+    /// Eq. 7 and the episode's return both: each update's `T_a ≤ 0` is kept, and at the
+    /// episode's end each kept positive of π_i is confirmed if the return is at least the
+    /// mean return of the earlier episodes π_i acted in (the `Episode` rule), else it
+    /// counts negative. An update with `T_a > 0` is negative at once.
+    EpisodeAndLoss,
 }
 
 /// SAP-Net's variants beyond the paper (`SapNetWith(...)` in `protocol.methods`); the
@@ -70,6 +95,9 @@ impl SapNetKnobs {
             Judgment::Step => {}
             Judgment::Episode => label.push_str("-episode"),
             Judgment::KSteps(k) => label.push_str(&format!("-k{k}")),
+            Judgment::TdChange => label.push_str("-td"),
+            Judgment::Advantage => label.push_str("-advantage"),
+            Judgment::EpisodeAndLoss => label.push_str("-episode-and-loss"),
         }
         if self.decay != 1.0 {
             label.push_str(&format!("-decay{}", self.decay));
@@ -100,21 +128,54 @@ impl SapNetKnobs {
     }
 }
 
+/// A step of an episode in progress as `Advantage` keeps it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ActedStep {
+    source: usize,
+    reward: f64,
+    /// V_i(s_t) = max_a Q_i(s_t, a) when the source acted.
+    value: f64,
+}
+
+/// `A_t = G_t − V_i(s_t)` of every step of an episode, in step order, with
+/// `G_t = Σ_{k=t}^{T} γ^{k−t}·r_k + γ^{T+1−t}·tail[i]` (no tail: the episode terminated).
+/// Summed from the last step back: G_T = r_T, G_t = r_t + γ·G_{t+1}.
+fn advantages(steps: &[ActedStep], tail: Option<&[f64]>, gamma: f64) -> Vec<f64> {
+    let mut advantages = vec![0.0; steps.len()];
+    let (mut rewards_to_go, mut discount) = (0.0, gamma);
+    for (t, step) in steps.iter().enumerate().rev() {
+        rewards_to_go = step.reward + gamma * rewards_to_go;
+        let bootstrap = tail.map_or(0.0, |values| discount * values[step.source]);
+        advantages[t] = rewards_to_go + bootstrap - step.value;
+        discount *= gamma;
+    }
+    advantages
+}
+
 /// SAP-Net over the library, with its judgment's bookkeeping.
 #[derive(Debug)]
 pub struct SapNetSelector {
     net: SapNet,
     knobs: SapNetKnobs,
+    /// The DQN's γ, for `Advantage`'s return-to-go.
+    gamma: f64,
     positive: Vec<u64>,
     negative: Vec<u64>,
     /// Learning steps so far, the clock of the temperature schedule.
     steps: u64,
-    /// `Episode`: which sources acted in the episode in progress, and per source the mean
-    /// return of the earlier episodes it acted in, with their count.
+    /// `Episode`, `EpisodeAndLoss`: which sources acted in the episode in progress, and per
+    /// source the mean return of the earlier episodes it acted in, with their count.
     acted: Vec<bool>,
     mean_return: Vec<(f64, u64)>,
     /// `KSteps`: per source, E before the window of updates in progress and its length.
     window: Vec<(f64, u32)>,
+    /// `EpisodeAndLoss`: the source of each positive eq. 7 judgment of the episode in
+    /// progress, in step order, waiting for the episode's return.
+    kept: Vec<usize>,
+    /// `Advantage`: each acting step of the episode in progress, in order, and the sources'
+    /// values at the state a time limit cut it at.
+    acted_steps: Vec<ActedStep>,
+    tail_values: Option<Vec<f64>>,
     tracing: bool,
     traced: Vec<Activation>,
     /// What the latest positive judgment deposited (eq. 8–11).
@@ -122,10 +183,12 @@ pub struct SapNetSelector {
 }
 
 impl SapNetSelector {
+    /// `gamma` is the DQN's discount (read by `Advantage` only).
     pub fn new(
         policies: &[PolicyDescription],
         mut params: SapNetParams,
         knobs: &SapNetKnobs,
+        gamma: f64,
     ) -> Result<Self, SapNetError> {
         if let Some(schedule) = &knobs.temperature {
             params.temperature = schedule.at(0);
@@ -134,12 +197,16 @@ impl SapNetSelector {
         Ok(Self {
             net: SapNet::from_policies(policies, params)?,
             knobs: knobs.clone(),
+            gamma,
             positive: vec![0; n],
             negative: vec![0; n],
             steps: 0,
             acted: vec![false; n],
             mean_return: vec![(0.0, 0); n],
             window: vec![(0.0, 0); n],
+            kept: Vec::new(),
+            acted_steps: Vec::new(),
+            tail_values: None,
             tracing: false,
             traced: Vec::new(),
             deposit: Deposit::default(),
@@ -149,6 +216,25 @@ impl SapNetSelector {
     /// The SAP-Net, with its graph and activations.
     pub fn net(&self) -> &SapNet {
         &self.net
+    }
+
+    /// The `Episode` rule at an episode's end, for each source that acted in it (`None`
+    /// for the others): whether `episode_return` is at least the mean return of the
+    /// earlier episodes it acted in (the first is positive); folds the return into those
+    /// means and clears who acted.
+    fn episode_verdicts(&mut self, episode_return: f64) -> Vec<Option<bool>> {
+        (0..self.acted.len())
+            .map(|i| {
+                if !std::mem::take(&mut self.acted[i]) {
+                    return None;
+                }
+                let (mean, count) = self.mean_return[i];
+                let positive = count == 0 || episode_return >= mean;
+                let count = count + 1;
+                self.mean_return[i] = (mean + (episode_return - mean) / count as f64, count);
+                Some(positive)
+            })
+            .collect()
     }
 
     /// Counts the judgment, then activates `i` (eq. 8–11) if it was positive.
@@ -188,10 +274,31 @@ impl Selector for SapNetSelector {
         Actor::Source(i)
     }
 
+    fn needs(&self) -> Needs {
+        Needs {
+            td_error: self.knobs.judgment == Judgment::TdChange,
+            values: self.knobs.judgment == Judgment::Advantage,
+        }
+    }
+
     fn on_update(&mut self, source: usize, report: &UpdateReport) -> Option<bool> {
         let positive = match self.knobs.judgment {
             Judgment::Step => sapnet::judge(report.previous_statistic_loss, report.statistic_loss),
-            Judgment::Episode => return None,
+            Judgment::Episode | Judgment::Advantage => return None,
+            Judgment::TdChange => {
+                let td = report
+                    .td
+                    .expect("the run measures the TD error when the selector needs it");
+                td.after.abs() <= td.before.abs()
+            }
+            Judgment::EpisodeAndLoss => {
+                if sapnet::judge(report.previous_statistic_loss, report.statistic_loss) {
+                    // Confirmed or not by the episode's return.
+                    self.kept.push(source);
+                    return None;
+                }
+                false
+            }
             Judgment::KSteps(k) => {
                 let (start, count) = &mut self.window[source];
                 if *count == 0 {
@@ -221,19 +328,48 @@ impl Selector for SapNetSelector {
         }
     }
 
-    fn on_episode_end(&mut self, end: &EpisodeEnd) {
-        if self.knobs.judgment != Judgment::Episode {
-            return;
+    fn on_acted(&mut self, source: usize, reward: f64, value: f64) {
+        if self.knobs.judgment == Judgment::Advantage {
+            self.acted_steps.push(ActedStep {
+                source,
+                reward,
+                value,
+            });
         }
-        for i in 0..self.acted.len() {
-            if !std::mem::take(&mut self.acted[i]) {
-                continue;
+    }
+
+    fn on_truncated(&mut self, values: &[f64]) {
+        if self.knobs.judgment == Judgment::Advantage {
+            self.tail_values = Some(values.to_vec());
+        }
+    }
+
+    fn on_episode_end(&mut self, end: &EpisodeEnd) {
+        match self.knobs.judgment {
+            Judgment::Episode => {
+                let verdicts = self.episode_verdicts(end.episode_return);
+                for (i, verdict) in verdicts.into_iter().enumerate() {
+                    if let Some(positive) = verdict {
+                        self.judged(i, positive);
+                    }
+                }
             }
-            let (mean, count) = self.mean_return[i];
-            let positive = count == 0 || end.episode_return >= mean;
-            let count = count + 1;
-            self.mean_return[i] = (mean + (end.episode_return - mean) / count as f64, count);
-            self.judged(i, positive);
+            Judgment::EpisodeAndLoss => {
+                let verdicts = self.episode_verdicts(end.episode_return);
+                for i in std::mem::take(&mut self.kept) {
+                    let confirmed = verdicts[i].expect("a source judged by eq. 7 acted");
+                    self.judged(i, confirmed);
+                }
+            }
+            Judgment::Advantage => {
+                let steps = std::mem::take(&mut self.acted_steps);
+                let tail = self.tail_values.take();
+                let advantages = advantages(&steps, tail.as_deref(), self.gamma);
+                for (step, advantage) in steps.iter().zip(advantages) {
+                    self.judged(step.source, advantage >= 0.0);
+                }
+            }
+            Judgment::Step | Judgment::KSteps(_) | Judgment::TdChange => {}
         }
     }
 
@@ -282,6 +418,7 @@ mod tests {
             loss: 0.0,
             previous_statistic_loss: before,
             statistic_loss: after,
+            td: None,
         }
     }
 
@@ -291,7 +428,7 @@ mod tests {
             PolicyDescription::new(vec![8], "t"),
             PolicyDescription::new(vec![8, 8], "t"),
         ];
-        SapNetSelector::new(&policies, SapNetParams::default(), &knobs).unwrap()
+        SapNetSelector::new(&policies, SapNetParams::default(), &knobs, 0.99).unwrap()
     }
 
     #[test]
@@ -314,9 +451,13 @@ mod tests {
             PolicyDescription::new(vec![8], "t"),
             PolicyDescription::new(vec![9], "t"),
         ];
-        let mut s =
-            SapNetSelector::new(&policies, SapNetParams::default(), &SapNetKnobs::default())
-                .unwrap();
+        let mut s = SapNetSelector::new(
+            &policies,
+            SapNetParams::default(),
+            &SapNetKnobs::default(),
+            0.99,
+        )
+        .unwrap();
         assert_eq!(s.on_update(0, &report(0.5, 0.4)), Some(true));
         let deposit = s.last_deposit().unwrap();
         assert_eq!(deposit.own, 1.0);
@@ -367,6 +508,140 @@ mod tests {
         assert_eq!(s.mean_return[0].1, 3);
     }
 
+    fn td_report(before: f64, after: f64) -> UpdateReport {
+        UpdateReport {
+            td: Some(crate::dqn::TdError { before, after }),
+            ..report(0.0, 0.0)
+        }
+    }
+
+    fn end(episode_return: f64) -> EpisodeEnd {
+        EpisodeEnd {
+            episode_return,
+            discounted_return: 0.0,
+        }
+    }
+
+    #[test]
+    fn td_change_judges_every_update_by_the_size_of_the_td_error() {
+        let mut s = selector(SapNetKnobs {
+            judgment: Judgment::TdChange,
+            ..SapNetKnobs::default()
+        });
+        assert_eq!(
+            s.needs(),
+            Needs {
+                td_error: true,
+                values: false
+            }
+        );
+        // |δ| 3.46 → 3.45: smaller, positive; −0.5 → 0.5: the same size, positive;
+        // 0.2 → −0.3: larger, negative (the sign does not matter, the size does).
+        assert_eq!(s.on_update(0, &td_report(3.46, 3.45)), Some(true));
+        assert_eq!(s.on_update(0, &td_report(-0.5, 0.5)), Some(true));
+        assert_eq!(s.on_update(1, &td_report(0.2, -0.3)), Some(false));
+        // E rose on every one of them: eq. 7 would have said negative; E is not read.
+        let view = s.view();
+        assert_eq!((view.positive, view.negative), (vec![2, 0], vec![0, 1]));
+        assert_eq!(view.scores, vec![2.0, 0.0]);
+    }
+
+    /// γ = 0.5 for round numbers. Steps (source, r, V): (0, 1, 1.5), (1, 1, 0.5),
+    /// (0, 2, 3.0). Terminated: G_2 = 2, G_1 = 1 + 0.5·2 = 2, G_0 = 1 + 0.5·2 = 2, so
+    /// A = 2 − 1.5, 2 − 0.5, 2 − 3 = 0.5, 1.5, −1. Cut by the time limit with
+    /// V_0(s_3) = 4, V_1(s_3) = 8: G_2 += 0.5·4 = 4, G_1 += 0.25·8 = 4, G_0 += 0.125·4 =
+    /// 2.5, so A = 1, 3.5, 1.
+    #[test]
+    fn the_advantage_is_the_return_to_go_over_the_value_estimate() {
+        let steps = [(0, 1.0, 1.5), (1, 1.0, 0.5), (0, 2.0, 3.0)].map(|(source, reward, value)| {
+            ActedStep {
+                source,
+                reward,
+                value,
+            }
+        });
+        assert_eq!(advantages(&steps, None, 0.5), vec![0.5, 1.5, -1.0]);
+        assert_eq!(
+            advantages(&steps, Some(&[4.0, 8.0]), 0.5),
+            vec![1.0, 3.5, 1.0]
+        );
+
+        // The selector judges them at the episode's end, one per step, in step order.
+        let mut s = SapNetSelector::new(
+            &[
+                PolicyDescription::new(vec![8], "t"),
+                PolicyDescription::new(vec![8, 8], "t"),
+            ],
+            SapNetParams::default(),
+            &SapNetKnobs {
+                judgment: Judgment::Advantage,
+                ..SapNetKnobs::default()
+            },
+            0.5,
+        )
+        .unwrap();
+        assert!(s.needs().values && !s.needs().td_error);
+        for step in &steps {
+            s.on_acted(step.source, step.reward, step.value);
+            // Nothing is judged before the episode ends.
+            assert_eq!(s.on_update(step.source, &report(0.5, 0.4)), None);
+        }
+        assert_eq!(s.view().positive, vec![0, 0]);
+        s.on_episode_end(&end(4.0));
+        let view = s.view();
+        assert_eq!((view.positive, view.negative), (vec![1, 1], vec![1, 0]));
+        // The next episode, cut by its time limit: all three positive.
+        for step in &steps {
+            s.on_acted(step.source, step.reward, step.value);
+        }
+        s.on_truncated(&[4.0, 8.0]);
+        s.on_episode_end(&end(4.0));
+        let view = s.view();
+        assert_eq!((view.positive, view.negative), (vec![3, 2], vec![1, 0]));
+        assert_eq!(view.scores, vec![3.0, 2.0]);
+        // The tail was the cut episode's alone: a terminated one after it has none.
+        s.on_acted(0, 1.0, 1.5);
+        s.on_episode_end(&end(1.0));
+        assert_eq!(s.view().negative, vec![2, 0]);
+    }
+
+    #[test]
+    fn episode_and_loss_confirms_eq_7_positives_by_the_episodes_return() {
+        let mut s = selector(SapNetKnobs {
+            judgment: Judgment::EpisodeAndLoss,
+            ..SapNetKnobs::default()
+        });
+        assert_eq!(s.needs(), Needs::default());
+        let act = |s: &mut SapNetSelector, i: usize| {
+            s.acted[i] = true;
+        };
+        // Episode 1 (return 10, source 0's first: its verdict is positive). E falls, rises,
+        // falls: two kept positives, one negative at once.
+        act(&mut s, 0);
+        assert_eq!(s.on_update(0, &report(0.5, 0.4)), None);
+        assert_eq!(s.on_update(0, &report(0.4, 0.6)), Some(false));
+        assert_eq!(s.on_update(0, &report(0.6, 0.5)), None);
+        assert_eq!((s.view().positive[0], s.view().negative[0]), (0, 1));
+        s.on_episode_end(&end(10.0));
+        assert_eq!((s.view().positive[0], s.view().negative[0]), (2, 1));
+        // Episode 2 (return 8 < mean 10): its kept positive counts negative; source 1 acted
+        // for the first time and its kept positive is confirmed.
+        act(&mut s, 0);
+        act(&mut s, 1);
+        assert_eq!(s.on_update(0, &report(0.5, 0.4)), None);
+        assert_eq!(s.on_update(1, &report(0.5, 0.4)), None);
+        s.on_episode_end(&end(8.0));
+        let view = s.view();
+        assert_eq!((view.positive, view.negative), (vec![2, 1], vec![2, 0]));
+        assert_eq!(view.scores, vec![2.0, 1.0]);
+        // Episode 3 (return 9.5 ≥ source 0's mean 9): confirmed.
+        act(&mut s, 0);
+        s.on_update(0, &report(0.5, 0.4));
+        s.on_episode_end(&end(9.5));
+        assert_eq!(s.view().positive[0], 3);
+        assert_eq!(s.mean_return[0], (27.5 / 3.0, 3));
+    }
+
     #[test]
     fn decay_and_the_schedule_act_after_every_step() {
         let mut s = selector(SapNetKnobs {
@@ -402,6 +677,16 @@ mod tests {
             label: None,
         };
         assert_eq!(knobs.label(), "sapnet-tau-exp4-0.5-episode-decay0.999");
+        let judged = |judgment| {
+            SapNetKnobs {
+                judgment,
+                ..SapNetKnobs::default()
+            }
+            .label()
+        };
+        assert_eq!(judged(Judgment::TdChange), "sapnet-td");
+        assert_eq!(judged(Judgment::Advantage), "sapnet-advantage");
+        assert_eq!(judged(Judgment::EpisodeAndLoss), "sapnet-episode-and-loss");
     }
 
     #[test]

@@ -119,6 +119,14 @@ pub struct RunRecord<M = MethodId> {
     /// The first step at which one source's probability of being picked exceeded 0.99
     /// (lock-in), for selectors with probabilities.
     pub lock_in_step: Option<u64>,
+    /// Positive and negative judgments of each source over the run (SAP-Net's eq. 7 or
+    /// its `judgment` knob; a judgment deferred to an episode's end counts if the episode
+    /// ended). Zeros for a method that does not judge, empty without a library (and in
+    /// results written before the field existed).
+    #[serde(default)]
+    pub positive: Vec<u64>,
+    #[serde(default)]
+    pub negative: Vec<u64>,
     /// Returns of the greedy test episodes after training (empty if stopped before).
     pub test_returns: Vec<f64>,
     /// Stopped by the user before the planned episodes were done.
@@ -139,6 +147,8 @@ impl RunRecord<String> {
             chosen: self.chosen,
             source_steps: self.source_steps,
             lock_in_step: self.lock_in_step,
+            positive: self.positive,
+            negative: self.negative,
             test_returns: self.test_returns,
             stopped: self.stopped,
             wall_s: self.wall_s,

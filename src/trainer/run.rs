@@ -180,6 +180,25 @@ impl Learners<'_> {
         }
     }
 
+    /// `max_a Q(obs, a)` of the network that acts as `actor`.
+    fn value(&self, actor: Actor, obs: &[f32]) -> Result<f64, DqnError> {
+        match actor {
+            Actor::Source(i) => self.agents[i].value(obs),
+            Actor::SourceGreedy(i) => self.sources[i].net.max_q(obs).map(f64::from),
+            Actor::Learner => self.learner().value(obs),
+        }
+    }
+
+    /// `max_a Q_j(obs, a)` of every source: its learning copy, if sources learn.
+    fn source_values(&self, obs: &[f32]) -> Result<Vec<f64>, DqnError> {
+        if self.agents.is_empty() {
+            let values = self.sources.iter().map(|s| s.net.max_q(obs).map(f64::from));
+            values.collect()
+        } else {
+            self.agents.iter().map(|a| a.value(obs)).collect()
+        }
+    }
+
     fn learner(&self) -> &DqnAgent {
         self.learner
             .as_ref()
@@ -232,6 +251,7 @@ pub fn selector(spec: &RunSpec) -> Result<Box<dyn reuse::Selector>, TrainerError
     let library = reuse::Library {
         descriptions: &descriptions,
         scores: &scores,
+        gamma: spec.dqn.gamma,
         return_range: spec.env.return_range(),
         discounted_return_range: spec.env.discounted_return_range(spec.dqn.gamma),
     };
@@ -257,8 +277,10 @@ pub fn train(
         spec.sources.iter().map(|s| s.description.clone()).collect();
     let mut selector = selector(spec)?;
     let learning = selector.learning();
+    // Asked once: a method that needs nothing measures nothing.
+    let needs = selector.needs();
     let n = spec.sources.len();
-    let agents = match learning {
+    let mut agents = match learning {
         Learning::ActingSource => spec
             .sources
             .iter()
@@ -266,6 +288,9 @@ pub fn train(
             .collect::<Result<Vec<_>, _>>()?,
         Learning::Learner => Vec::new(),
     };
+    if needs.td_error {
+        agents.iter_mut().for_each(|a| a.measure_td_error(true));
+    }
     let learner = match spec.reuse.learner_hidden() {
         Some(hidden) => {
             let architecture =
@@ -306,6 +331,8 @@ pub fn train(
         chosen: None,
         source_steps: Vec::new(),
         lock_in_step: None,
+        positive: Vec::new(),
+        negative: Vec::new(),
         test_returns: Vec::new(),
         stopped: false,
         wall_s: 0.0,
@@ -377,6 +404,11 @@ pub fn train(
                 selector.act(&mut selection_rng)
             };
             let action = learners.act(actor, &obs, &mut rng)?;
+            // V_i(s_t) of the acting source as it acts, before its update.
+            let value = match actor.source() {
+                Some(i) if needs.values && !in_warm_up => Some((i, learners.value(actor, &obs)?)),
+                _ => None,
+            };
             let step = env.step(action)?;
             replay.push(Transition {
                 obs: &obs,
@@ -389,6 +421,9 @@ pub fn train(
             steps += 1;
             if let Some(i) = actor.source() {
                 last_source = i;
+            }
+            if let Some((i, value)) = value {
+                selector.on_acted(i, step.reward, value);
             }
 
             let mut report = None;
@@ -483,6 +518,11 @@ pub fn train(
             discount *= spec.dqn.gamma;
             episode_steps += 1;
             if step.done() {
+                let bootstrapped =
+                    step.truncated && !step.terminated && !spec.dqn.truncation_as_terminal;
+                if needs.values && bootstrapped {
+                    selector.on_truncated(&learners.source_values(step.obs)?);
+                }
                 obs.copy_from_slice(env.reset(None)?);
                 break;
             }
@@ -519,6 +559,8 @@ pub fn train(
     record.steps = steps;
     record.updates = learners.updates();
     record.source_steps = tally.run.clone();
+    let view = selector.view();
+    (record.positive, record.negative) = (view.positive, view.negative);
     let net = match selector.chosen() {
         Some(chosen) => {
             let view = selector.view();

@@ -124,6 +124,7 @@ mod tests {
             loss: 0.5,
             previous_statistic_loss: e.0,
             statistic_loss: e.1,
+            td: None,
         });
         Event::Step(StepRecord {
             run: 0,

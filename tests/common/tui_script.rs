@@ -109,6 +109,7 @@ pub fn episodes(episodes: u32) -> Vec<Event> {
                 loss: 0.05,
                 previous_statistic_loss: 0.0421,
                 statistic_loss: 0.0417,
+                td: None,
             }),
             judgment: Some(true),
             deposit: Some(Deposit {
@@ -172,6 +173,8 @@ pub fn sapnet_end(episodes: u32) -> Event {
         }),
         source_steps: Vec::new(),
         lock_in_step: None,
+        positive: Vec::new(),
+        negative: Vec::new(),
         test_returns: vec![500.0, 500.0, 487.0, 500.0, 500.0],
         stopped: false,
         wall_s: 12.5,

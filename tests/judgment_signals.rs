@@ -1,0 +1,119 @@
+//! SAP-Net's judgments beyond the loss end to end: `assets/judgments_cartpole.ron` run
+//! headless with `--quick` on a copy of the shipped CartPole library. Every method is in
+//! the summary, and each judges as its rule says: the TD error's change and eq. 7 with the
+//! return once per update, the advantage once per acting step (one update per step here:
+//! the same count), each with positives and negatives.
+
+use std::path::Path;
+use std::process::Command;
+
+fn copy_library(task: &str, library: &Path) {
+    let from = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("saved_policies")
+        .join(task);
+    let to = library.join(task);
+    std::fs::create_dir_all(&to).unwrap();
+    for entry in std::fs::read_dir(&from).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_file() {
+            std::fs::copy(&path, to.join(path.file_name().unwrap())).unwrap();
+        }
+    }
+}
+
+fn sum(run: &serde_json::Value, key: &str) -> u64 {
+    run[key]
+        .as_array()
+        .unwrap_or_else(|| panic!("{key} in {run}"))
+        .iter()
+        .map(|n| n.as_u64().unwrap())
+        .sum()
+}
+
+#[test]
+fn the_quick_judgments_protocol_counts_every_new_judgment() {
+    let dir = tempfile::tempdir().unwrap();
+    let (library, out) = (dir.path().join("library"), dir.path().join("out"));
+    copy_library("cartpole", &library);
+    let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/judgments_cartpole.ron");
+    let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args(["--headless", "--quick", "--jobs", "2", "--config"])
+        .arg(&config)
+        .arg("--library")
+        .arg(&library)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let runs = summary["runs"].as_array().unwrap();
+    for method in [
+        "sapnet",
+        "sapnet-episode",
+        "sapnet-td",
+        "sapnet-advantage",
+        "sapnet-episode-and-loss",
+    ] {
+        let of_method: Vec<_> = runs.iter().filter(|r| r["method"] == method).collect();
+        assert_eq!(of_method.len(), 2, "{method}: {} runs", of_method.len());
+        for run in of_method {
+            let (positive, negative) = (sum(run, "positive"), sum(run, "negative"));
+            assert!(
+                positive > 0 && negative > 0,
+                "{method}: {positive} / {negative}"
+            );
+            let updates = run["updates"].as_u64().unwrap();
+            if method == "sapnet-episode" {
+                // Once per episode for each source that acted in it.
+                assert!(positive + negative < updates, "{method}");
+            } else {
+                // No run's last episode is cut (no step budget): every judgment is made.
+                assert_eq!(positive + negative, updates, "{method}: run {}", run["run"]);
+            }
+        }
+    }
+    // DQN from scratch reuses nothing and judges nothing.
+    let dqn = runs.iter().find(|r| r["method"] == "dqn[100]").unwrap();
+    assert_eq!(dqn["positive"], serde_json::json!([]));
+    let comparison = std::fs::read_to_string(out.join("comparison.csv")).unwrap();
+    for method in ["sapnet-td", "sapnet-advantage", "sapnet-episode-and-loss"] {
+        assert!(
+            comparison
+                .lines()
+                .any(|l| l.starts_with(&format!("{method},"))),
+            "{method} in comparison.csv:\n{comparison}"
+        );
+    }
+}
+
+/// The new judgments carry no value, so what can be wrong is the name: refused at the
+/// field with the judgments there are. A judgment with a knob beside it loads.
+#[test]
+fn a_judgment_is_named_or_refused_at_its_field() {
+    use sapnet::config::Config;
+    let err = Config::from_ron(
+        "(protocol: (methods: [SapNet, SapNetWith(judgment: Td)]))",
+        "x.ron",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("field `protocol.methods[1].SapNetWith.judgment`")
+            && err.contains("`TdChange`, `Advantage`, or `EpisodeAndLoss`"),
+        "{err}"
+    );
+    let config = Config::from_ron(
+        "(protocol: (methods: [SapNetWith(judgment: EpisodeAndLoss, decay: 0.99), \
+         SapNetWith(judgment: Advantage, label: Some(\"adv\"))]))",
+        "x.ron",
+    )
+    .unwrap();
+    let labels: Vec<String> = config.protocol.methods.iter().map(|m| m.label()).collect();
+    assert_eq!(labels, ["sapnet-episode-and-loss-decay0.99", "adv"]);
+}
