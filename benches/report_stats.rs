@@ -46,6 +46,7 @@ fn protocol(runs: u32) -> Protocol {
                 lock_in_step: Some(600),
                 positive: Vec::new(),
                 negative: Vec::new(),
+                exclusions: 0,
                 test_returns: (0..5).map(|_| rng.random_range(0.0..500.0)).collect(),
                 stopped: false,
                 wall_s: 0.0,

@@ -186,8 +186,10 @@ pub enum Method {
     /// Transfer learning with SAP-Net over the source library (Algorithm 3), as the paper
     /// specifies it.
     SapNet,
-    /// SAP-Net with knobs beyond the paper: a temperature schedule, another judgment,
-    /// activation decay (`SapNetWith(judgment: Episode)`; every knob left out is the paper's).
+    /// SAP-Net with knobs beyond the paper: a temperature schedule, another judgment
+    /// (`Episode`, `KSteps(k)`, `TdChange`, `Advantage`, `EpisodeAndLoss`: docs/REUSE.md,
+    /// docs/FUTURE_WORK.md), activation decay (`SapNetWith(judgment: Episode)`; every knob
+    /// left out is the paper's).
     SapNetWith(SapNetKnobs),
     /// A uniformly random source acts (and fine-tunes) at every step.
     Random,

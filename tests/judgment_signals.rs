@@ -59,6 +59,7 @@ fn the_quick_judgments_protocol_counts_every_new_judgment() {
         "sapnet-td",
         "sapnet-advantage",
         "sapnet-episode-and-loss",
+        "sapnet-exclude10x1000",
     ] {
         let of_method: Vec<_> = runs.iter().filter(|r| r["method"] == method).collect();
         assert_eq!(of_method.len(), 2, "{method}: {} runs", of_method.len());
@@ -77,6 +78,13 @@ fn the_quick_judgments_protocol_counts_every_new_judgment() {
                 assert_eq!(positive + negative, updates, "{method}: run {}", run["run"]);
             }
         }
+    }
+    // Candidates by category: 10 negatives in a row of a category happen within a quick
+    // run; only the method with the knob excludes.
+    for run in runs {
+        let excluding = run["method"] == "sapnet-exclude10x1000";
+        let exclusions = run["exclusions"].as_u64().unwrap();
+        assert_eq!(exclusions > 0, excluding, "{}: {exclusions}", run["method"]);
     }
     // DQN from scratch reuses nothing and judges nothing.
     let dqn = runs.iter().find(|r| r["method"] == "dqn[100]").unwrap();
@@ -116,4 +124,14 @@ fn a_judgment_is_named_or_refused_at_its_field() {
     .unwrap();
     let labels: Vec<String> = config.protocol.methods.iter().map(|m| m.label()).collect();
     assert_eq!(labels, ["sapnet-episode-and-loss-decay0.99", "adv"]);
+    let err = Config::from_ron(
+        "(protocol: (methods: [SapNetWith(exclusion: Some(after: 0, steps: 5))]))",
+        "x.ron",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("field `protocol.methods[0].exclusion.after`: expected at least 1"),
+        "{err}"
+    );
 }

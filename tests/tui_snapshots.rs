@@ -93,6 +93,44 @@ fn the_reward_chart_names_its_curves_in_its_title_at_every_size() {
     }
 }
 
+/// A category out of the candidates (`SapNetWith(exclusion: …)`): its nodes are drawn `×`
+/// and the graph's title counts them, on the dashboard and in teach mode on the live net.
+#[test]
+fn an_excluded_category_is_shown_on_the_graph_and_in_teach() {
+    let mut d = dashboard();
+    // The one-hidden-layer sources 0, 4 and 9, as the trainer's snapshot gives them.
+    let excluded: Vec<bool> = (0..10).map(|i| [0, 4, 9].contains(&i)).collect();
+    let Event::Activations(mut snapshot) = tui_script::probabilities_at(
+        tui_script::method("sapnet"),
+        6_500,
+        (0..10).map(|i| if i == 6 { 1.0 } else { 0.0 }).collect(),
+    ) else {
+        unreachable!()
+    };
+    snapshot.excluded = excluded.clone();
+    d.on_event(Event::Activations(snapshot));
+    assert_eq!(d.sapnet.as_ref().unwrap().excluded, excluded);
+    for size in SIZES {
+        let terminal = draw_dashboard(&d, size);
+        let screen = format!("{}", terminal.backend());
+        assert!(screen.contains("SAP-Net graph · × 3 excluded"), "{screen}");
+        for node in ["×0", "×4", "×9"] {
+            assert!(screen.contains(node), "{size:?}: {node} in\n{screen}");
+        }
+        insta::assert_snapshot!(
+            format!("dashboard_excluded_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+    d.on_key(key('t'));
+    let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
+    terminal
+        .draw(|f| view::draw_dashboard(f, &d, Theme::plain()))
+        .unwrap();
+    let screen = format!("{}", terminal.backend());
+    assert!(screen.contains("×0") && screen.contains("×9"), "{screen}");
+}
+
 #[test]
 fn dashboard_after_the_run_names_the_chosen_policy_and_its_tests() {
     let mut d = dashboard();

@@ -112,6 +112,7 @@ mod tests {
             lock_in_step: None,
             positive: Vec::new(),
             negative: Vec::new(),
+            exclusions: 0,
             test_returns: vec![10.0, 20.0],
             stopped: false,
             wall_s: 0.0,

@@ -84,6 +84,7 @@ mod tests {
             lock_in_step: None,
             positive: Vec::new(),
             negative: Vec::new(),
+            exclusions: 0,
             test_returns: tests,
             stopped: false,
             wall_s: 0.0,

@@ -57,6 +57,7 @@ impl Selector for BestSource {
             probabilities,
             positive: vec![0; n],
             negative: vec![0; n],
+            excluded: Vec::new(),
         }
     }
 

@@ -21,6 +21,7 @@
 //! an arm in [`build`].
 
 pub mod best_source;
+pub mod exclusion;
 pub mod prql;
 pub mod random;
 pub mod sapnet;
@@ -109,6 +110,9 @@ pub struct SelectorView {
     /// are made: a judgment deferred to the episode's end counts then.
     pub positive: Vec<u64>,
     pub negative: Vec<u64>,
+    /// Per source, whether it is out of the candidates now ([`exclusion`]); empty for a
+    /// method that excludes none.
+    pub excluded: Vec<bool>,
 }
 
 /// The change of the scores that a positive judgment made: on the judged source (eq. 8,
@@ -123,6 +127,11 @@ pub struct Deposit {
 pub trait Selector: Send + fmt::Debug {
     /// Who learns from the run's steps.
     fn learning(&self) -> Learning;
+
+    /// Times a category was left out of the candidates so far ([`exclusion`]).
+    fn exclusions_made(&self) -> u64 {
+        0
+    }
 
     /// Who chooses the action of the next step (after the warm-up).
     fn act(&mut self, rng: &mut StdRng) -> Actor;

@@ -246,6 +246,7 @@ impl Selector for Prql {
             probabilities: self.probabilities()[1..].to_vec(),
             positive: vec![0; n],
             negative: vec![0; n],
+            excluded: Vec::new(),
         }
     }
 

@@ -77,6 +77,7 @@ impl Selector for Random {
             probabilities,
             positive: vec![0; self.n],
             negative: vec![0; self.n],
+            excluded: Vec::new(),
         }
     }
 

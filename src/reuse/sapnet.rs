@@ -7,6 +7,7 @@
 use rand::rngs::StdRng;
 use serde::{Deserialize, Serialize};
 
+use super::exclusion::{Exclusion, Exclusions};
 use super::schedule::Schedule;
 use super::{Activation, Actor, Deposit, EpisodeEnd, Learning, Needs, Selector, SelectorView};
 use crate::dqn::UpdateReport;
@@ -64,6 +65,10 @@ pub struct SapNetKnobs {
     /// λ in (0, 1]: every activation is multiplied by λ after every learning step
     /// (1: the paper).
     pub decay: f64,
+    /// Candidates by category: a category of the first prototype's whose members are judged
+    /// negative `after` times in a row is left out of eq. 6 for `steps` learning steps
+    /// ([`super::exclusion`]). `None`: every policy is a candidate (the paper).
+    pub exclusion: Option<Exclusion>,
 }
 
 impl Default for SapNetKnobs {
@@ -73,6 +78,7 @@ impl Default for SapNetKnobs {
             temperature: None,
             judgment: Judgment::Step,
             decay: 1.0,
+            exclusion: None,
         }
     }
 }
@@ -102,6 +108,9 @@ impl SapNetKnobs {
         if self.decay != 1.0 {
             label.push_str(&format!("-decay{}", self.decay));
         }
+        if let Some(e) = self.exclusion {
+            label.push_str(&format!("-exclude{}x{}", e.after, e.steps));
+        }
         label
     }
 
@@ -120,6 +129,9 @@ impl SapNetKnobs {
             return Err(format!(
                 "field `{field}.judgment`: expected KSteps(k) with k ≥ 1, got KSteps(0)"
             ));
+        }
+        if let Some(exclusion) = &self.exclusion {
+            exclusion.validate(&format!("{field}.exclusion"))?;
         }
         if let Some(label) = &self.label {
             super::check_label(field, label)?;
@@ -180,6 +192,8 @@ pub struct SapNetSelector {
     traced: Vec<Activation>,
     /// What the latest positive judgment deposited (eq. 8–11).
     deposit: Deposit,
+    /// Candidates by category, when the knob is set.
+    exclusions: Option<Exclusions>,
 }
 
 impl SapNetSelector {
@@ -194,7 +208,17 @@ impl SapNetSelector {
             params.temperature = schedule.at(0);
         }
         let n = policies.len();
+        let exclusions = knobs.exclusion.map(|rule| {
+            let prototype = params
+                .prototypes
+                .first()
+                .map_or(crate::sapnet::Prototype::HiddenLayers, |p| {
+                    p.prototype.clone()
+                });
+            Exclusions::new(rule, prototype.group_indices(policies))
+        });
         Ok(Self {
+            exclusions,
             net: SapNet::from_policies(policies, params)?,
             knobs: knobs.clone(),
             gamma,
@@ -211,6 +235,14 @@ impl SapNetSelector {
             traced: Vec::new(),
             deposit: Deposit::default(),
         })
+    }
+
+    /// Eq. 6's probabilities, over the candidates while a category is excluded.
+    fn probabilities(&self) -> Vec<f64> {
+        match &self.exclusions {
+            Some(e) if e.any() => self.net.candidate_probabilities(&e.excluded()),
+            _ => self.net.probabilities(),
+        }
     }
 
     /// The SAP-Net, with its graph and activations.
@@ -239,6 +271,9 @@ impl SapNetSelector {
 
     /// Counts the judgment, then activates `i` (eq. 8–11) if it was positive.
     fn judged(&mut self, i: usize, positive: bool) {
+        if let Some(exclusions) = &mut self.exclusions {
+            exclusions.judged(i, positive, self.steps);
+        }
         if !positive {
             self.negative[i] += 1;
             return;
@@ -267,9 +302,16 @@ impl Selector for SapNetSelector {
         Learning::ActingSource
     }
 
+    fn exclusions_made(&self) -> u64 {
+        self.exclusions.as_ref().map_or(0, Exclusions::made)
+    }
+
     /// Eq. 6.
     fn act(&mut self, rng: &mut StdRng) -> Actor {
-        let i = self.net.select(rng);
+        let i = match &self.exclusions {
+            Some(e) if e.any() => self.net.select_candidate(&e.excluded(), rng),
+            _ => self.net.select(rng),
+        };
         self.acted[i] = true;
         Actor::Source(i)
     }
@@ -318,6 +360,9 @@ impl Selector for SapNetSelector {
 
     fn on_step(&mut self) {
         self.steps += 1;
+        if let Some(exclusions) = &mut self.exclusions {
+            exclusions.at_step(self.steps);
+        }
         if self.knobs.decay != 1.0 {
             self.net.decay(self.knobs.decay);
         }
@@ -377,9 +422,13 @@ impl Selector for SapNetSelector {
         SelectorView {
             score_name: "A",
             scores: self.net.activations().to_vec(),
-            probabilities: self.net.probabilities(),
+            probabilities: self.probabilities(),
             positive: self.positive.clone(),
             negative: self.negative.clone(),
+            excluded: self
+                .exclusions
+                .as_ref()
+                .map_or_else(Vec::new, Exclusions::excluded),
         }
     }
 
@@ -388,7 +437,10 @@ impl Selector for SapNetSelector {
     }
 
     fn top_probability(&self) -> Option<f64> {
-        Some(self.net.top_probability())
+        match &self.exclusions {
+            Some(e) if e.any() => self.probabilities().into_iter().reduce(f64::max),
+            _ => Some(self.net.top_probability()),
+        }
     }
 
     /// The highest activation (Algorithm 3).
@@ -429,6 +481,43 @@ mod tests {
             PolicyDescription::new(vec![8, 8], "t"),
         ];
         SapNetSelector::new(&policies, SapNetParams::default(), &knobs, 0.99).unwrap()
+    }
+
+    /// Policy 0 (one hidden layer) judged negative twice in a row: its category is out of
+    /// eq. 6 for 5 steps, never drawn and at probability 0 meanwhile, though it holds the
+    /// larger activation; then it is a candidate again.
+    #[test]
+    fn an_excluded_category_is_never_selected_while_excluded() {
+        use rand::SeedableRng;
+        let mut s = selector(SapNetKnobs {
+            exclusion: Some(Exclusion { after: 2, steps: 5 }),
+            ..SapNetKnobs::default()
+        });
+        assert_eq!(s.on_update(0, &report(0.5, 0.4)), Some(true));
+        assert_eq!(s.view().scores, vec![1.0, 0.0]);
+        s.on_update(0, &report(0.4, 0.6));
+        assert!(s.view().excluded.iter().all(|e| !e), "one negative of two");
+        s.on_update(0, &report(0.6, 0.7));
+        assert_eq!(s.view().excluded, vec![true, false]);
+        assert_eq!(s.view().probabilities, vec![0.0, 1.0]);
+        assert_eq!(s.top_probability(), Some(1.0));
+        let mut rng = StdRng::seed_from_u64(1);
+        for _ in 0..4 {
+            for _ in 0..100 {
+                assert_eq!(s.act(&mut rng), Actor::Source(1));
+            }
+            s.on_step();
+        }
+        assert_eq!(s.view().excluded, vec![true, false], "step 4 of 5");
+        s.on_step();
+        assert_eq!(s.view().excluded, vec![false, false]);
+        let p = s.view().probabilities;
+        assert!(
+            (p[0] - 1.0_f64.exp() / (1.0 + 1.0_f64.exp())).abs() < 1e-12,
+            "{p:?}"
+        );
+        assert_eq!(s.exclusions_made(), 1);
+        assert_eq!(s.knobs.label(), "sapnet-exclude2x5");
     }
 
     #[test]

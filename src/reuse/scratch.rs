@@ -24,6 +24,7 @@ impl Selector for Scratch {
             probabilities: Vec::new(),
             positive: Vec::new(),
             negative: Vec::new(),
+            excluded: Vec::new(),
         }
     }
 

@@ -87,6 +87,7 @@ impl Selector for Ucb1 {
             probabilities,
             positive: vec![0; n],
             negative: vec![0; n],
+            excluded: Vec::new(),
         }
     }
 

@@ -186,6 +186,16 @@ impl SapNet {
         self.selection.draw(rng)
     }
 
+    /// Eq. 6's probabilities over the candidates only, the `excluded` policies at 0.
+    pub fn candidate_probabilities(&self, excluded: &[bool]) -> Vec<f64> {
+        selection::candidate_probabilities(&self.activations, self.params.temperature, excluded)
+    }
+
+    /// Draws the policy that acts next among the candidates (`excluded[i]` false).
+    pub fn select_candidate(&self, excluded: &[bool], rng: &mut impl Rng) -> usize {
+        selection::select_candidate(&self.activations, self.params.temperature, excluded, rng)
+    }
+
     /// The chosen policy after training: the highest activation, the lowest index on a tie.
     ///
     /// # Panics

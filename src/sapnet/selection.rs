@@ -91,6 +91,48 @@ impl SelectionTerms {
     }
 }
 
+/// Eq. 6 over the candidates only (`excluded[i]` false): the others' probabilities are 0,
+/// and the candidates' are renormalised among themselves. The largest activation of the
+/// candidates is subtracted, not of all: an excluded policy far ahead would otherwise
+/// round every candidate's term to 0.
+///
+/// # Panics
+/// If `excluded` differs in length from `activations` or excludes every policy.
+pub fn candidate_probabilities(activations: &[f64], tau: f64, excluded: &[bool]) -> Vec<f64> {
+    let terms = candidate_terms(activations, tau, excluded);
+    let total: f64 = terms.iter().sum();
+    terms.iter().map(|t| t / total).collect()
+}
+
+/// As [`select`] over the candidates, with the probabilities of
+/// [`candidate_probabilities`]; one uniform number, as [`select`] draws.
+pub fn select_candidate(
+    activations: &[f64],
+    tau: f64,
+    excluded: &[bool],
+    rng: &mut impl Rng,
+) -> usize {
+    let terms = candidate_terms(activations, tau, excluded);
+    let total = terms.iter().sum();
+    draw(terms.into_iter(), total, rng)
+}
+
+fn candidate_terms(activations: &[f64], tau: f64, excluded: &[bool]) -> Vec<f64> {
+    assert_eq!(activations.len(), excluded.len(), "one flag per policy");
+    assert!(excluded.iter().any(|e| !e), "no candidate is left");
+    let max = activations
+        .iter()
+        .zip(excluded)
+        .filter(|(_, &e)| !e)
+        .map(|(&a, _)| a)
+        .fold(f64::NEG_INFINITY, f64::max);
+    activations
+        .iter()
+        .zip(excluded)
+        .map(|(&a, &e)| if e { 0.0 } else { ((a - max) / tau).exp() })
+        .collect()
+}
+
 fn draw(terms: impl Iterator<Item = f64>, total: f64, rng: &mut impl Rng) -> usize {
     let target = rng.random::<f64>() * total;
     let mut running = 0.0;
@@ -119,6 +161,24 @@ mod tests {
     use rand::SeedableRng;
 
     use super::*;
+
+    /// By hand: A = (0, ln 3, 1000) at τ 1 with the third excluded: e^0 and e^{ln 3}
+    /// over their sum, 1/4 and 3/4, and the third never drawn.
+    #[test]
+    fn an_excluded_policy_is_never_drawn_and_the_others_renormalise() {
+        let a = [0.0, 3f64.ln(), 1000.0];
+        let excluded = [false, false, true];
+        let p = candidate_probabilities(&a, 1.0, &excluded);
+        assert!(
+            (p[0] - 0.25).abs() < 1e-12 && (p[1] - 0.75).abs() < 1e-12,
+            "{p:?}"
+        );
+        assert_eq!(p[2], 0.0);
+        let mut rng = StdRng::seed_from_u64(3);
+        for _ in 0..10_000 {
+            assert_ne!(select_candidate(&a, 1.0, &excluded, &mut rng), 2);
+        }
+    }
 
     #[test]
     fn sampling_follows_the_probabilities() {

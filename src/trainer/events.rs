@@ -127,6 +127,10 @@ pub struct RunRecord<M = MethodId> {
     pub positive: Vec<u64>,
     #[serde(default)]
     pub negative: Vec<u64>,
+    /// Times a category was left out of the candidates (`SapNetWith(exclusion: …)`); 0 for
+    /// a method without the knob, and in results written before the field existed.
+    #[serde(default)]
+    pub exclusions: u64,
     /// Returns of the greedy test episodes after training (empty if stopped before).
     pub test_returns: Vec<f64>,
     /// Stopped by the user before the planned episodes were done.
@@ -149,6 +153,7 @@ impl RunRecord<String> {
             lock_in_step: self.lock_in_step,
             positive: self.positive,
             negative: self.negative,
+            exclusions: self.exclusions,
             test_returns: self.test_returns,
             stopped: self.stopped,
             wall_s: self.wall_s,
@@ -224,6 +229,9 @@ pub struct ActivationSnapshot {
     /// step at which one source's probability exceeded [`super::LOCK_IN`], and which. A
     /// screen shows this figure, not the step of the first frame that noticed it.
     pub lock_in: Option<LockIn>,
+    /// Per source, whether it is out of eq. 6's candidates now (its category excluded,
+    /// `SapNetWith(exclusion: …)`); empty when the method excludes none.
+    pub excluded: Vec<bool>,
 }
 
 /// The first step at which `source`'s probability of being picked exceeded

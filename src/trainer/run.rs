@@ -333,6 +333,7 @@ pub fn train(
         lock_in_step: None,
         positive: Vec::new(),
         negative: Vec::new(),
+        exclusions: 0,
         test_returns: Vec::new(),
         stopped: false,
         wall_s: 0.0,
@@ -363,6 +364,7 @@ pub fn train(
             positive: view.positive,
             negative: view.negative,
             lock_in,
+            excluded: view.excluded,
         })
     };
     let send_traces = |selector: &mut dyn Selector, step: u64| {
@@ -561,6 +563,7 @@ pub fn train(
     record.source_steps = tally.run.clone();
     let view = selector.view();
     (record.positive, record.negative) = (view.positive, view.negative);
+    record.exclusions = selector.exclusions_made();
     let net = match selector.chosen() {
         Some(chosen) => {
             let view = selector.view();

@@ -146,6 +146,8 @@ pub struct SapNetView {
     pub selections: Vec<u64>,
     pub positive: Vec<u64>,
     pub negative: Vec<u64>,
+    /// Per policy, whether its category is out of the candidates now (empty: none is).
+    pub excluded: Vec<bool>,
     /// The policy that acted at the latest step.
     pub acting: Option<usize>,
     /// The last policy that activated and spread, and the step it did.
@@ -160,6 +162,11 @@ pub struct SapNetView {
 }
 
 impl SapNetView {
+    /// Whether policy `i` is out of the candidates now.
+    pub fn is_excluded(&self, i: usize) -> bool {
+        self.excluded.get(i).copied().unwrap_or(false)
+    }
+
     /// The category of each policy under the config's first prototype, numbered in order
     /// of appearance.
     pub fn categories(&self) -> Vec<usize> {
@@ -380,6 +387,7 @@ impl Dashboard {
                         selections: vec![0; n],
                         positive: vec![0; n],
                         negative: vec![0; n],
+                        excluded: Vec::new(),
                         acting: None,
                         spread: None,
                         locked: None,
@@ -469,6 +477,7 @@ impl Dashboard {
             view.selections = snapshot.selections;
             view.positive = snapshot.positive;
             view.negative = snapshot.negative;
+            view.excluded = snapshot.excluded;
             // Lock-in as the headless comparison measures it: only for a method that
             // picks by probabilities. UCB1's view gives its next pick probability 1, which
             // is a rule, not a softmax that collapsed.
@@ -653,7 +662,9 @@ impl Dashboard {
             return Action::None;
         };
         let names = view.policies.iter().map(|p| p.name.clone()).collect();
-        let mut teach = Teach::new(names, view.net.clone()).with_groups(view.categories());
+        let mut teach = Teach::new(names, view.net.clone())
+            .with_groups(view.categories())
+            .with_excluded(view.excluded.clone());
         teach.move_cursor(self.cursor as isize);
         self.teach = Some(teach);
         let was_running = self.mode == Mode::Running;

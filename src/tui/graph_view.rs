@@ -32,6 +32,9 @@ pub struct Scene<'a> {
     pub lit: &'a [(usize, usize)],
     /// The edge of the call about to be made (teach).
     pub walking: Option<(usize, usize)>,
+    /// Per policy, whether its category is out of eq. 6's candidates (drawn `×`, dim);
+    /// empty for none.
+    pub excluded: &'a [bool],
 }
 
 /// Draws `scene` in `block` over `area`.
@@ -107,10 +110,15 @@ pub fn draw(frame: &mut Frame, area: Rect, block: Block, scene: Scene, theme: Th
                 if scene.active == Some(i) {
                     style = theme.active();
                 }
+                let excluded = scene.excluded.get(i).copied().unwrap_or(false);
+                if excluded {
+                    style = theme.dim();
+                }
                 if scene.cursor == Some(i) {
                     style = style.patch(theme.cursor());
                 }
-                let text = format!("{}{}", heat_symbol(level), labels[i]);
+                let symbol = if excluded { "×" } else { heat_symbol(level) };
+                let text = format!("{symbol}{}", labels[i]);
                 // Roughly centre the label on the node (0.04 units is about a cell of a
                 // panel 60 cells wide; exact centring would need the panel's width).
                 ctx.print(

@@ -36,6 +36,9 @@ pub struct Teach {
     running: bool,
     /// Category of each policy, to draw related policies together.
     groups: Option<Vec<usize>>,
+    /// Per policy, whether the live run had its category out of the candidates when teach
+    /// mode opened on its net (empty: none, or a lesson).
+    excluded: Vec<bool>,
     /// What `+` and `−` change (`1`…`5`).
     knob: Knob,
     /// Which of the picked policy's edges a weight edit changes (`e` moves it).
@@ -105,6 +108,7 @@ impl Teach {
             walk: None,
             running: false,
             groups: None,
+            excluded: Vec::new(),
             knob: Knob::default(),
             edge: 0,
             last_edit: None,
@@ -120,6 +124,17 @@ impl Teach {
 
     pub fn groups(&self) -> Option<&[usize]> {
         self.groups.as_deref()
+    }
+
+    /// The live run's excluded policies, shown on the graph (spreading by hand ignores them:
+    /// exclusion acts on eq. 6's draw, not on eq. 8–11).
+    pub fn with_excluded(mut self, excluded: Vec<bool>) -> Self {
+        self.excluded = excluded;
+        self
+    }
+
+    pub fn excluded(&self) -> &[bool] {
+        &self.excluded
     }
 
     /// The policies' names as shown: π0… as the lesson gives them, or π1… (`p`).

@@ -208,6 +208,7 @@ pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         active: walk.as_ref().map(|w| w.policy),
         lit: &lit,
         walking: next.map(|c| (c.from, c.to)),
+        excluded: teach.excluded(),
     };
     let params = teach.net().params();
     let title = format!(

@@ -188,12 +188,17 @@ fn draw_training(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
                 active: view.acting,
                 lit: &lit,
                 walking: None,
+                excluded: &view.excluded,
             };
-            let graph_title = if view.score_name == "A" {
+            let mut graph_title = if view.score_name == "A" {
                 "SAP-Net graph".to_string()
             } else {
                 format!("library graph · {} ({})", view.method, view.score_name)
             };
+            let out = view.excluded.iter().filter(|&&e| e).count();
+            if out > 0 {
+                graph_title.push_str(&format!(" · × {out} excluded"));
+            }
             if !graph.is_empty() {
                 graph_view::draw(
                     frame,

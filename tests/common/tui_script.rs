@@ -130,6 +130,7 @@ pub fn episodes(episodes: u32) -> Vec<Event> {
             positive: positive.clone(),
             negative: negative.clone(),
             lock_in: None,
+            excluded: Vec::new(),
         }));
         events.push(episode_end("sapnet", episode, f64::from(length)));
         // The baseline's ~10-step episodes run ahead of SAP-Net's, as they do live.
@@ -175,6 +176,7 @@ pub fn sapnet_end(episodes: u32) -> Event {
         lock_in_step: None,
         positive: Vec::new(),
         negative: Vec::new(),
+        exclusions: 0,
         test_returns: vec![500.0, 500.0, 487.0, 500.0, 500.0],
         stopped: false,
         wall_s: 12.5,
@@ -197,5 +199,6 @@ pub fn probabilities_at(method: MethodId, step: u64, probabilities: Vec<f64>) ->
         positive: vec![0; n],
         negative: vec![0; n],
         lock_in: None,
+        excluded: Vec::new(),
     })
 }
