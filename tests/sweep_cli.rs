@@ -180,6 +180,20 @@ fn a_sweep_through_gnu_parallel_survives_a_killed_cell() {
     assert!(a
         .join("merged/sapnet.temperature=4.0/learning_curve.png")
         .exists());
+    // The value's plots name it, and say what their band is over how many runs: 3 seeds
+    // × 2 runs of each method (DQN's counted once per seed, as above).
+    let value = a.join("merged/sapnet.temperature=4.0");
+    let curve = std::fs::read_to_string(value.join("learning_curve.svg")).unwrap();
+    for text in [
+        "sapnet.temperature = 4.0 · ",
+        "band: ± 1 sd over 6 runs",
+        "sapnet (6 runs)",
+    ] {
+        assert!(curve.contains(text), "learning_curve.svg lacks {text:?}");
+    }
+    let intervals = std::fs::read_to_string(value.join("intervals.svg")).unwrap();
+    assert!(intervals.contains("sapnet.temperature = 4.0 · "));
+    assert!(intervals.contains("over 6 runs per method"));
 }
 
 #[test]

@@ -100,6 +100,9 @@ pub struct Report {
     pub reference: Option<String>,
     /// Methods left out of a pooled report because they did not run on every task.
     pub left_out: Vec<String>,
+    /// What the report is about beyond its tasks, first in its plots' titles: a sweep's
+    /// axis value. None from [`Report::of`].
+    pub subject: Option<String>,
 }
 
 /// A method's runs gathered from every task: the scores the statistics take.
@@ -184,6 +187,7 @@ impl Report {
             profiles,
             reference,
             left_out,
+            subject: None,
         }
     }
 

@@ -95,7 +95,7 @@ pub fn read(dir: &Path) -> Result<PlotData> {
             let (runs, tested) = (of(&returns), of(&tests));
             (!runs.is_empty()).then_some(Curve {
                 label,
-                sapnet: method.kind == MethodKind::SapNet,
+                kind: method.kind,
                 returns: runs,
                 tests: tested,
             })
@@ -133,6 +133,8 @@ pub fn read(dir: &Path) -> Result<PlotData> {
         .collect();
     Ok(PlotData {
         task: config.env.gym_id(),
+        subject: None,
+        return_range: crate::report::plots::return_bounds(&config.env),
         window: config.protocol.moving_average,
         curves,
         policy_names: read.names,

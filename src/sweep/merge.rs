@@ -144,7 +144,12 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
                 rewards: &pooled.rewards,
             })
             .collect();
-        let report = Report::of(&tasks);
+        let mut report = Report::of(&tasks);
+        report.subject = Some(if axis == ACROSS_TASKS {
+            value.clone()
+        } else {
+            format!("{axis} = {value}")
+        });
         let lead = [axis.clone(), value.clone(), group.len().to_string()];
         let (header, records) = comparison::csv_records(&report.comparison, report.units);
         comparisons.extend(&["axis", "value", "cells"], &lead, &header, records);
@@ -168,7 +173,7 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
             };
             std::fs::create_dir_all(&curves)
                 .with_context(|| format!("creating {}", curves.display()))?;
-            report::write_plots(&curves, &plot_data(pooled))
+            report::write_plots(&curves, &plot_data(pooled, report.subject.clone()))
                 .with_context(|| format!("drawing the plots in {}", curves.display()))?;
         }
         let mut title = format!("{axis} = {value}");
@@ -344,8 +349,8 @@ fn pool(group: &[&Results]) -> Results {
     }
 }
 
-/// Learning curves and tests of the pooled runs.
-fn plot_data(pooled: &Results) -> PlotData {
+/// Learning curves and tests of the pooled runs, titled with `subject` (the axis value).
+fn plot_data(pooled: &Results, subject: Option<String>) -> PlotData {
     let curves = method_ids(&pooled.config)
         .into_iter()
         .filter_map(|id| {
@@ -360,7 +365,7 @@ fn plot_data(pooled: &Results) -> PlotData {
                 .collect();
             (!returns.is_empty()).then(|| Curve {
                 label: id.label().to_string(),
-                sapnet: id.kind == crate::config::MethodKind::SapNet,
+                kind: id.kind,
                 returns,
                 tests: mine.iter().map(|r| r.record.test_returns.clone()).collect(),
             })
@@ -368,6 +373,8 @@ fn plot_data(pooled: &Results) -> PlotData {
         .collect();
     PlotData {
         task: pooled.config.env.gym_id(),
+        subject,
+        return_range: report::plots::return_bounds(&pooled.config.env),
         window: pooled.config.protocol.moving_average,
         curves,
         policy_names: Vec::new(),

@@ -4,7 +4,9 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{method_colour, value_range, Curve, Drawn, PlotData, FAMILY};
+use super::legend::{self, Entry, Swatch};
+use super::palette::{method_pens, Pen};
+use super::{axes, Curve, Drawn, PlotData, FAMILY};
 use crate::report::runs::moving_average;
 
 /// Element-wise mean of series of different lengths: index `i` averages the series that
@@ -37,87 +39,135 @@ pub fn std_over_runs(series: &[Vec<f64>]) -> Vec<f64> {
         .collect()
 }
 
-/// Fig. 5/7: moving average of `window` returns, averaged over runs, one line per method.
+/// The methods' pens, in the order listed.
+fn pens(curves: &[Curve]) -> Vec<Pen> {
+    method_pens(&curves.iter().map(|c| c.kind).collect::<Vec<_>>())
+}
+
+/// The chart's area and the legend's column beside it, a little below the title.
+fn beside_legend<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+) -> (DrawingArea<DB, Shift>, DrawingArea<DB, Shift>) {
+    let width = root.dim_in_pixel().0;
+    let (chart, legend) = root.split_horizontally(width.saturating_sub(legend::WIDTH));
+    (chart, legend.margin(48, 0, 4, 0))
+}
+
+/// Fig. 5/7: moving average of `window` returns, averaged over runs, one line per method,
+/// with a band of ± one standard deviation of the runs' moving averages.
 pub(super) fn learning_curve<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     data: &PlotData,
 ) -> Drawn<DB> {
     root.fill(&WHITE)?;
     let w = data.window.max(1);
-    let lines: Vec<(usize, &Curve, Vec<f64>)> = data
+    // Per method: the mean over runs of each run's moving average, and its spread.
+    let lines: Vec<(Vec<f64>, Vec<f64>)> = data
         .curves
         .iter()
-        .enumerate()
-        .map(|(i, c)| {
+        .map(|c| {
             let averaged: Vec<Vec<f64>> = c.returns.iter().map(|r| moving_average(r, w)).collect();
-            (i, c, mean_over_runs(&averaged))
+            (mean_over_runs(&averaged), std_over_runs(&averaged))
         })
         .collect();
     let episodes = lines
         .iter()
-        .map(|(_, _, l)| l.len() + w - 1)
+        .map(|(l, _)| l.len() + w - 1)
         .max()
         .unwrap_or(w);
-    let (low, high) = value_range(lines.iter().flat_map(|(_, _, l)| l.iter().copied()));
-    let mut chart = ChartBuilder::on(&root)
+    let banded = |i: usize| data.curves[i].returns.len() > 1;
+    let fit = axes::fit(
+        lines.iter().enumerate().flat_map(|(i, (mean, sd))| {
+            let sd = if banded(i) { sd.as_slice() } else { &[] };
+            mean.iter()
+                .copied()
+                .chain(mean.iter().zip(sd).flat_map(|(m, s)| [m - s, m + s]))
+        }),
+        data.return_range,
+    );
+    let (area, legend_area) = beside_legend(&root);
+    let mut chart = ChartBuilder::on(&area)
         .caption(
-            format!(
-                "{}: moving average of {w} episodes, mean of runs",
-                data.task
+            legend::title(
+                data.subject.as_deref(),
+                &format!(
+                    "{}: episode return, moving average of {w}, mean over runs",
+                    data.task
+                ),
             ),
-            (FAMILY, 22),
+            (FAMILY, 20),
         )
         .margin(12)
         // Room for the last x label, which plotters centres on the axis's end.
         .margin_right(30)
         .x_label_area_size(45)
         .y_label_area_size(60)
-        .build_cartesian_2d(0f64..episodes as f64, low..high)?;
+        .build_cartesian_2d(0f64..episodes as f64, fit.low..fit.high)?;
     chart
         .configure_mesh()
-        .x_desc("episode")
-        .y_desc("reward")
+        .x_desc(format!("episode (the last of each window of {w})"))
+        .y_desc(format!("episode return, MA{w}"))
         .x_label_formatter(&|x| format!("{x:.0}"))
         .y_label_formatter(&|y| format!("{y:.0}"))
         .label_style((FAMILY, 15))
         .draw()?;
-    for (i, curve, line) in &lines {
-        let colour = method_colour(&data.curves, *i);
-        let runs = curve.returns.len();
-        if runs > 1 {
-            let averaged: Vec<Vec<f64>> =
-                curve.returns.iter().map(|r| moving_average(r, w)).collect();
-            let spread = std_over_runs(&averaged);
-            let upper = line.iter().zip(&spread).enumerate();
-            let lower = line.iter().zip(&spread).enumerate().rev();
-            let band: Vec<(f64, f64)> = upper
-                .map(|(e, (m, s))| ((e + w) as f64, (m + s).min(high)))
-                .chain(lower.map(|(e, (m, s))| ((e + w) as f64, (m - s).max(low))))
+    let pens = pens(&data.curves);
+    for (i, (mean, spread)) in lines.iter().enumerate() {
+        if banded(i) {
+            let x = |e: usize| (e + w) as f64;
+            let band: Vec<(f64, f64)> = mean
+                .iter()
+                .zip(spread)
+                .enumerate()
+                .map(|(e, (m, s))| (x(e), fit.clamp(m + s)))
+                .chain(
+                    mean.iter()
+                        .zip(spread)
+                        .enumerate()
+                        .rev()
+                        .map(|(e, (m, s))| (x(e), fit.clamp(m - s))),
+                )
                 .collect();
             chart.draw_series(std::iter::once(Polygon::new(
                 band,
-                colour.mix(0.12).filled(),
+                pens[i].colour.mix(0.12).filled(),
             )))?;
         }
-        chart
-            .draw_series(LineSeries::new(
-                line.iter().enumerate().map(|(e, &v)| ((e + w) as f64, v)),
-                colour.stroke_width(2),
-            ))?
-            .label(format!(
-                "{} ({runs} run{})",
-                curve.label,
-                if runs == 1 { "" } else { "s" }
-            ))
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font((FAMILY, 15))
-        .draw()?;
+    // The lines over every band.
+    for (i, (mean, _)) in lines.iter().enumerate() {
+        let points = mean
+            .iter()
+            .enumerate()
+            .map(|(e, &v)| ((e + w) as f64, v))
+            .collect();
+        legend::draw_line(&mut chart, points, pens[i])?;
+    }
+    let entries: Vec<Entry> = data
+        .curves
+        .iter()
+        .zip(&pens)
+        .map(|(c, &pen)| Entry {
+            label: legend::with_runs(&c.label, c.returns.len()),
+            swatch: Swatch::Line(pen),
+        })
+        .collect();
+    let mut notes = vec![];
+    let banded_runs: Vec<usize> = (0..data.curves.len())
+        .filter(|&i| banded(i))
+        .map(|i| data.curves[i].returns.len())
+        .collect();
+    if !banded_runs.is_empty() {
+        notes.push(format!(
+            "band: ± 1 sd over {}",
+            legend::runs_phrase(banded_runs.iter().copied())
+        ));
+    }
+    if banded_runs.len() < data.curves.len() {
+        notes.push("a method of 1 run has no band".into());
+    }
+    notes.extend(fit.note().map(|n| format!("band {n}")));
+    legend::draw(&legend_area, &entries, &notes)?;
     root.present()
 }
 
@@ -128,43 +178,55 @@ pub(super) fn test_bars<DB: DrawingBackend>(
     data: &PlotData,
 ) -> Drawn<DB> {
     root.fill(&WHITE)?;
-    let tested: Vec<(usize, &Curve, Vec<f64>)> = data
+    let pens = pens(&data.curves);
+    // (method, its pen, mean over runs of each test, its spread).
+    let tested: Vec<(&Curve, Pen, Vec<f64>, Vec<f64>)> = data
         .curves
         .iter()
-        .enumerate()
-        .filter(|(_, c)| !c.tests.is_empty())
-        .map(|(i, c)| (i, c, mean_over_runs(&c.tests)))
+        .zip(&pens)
+        .filter(|(c, _)| !c.tests.is_empty())
+        .map(|(c, &pen)| (c, pen, mean_over_runs(&c.tests), std_over_runs(&c.tests)))
         .collect();
     let tests = tested
         .iter()
-        .map(|(_, _, t)| t.len())
+        .map(|(_, _, t, _)| t.len())
         .max()
         .unwrap_or(1)
         .max(1);
-    let (low, high) = value_range(
+    // The bars grow up (or hang down) from 0; whiskers where there are runs to differ.
+    let whiskered = |c: &Curve| c.tests.len() > 1;
+    let fit = axes::fit(
         tested
             .iter()
-            .flat_map(|(_, _, t)| t.iter().copied())
+            .flat_map(|(c, _, means, sd)| {
+                let sd = if whiskered(c) { sd.as_slice() } else { &[] };
+                means
+                    .iter()
+                    .copied()
+                    .chain(means.iter().zip(sd).flat_map(|(m, s)| [m - s, m + s]))
+            })
             .chain([0.0]),
+        data.return_range,
     );
-    // Headroom for the legend above the bars, which grow up (or hang down) from 0: about a
-    // twentieth of the height per method, and some.
-    let high = high + (high - low) * (0.08 + 0.06 * tested.len() as f64);
-    let mut chart = ChartBuilder::on(&root)
+    let (area, legend_area) = beside_legend(&root);
+    let mut chart = ChartBuilder::on(&area)
         .caption(
-            format!("{}: greedy test episodes, mean of runs", data.task),
-            (FAMILY, 22),
+            legend::title(
+                data.subject.as_deref(),
+                &format!("{}: greedy test episodes, mean over runs", data.task),
+            ),
+            (FAMILY, 20),
         )
         .margin(12)
         // Room for the last x label, which plotters centres on the axis's end.
         .margin_right(30)
         .x_label_area_size(45)
         .y_label_area_size(60)
-        .build_cartesian_2d(0.5f64..tests as f64 + 0.5, low..high)?;
+        .build_cartesian_2d(0.5f64..tests as f64 + 0.5, fit.low..fit.high)?;
     chart
         .configure_mesh()
-        .x_desc("test")
-        .y_desc("reward")
+        .x_desc("greedy test episode")
+        .y_desc("episode return")
         .x_labels(tests)
         .x_label_formatter(&|x| format!("{x:.0}"))
         .y_label_formatter(&|y| format!("{y:.0}"))
@@ -173,34 +235,41 @@ pub(super) fn test_bars<DB: DrawingBackend>(
         .draw()?;
     let group = 0.8;
     let width = group / tested.len().max(1) as f64;
-    for (k, (i, curve, means)) in tested.iter().enumerate() {
-        let colour = method_colour(&data.curves, *i);
+    for (k, (curve, pen, means, spread)) in tested.iter().enumerate() {
         let left = |t: usize| t as f64 + 1.0 - group / 2.0 + k as f64 * width;
-        chart
-            .draw_series(means.iter().enumerate().map(|(t, &v)| {
-                Rectangle::new(
-                    [(left(t), 0.0), (left(t) + width * 0.9, v)],
-                    colour.filled(),
-                )
-            }))?
-            .label(curve.label.clone())
-            .legend(move |(x, y)| Rectangle::new([(x, y - 6), (x + 14, y + 6)], colour.filled()));
-        // ± one standard deviation over runs, where there are runs to differ.
-        if curve.tests.len() > 1 {
-            let spread = std_over_runs(&curve.tests);
-            chart.draw_series(means.iter().zip(&spread).enumerate().map(|(t, (&m, &sd))| {
+        chart.draw_series(
+            means.iter().enumerate().flat_map(|(t, &v)| {
+                legend::bar([(left(t), 0.0), (left(t) + width * 0.9, v)], *pen)
+            }),
+        )?;
+        if whiskered(curve) {
+            chart.draw_series(means.iter().zip(spread).enumerate().map(|(t, (&m, &sd))| {
                 let x = left(t) + width * 0.45;
-                ErrorBar::new_vertical(x, (m - sd).max(low), m, (m + sd).min(high), BLACK, 6)
+                ErrorBar::new_vertical(x, fit.clamp(m - sd), m, fit.clamp(m + sd), BLACK, 6)
             }))?;
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font((FAMILY, 15))
-        .draw()?;
+    let entries: Vec<Entry> = tested
+        .iter()
+        .map(|(c, pen, _, _)| Entry {
+            label: legend::with_runs(&c.label, c.tests.len()),
+            swatch: Swatch::Bar(*pen),
+        })
+        .collect();
+    let mut notes = vec![];
+    let whiskered_runs: Vec<usize> = tested
+        .iter()
+        .filter(|(c, ..)| whiskered(c))
+        .map(|(c, ..)| c.tests.len())
+        .collect();
+    if !whiskered_runs.is_empty() {
+        notes.push(format!(
+            "whiskers: ± 1 sd over {}",
+            legend::runs_phrase(whiskered_runs)
+        ));
+    }
+    notes.extend(fit.note().map(|n| format!("whiskers {n}")));
+    legend::draw(&legend_area, &entries, &notes)?;
     root.present()
 }
 
@@ -215,6 +284,53 @@ mod tests {
             vec![2.0, 3.0, 3.0]
         );
         assert!(mean_over_runs(&[]).is_empty());
+    }
+
+    /// `tests.svg` drawn from two SAP-Net runs whose tests differ widely (mean 250 ± 353.6:
+    /// past both ends of CartPole's 0..500) and one DQN run.
+    #[test]
+    fn the_test_bars_say_what_their_whiskers_are_and_where_they_stop() {
+        let data = PlotData {
+            task: "CartPole-v1".into(),
+            subject: None,
+            return_range: Some((0.0, 500.0)),
+            window: 10,
+            curves: vec![
+                Curve {
+                    label: "sapnet".into(),
+                    kind: crate::config::MethodKind::SapNet,
+                    returns: vec![],
+                    tests: vec![vec![0.0, 10.0], vec![500.0, 20.0]],
+                },
+                Curve {
+                    label: "dqn[100]".into(),
+                    kind: crate::config::MethodKind::Dqn,
+                    returns: vec![],
+                    tests: vec![vec![9.0, 10.0]],
+                },
+            ],
+            policy_names: vec![],
+            activations: vec![],
+            acted: vec![],
+        };
+        super::super::register_font().unwrap();
+        let mut svg = String::new();
+        test_bars(
+            SVGBackend::with_string(&mut svg, (1300, 600)).into_drawing_area(),
+            &data,
+        )
+        .unwrap();
+        for text in [
+            "sapnet (2 runs)",
+            "dqn[100] (1 run)",
+            "whiskers: ± 1 sd over 2 runs",
+            "whiskers clamped at the task",
+            "min 0",
+            "and max 500",
+            "episode return",
+        ] {
+            assert!(svg.contains(text), "tests.svg lacks {text:?}");
+        }
     }
 
     #[test]

@@ -11,8 +11,9 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{atomically, colour_of, register_font, Drawn, FAMILY};
-use crate::config::MethodKind;
+use super::legend::{self, Entry, Swatch};
+use super::palette::{method_pens, Pen};
+use super::{atomically, axes, register_font, Drawn, FAMILY};
 use crate::report::{Aggregates, Report, Units};
 use crate::stats::{bootstrap, profile, Estimate};
 
@@ -21,7 +22,7 @@ pub fn write_intervals(dir: &Path, report: &Report) -> Result<()> {
     register_font()?;
     let methods = report.comparison.len().max(1) as u32;
     let panels = (1400, 2 * (40 + 26 * methods) + 80);
-    let square = (1000, 650);
+    let square = (1000 + legend::WIDTH, 650);
     let improvement = (1200, 100 + 26 * methods);
     macro_rules! both {
         ($name:literal, $size:expr, $draw:expr) => {
@@ -49,36 +50,41 @@ fn units(report: &Report) -> &'static str {
     }
 }
 
-fn tasks(report: &Report) -> String {
-    report.tasks.join(", ")
+/// A title: the sweep's axis value if any, the tasks, then `rest`.
+fn title(report: &Report, rest: &str) -> String {
+    legend::title(
+        report.subject.as_deref(),
+        &format!("{}: {rest}", report.tasks.join(", ")),
+    )
 }
 
-/// The methods' colours, as the learning curves give them.
+/// "2 runs" (or "2–5 runs") per method.
+fn runs(report: &Report) -> String {
+    legend::runs_phrase(report.comparison.iter().map(|m| m.runs))
+}
+
+/// The methods' pens, as the learning curves give them.
+fn pens(report: &Report) -> Vec<Pen> {
+    method_pens(&report.comparison.iter().map(|m| m.kind).collect::<Vec<_>>())
+}
+
 fn colours(report: &Report) -> Vec<RGBColor> {
-    let sapnet: Vec<bool> = report
-        .comparison
-        .iter()
-        .map(|m| m.kind == MethodKind::SapNet)
-        .collect();
-    (0..sapnet.len()).map(|i| colour_of(&sapnet, i)).collect()
+    pens(report).iter().map(|p| p.colour).collect()
 }
 
 /// Two rows of panels (the test score, the training return), one column per aggregate:
 /// a method's bar spans its 95% interval, the tick marks the point.
 fn aggregates<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Report) -> Drawn<DB> {
     root.fill(&WHITE)?;
-    let runs: Vec<usize> = report.comparison.iter().map(|m| m.runs).collect();
-    let runs = match (runs.iter().min(), runs.iter().max()) {
-        (Some(lo), Some(hi)) if lo == hi => format!("{lo} runs"),
-        (Some(lo), Some(hi)) => format!("{lo}–{hi} runs"),
-        _ => "no runs".into(),
-    };
-    let (title, body) = root.split_vertically(50);
-    title.titled(
-        &format!(
-            "{}: 95% stratified bootstrap intervals ({} resamples) over {runs} per method",
-            tasks(report),
-            bootstrap::RESAMPLES
+    let (heading, body) = root.split_vertically(50);
+    heading.titled(
+        &title(
+            report,
+            &format!(
+                "95% stratified bootstrap intervals ({} resamples) over {} per method",
+                bootstrap::RESAMPLES,
+                runs(report)
+            ),
         ),
         (FAMILY, 22),
     )?;
@@ -127,7 +133,7 @@ fn interval_panel<DB: DrawingBackend>(
     colours: &[RGBColor],
     with_names: bool,
 ) -> Drawn<DB> {
-    let (low, high) = super::value_range(
+    let (low, high) = axes::value_range(
         estimates
             .iter()
             .flatten()
@@ -174,7 +180,7 @@ fn interval_panel<DB: DrawingBackend>(
         let colour = colours[i];
         chart.draw_series(std::iter::once(Rectangle::new(
             [(e.lo, y - 0.32), (e.hi.max(e.lo), y + 0.32)],
-            colour.mix(0.55).filled(),
+            colour.mix(0.8).filled(),
         )))?;
         chart.draw_series(std::iter::once(PathElement::new(
             [(e.point, y - 0.4), (e.point, y + 0.4)],
@@ -185,17 +191,16 @@ fn interval_panel<DB: DrawingBackend>(
 }
 
 /// Performance profiles of the normalised test score: the share of runs above τ, with a
-/// 95% band.
+/// 95% band; the legend beside.
 fn profiles<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Report) -> Drawn<DB> {
     root.fill(&WHITE)?;
     let levels = profile::levels();
-    let colours = colours(report);
-    let mut chart = ChartBuilder::on(&root)
+    let pens = pens(report);
+    let width = root.dim_in_pixel().0;
+    let (area, legend_area) = root.split_horizontally(width.saturating_sub(legend::WIDTH));
+    let mut chart = ChartBuilder::on(&area)
         .caption(
-            format!(
-                "{}: performance profiles of the greedy test score, 95% bands",
-                tasks(report)
-            ),
+            title(report, "performance profiles of the greedy test score"),
             (FAMILY, 20),
         )
         .margin(12)
@@ -210,6 +215,7 @@ fn profiles<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Report) -
         .light_line_style(WHITE)
         .label_style((FAMILY, 15))
         .draw()?;
+    let mut entries = Vec::new();
     for profile in &report.profiles {
         let Some(i) = report
             .comparison
@@ -218,7 +224,7 @@ fn profiles<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Report) -
         else {
             continue;
         };
-        let colour = colours[i];
+        let pen = pens[i];
         let band: Vec<(f64, f64)> = levels
             .iter()
             .zip(&profile.shares)
@@ -233,27 +239,25 @@ fn profiles<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Report) -
             .collect();
         chart.draw_series(std::iter::once(Polygon::new(
             band,
-            colour.mix(0.1).filled(),
+            pen.colour.mix(0.1).filled(),
         )))?;
-        let runs = report.comparison[i].runs;
-        chart
-            .draw_series(LineSeries::new(
-                levels
-                    .iter()
-                    .zip(&profile.shares)
-                    .map(|(&t, e)| (t, e.point)),
-                colour.stroke_width(2),
-            ))?
-            .label(format!("{} ({runs} runs)", profile.method))
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
+        let points = levels
+            .iter()
+            .zip(&profile.shares)
+            .map(|(&t, e)| (t, e.point))
+            .collect();
+        legend::draw_line(&mut chart, points, pen)?;
+        entries.push(Entry {
+            label: legend::with_runs(&profile.method, report.comparison[i].runs),
+            swatch: Swatch::Line(pen),
+        });
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font((FAMILY, 14))
-        .draw()?;
+    let notes = [format!(
+        "band: 95% stratified bootstrap CI ({} resamples) over {}",
+        bootstrap::RESAMPLES,
+        runs(report)
+    )];
+    legend::draw(&legend_area.margin(48, 0, 4, 0), &entries, &notes)?;
     root.present()
 }
 
@@ -264,11 +268,15 @@ fn probabilities<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Repo
     let Some(reference) = &report.reference else {
         return root.present();
     };
-    let (title, body) = root.split_vertically(46);
-    title.titled(
-        &format!(
-            "{}: probability that a run of {reference} beats a run of each method, 95% intervals",
-            tasks(report)
+    let (heading, body) = root.split_vertically(46);
+    heading.titled(
+        &title(
+            report,
+            &format!(
+                "P(a run of {reference} beats a run of each method), 95% stratified \
+                 bootstrap intervals over {}",
+                runs(report)
+            ),
         ),
         (FAMILY, 18),
     )?;
@@ -324,7 +332,7 @@ fn probabilities<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Repo
             let y = (n - 1 - i) as f64;
             chart.draw_series(std::iter::once(Rectangle::new(
                 [(e.lo, y - 0.32), (e.hi.max(e.lo), y + 0.32)],
-                shades[i].mix(0.55).filled(),
+                shades[i].mix(0.8).filled(),
             )))?;
             chart.draw_series(std::iter::once(PathElement::new(
                 [(e.point, y - 0.4), (e.point, y + 0.4)],

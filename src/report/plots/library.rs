@@ -4,9 +4,13 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{
-    marker, mean_over_runs, source_colour, value_range, Drawn, PlotData, FAMILY, SOURCE_COLOURS,
-};
+use super::axes::value_range;
+use super::legend::{self, Entry, Swatch};
+use super::palette::{marker, source_colour, Pen, SOURCE_COLOURS};
+use super::{mean_over_runs, Drawn, PlotData, FAMILY};
+
+/// The width of the sources' legend beside the selection panels.
+const SOURCES_LEGEND: u32 = 200;
 
 /// The activation of each source policy at the end of every episode, averaged over runs.
 pub(super) fn activation_lines<DB: DrawingBackend>(
@@ -30,10 +34,13 @@ pub(super) fn activation_lines<DB: DrawingBackend>(
     let runs = data.activations.len();
     let mut chart = ChartBuilder::on(&root)
         .caption(
-            format!(
-                "{}: activation of each source policy, mean of {runs} run{}",
-                data.task,
-                if runs == 1 { "" } else { "s" }
+            legend::title(
+                data.subject.as_deref(),
+                &format!(
+                    "{}: activation of each source policy, mean of {}",
+                    data.task,
+                    legend::runs_phrase([runs])
+                ),
             ),
             (FAMILY, 22),
         )
@@ -109,14 +116,27 @@ pub(super) fn selection_shares<DB: DrawingBackend>(
 ) -> Drawn<DB> {
     root.fill(&WHITE)?;
     let root = root.titled(
-        &format!(
-            "{}: share of the acting steps taken by each source, mean of runs",
-            data.task
+        &legend::title(
+            data.subject.as_deref(),
+            &format!(
+                "{}: share of the acting steps taken by each source, mean over runs",
+                data.task
+            ),
         ),
         (FAMILY, 20),
     )?;
-    let panels = root.split_evenly((data.acted.len(), 1));
+    // One legend for every panel, beside them, top to bottom as the areas are stacked.
+    let (root, legend_area) = root.split_horizontally(root.dim_in_pixel().0 - SOURCES_LEGEND);
     let policies = data.policy_names.len();
+    let entries: Vec<Entry> = (0..policies)
+        .rev()
+        .map(|p| Entry {
+            label: data.policy_names[p].clone(),
+            swatch: Swatch::Bar(Pen::solid(source_colour(p))),
+        })
+        .collect();
+    legend::draw(&legend_area.margin(30, 0, 0, 0), &entries, &[])?;
+    let panels = root.split_evenly((data.acted.len(), 1));
     for (panel, (label, runs)) in panels.iter().zip(&data.acted) {
         // run → episode → share per policy.
         let shares: Vec<Vec<Vec<f64>>> = runs
@@ -142,9 +162,9 @@ pub(super) fn selection_shares<DB: DrawingBackend>(
             .collect();
         let episodes = per_policy.iter().map(Vec::len).max().unwrap_or(1).max(2);
         let mut chart = ChartBuilder::on(panel)
-            .caption(label.as_str(), (FAMILY, 16))
+            .caption(legend::with_runs(label, runs.len()), (FAMILY, 16))
             .margin(8)
-            .margin_right(140)
+            .margin_right(20)
             .x_label_area_size(30)
             .y_label_area_size(50)
             .build_cartesian_2d(1f64..episodes as f64, 0f64..1f64)?;
@@ -167,21 +187,8 @@ pub(super) fn selection_shares<DB: DrawingBackend>(
                     ((e + 1) as f64, stacked.min(1.0))
                 })
                 .collect();
-            chart
-                .draw_series(AreaSeries::new(top, 0.0, colour.filled()))?
-                .label(data.policy_names[p].clone())
-                .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 5), (x + 12, y + 5)], colour.filled())
-                });
+            chart.draw_series(AreaSeries::new(top, 0.0, colour.filled()))?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .margin(4)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK)
-            .label_font((FAMILY, 11))
-            .draw()?;
     }
     root.present()
 }

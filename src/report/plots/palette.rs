@@ -1,0 +1,260 @@
+//! Every colour the plots use. Methods come in families, one hue each (SAP-Net and its
+//! variants red, the random selectors blue, UCB1 green, PRQ-learning purple, the best
+//! source orange, DQN grey); the members of a family differ in lightness and, on lines,
+//! in dash, so that eleven methods or more stay apart. Source policies get twenty
+//! categorical colours.
+
+use plotters::prelude::*;
+
+use crate::config::MethodKind;
+
+/// How a method's line is stroked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Dash {
+    Solid,
+    Dashed,
+}
+
+/// A method's colour and dash.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Pen {
+    pub colour: RGBColor,
+    pub dash: Dash,
+}
+
+impl Pen {
+    /// A solid pen of `colour` (a source's, in a legend).
+    pub fn solid(colour: RGBColor) -> Self {
+        Self {
+            colour,
+            dash: Dash::Solid,
+        }
+    }
+
+    /// How a bar of this pen is filled: a dashed pen's paler, so that bars side by side
+    /// differ as its lines do.
+    pub fn fill(&self) -> ShapeStyle {
+        match self.dash {
+            Dash::Solid => self.colour.filled(),
+            Dash::Dashed => self.colour.mix(0.35).filled(),
+        }
+    }
+
+    /// A dashed pen's bar is outlined in its colour.
+    pub fn outline(&self) -> Option<ShapeStyle> {
+        (self.dash == Dash::Dashed).then(|| self.colour.stroke_width(2))
+    }
+}
+
+/// The hue (degrees) and saturation of a family; DQN's family is grey.
+fn family(kind: MethodKind) -> (f64, f64) {
+    match kind {
+        MethodKind::SapNet => (0.0, 0.72),
+        MethodKind::Random | MethodKind::RandomPerEpisode => (212.0, 0.65),
+        MethodKind::Ucb1 => (125.0, 0.55),
+        MethodKind::Prql => (280.0, 0.50),
+        MethodKind::BestSource => (30.0, 0.80),
+        MethodKind::Dqn => (0.0, 0.0),
+    }
+}
+
+/// The members of a family in turn: three solid lines 0.2 apart in lightness, then two
+/// dashed ones between them; a sixth member and on repeat with the dash swapped. Neighbours
+/// in this order (bars side by side) are at least 0.2 apart.
+const MEMBERS: [(f64, Dash); 5] = [
+    (0.45, Dash::Solid),
+    (0.25, Dash::Solid),
+    (0.65, Dash::Solid),
+    (0.35, Dash::Dashed),
+    (0.55, Dash::Dashed),
+];
+
+/// The pens of methods of these kinds, in order: member `k` of its family is the `k`-th
+/// method of that family listed.
+pub(super) fn method_pens(kinds: &[MethodKind]) -> Vec<Pen> {
+    kinds
+        .iter()
+        .enumerate()
+        .map(|(i, &kind)| {
+            let (hue, saturation) = family(kind);
+            let member = kinds[..i]
+                .iter()
+                .filter(|&&k| family(k) == (hue, saturation))
+                .count();
+            let (lightness, dash) = MEMBERS[member % MEMBERS.len()];
+            let dash = match (member / MEMBERS.len() % 2, dash) {
+                (0, dash) => dash,
+                (_, Dash::Solid) => Dash::Dashed,
+                (_, Dash::Dashed) => Dash::Solid,
+            };
+            Pen {
+                colour: hsl(hue, saturation, lightness),
+                dash,
+            }
+        })
+        .collect()
+}
+
+/// HSL to RGB (hue in degrees, saturation and lightness in [0, 1]).
+fn hsl(hue: f64, saturation: f64, lightness: f64) -> RGBColor {
+    let chroma = (1.0 - (2.0 * lightness - 1.0).abs()) * saturation;
+    let h = hue.rem_euclid(360.0) / 60.0;
+    let x = chroma * (1.0 - (h % 2.0 - 1.0).abs());
+    let (r, g, b) = match h as u32 {
+        0 => (chroma, x, 0.0),
+        1 => (x, chroma, 0.0),
+        2 => (0.0, chroma, x),
+        3 => (0.0, x, chroma),
+        4 => (x, 0.0, chroma),
+        _ => (chroma, 0.0, x),
+    };
+    let m = lightness - chroma / 2.0;
+    let byte = |v: f64| ((v + m) * 255.0).round().clamp(0.0, 255.0) as u8;
+    RGBColor(byte(r), byte(g), byte(b))
+}
+
+/// Matplotlib's `tab10`, then ten more far from them and from each other (five of
+/// `tab20`'s light tints, navy, maroon, teal, near-black and gold; the nearest pair, the
+/// lavender and the light pink, 50 apart in RGB): twenty colours told apart at a glance
+/// (plotters' `Palette99` puts near-identical ones next to each other). A library of more
+/// than twenty sources repeats them; the activation plot's markers still differ.
+pub(super) const SOURCE_COLOURS: [RGBColor; 20] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+    RGBColor(0, 0, 128),
+    RGBColor(255, 187, 120),
+    RGBColor(152, 223, 138),
+    RGBColor(128, 0, 0),
+    RGBColor(197, 176, 213),
+    RGBColor(0, 128, 128),
+    RGBColor(247, 182, 210),
+    RGBColor(40, 40, 40),
+    RGBColor(219, 219, 141),
+    RGBColor(255, 215, 0),
+];
+
+pub(super) fn source_colour(p: usize) -> RGBColor {
+    SOURCE_COLOURS[p % SOURCE_COLOURS.len()]
+}
+
+/// Marker `shape` (any number: four shapes in turn) at `at` pixels from its anchor.
+pub(super) fn marker<DB: DrawingBackend>(
+    shape: usize,
+    at: (i32, i32),
+    colour: RGBColor,
+) -> DynElement<'static, DB, (i32, i32)> {
+    match shape % 4 {
+        0 => Circle::new(at, 4, colour.filled()).into_dyn(),
+        1 => TriangleMarker::new(at, 6, colour.filled()).into_dyn(),
+        2 => Cross::new(at, 5, colour.stroke_width(2)).into_dyn(),
+        _ => Circle::new(at, 4, colour.stroke_width(2)).into_dyn(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn distance(a: RGBColor, b: RGBColor) -> f64 {
+        let d = |x: u8, y: u8| (f64::from(x) - f64::from(y)).powi(2);
+        (d(a.0, b.0) + d(a.1, b.1) + d(a.2, b.2)).sqrt()
+    }
+
+    /// The hue of an RGB colour in degrees, None for a grey.
+    fn hue(c: RGBColor) -> Option<f64> {
+        let (r, g, b) = (f64::from(c.0), f64::from(c.1), f64::from(c.2));
+        let (max, min) = (r.max(g).max(b), r.min(g).min(b));
+        if max - min < 1.0 {
+            return None;
+        }
+        let h = if max == r {
+            ((g - b) / (max - min)).rem_euclid(6.0)
+        } else if max == g {
+            (b - r) / (max - min) + 2.0
+        } else {
+            (r - g) / (max - min) + 4.0
+        };
+        Some(h * 60.0)
+    }
+
+    #[test]
+    fn hsl_gives_the_known_colours() {
+        // Pure red, a mid grey, and hsl(212°, 65%, 45%): C = 0.585, X = 0.585·(1 − |3.533 % 2
+        // − 1|) = 0.273, m = 0.1575 → (0.1575, 0.4305, 0.7425) → (40, 110, 189).
+        assert_eq!(hsl(0.0, 1.0, 0.5), RGBColor(255, 0, 0));
+        assert_eq!(hsl(0.0, 0.0, 0.5), RGBColor(128, 128, 128));
+        assert_eq!(hsl(212.0, 0.65, 0.45), RGBColor(40, 110, 189));
+    }
+
+    /// The reuse comparison's eleven methods (five SAP-Net, two random, UCB1, PRQ, the best
+    /// source, DQN) and two more DQNs: every pen differs, every family shares one hue.
+    #[test]
+    fn thirteen_methods_get_distinct_pens_with_families_by_hue() {
+        use MethodKind::*;
+        let kinds = [
+            SapNet,
+            SapNet,
+            SapNet,
+            SapNet,
+            SapNet,
+            Random,
+            RandomPerEpisode,
+            Ucb1,
+            Prql,
+            BestSource,
+            Dqn,
+            Dqn,
+            Dqn,
+        ];
+        let pens = method_pens(&kinds);
+        for i in 0..pens.len() {
+            for j in 0..i {
+                let apart = distance(pens[i].colour, pens[j].colour);
+                assert!(apart > 30.0, "methods {j} and {i}: {apart:.1} apart");
+                if family(kinds[i]) == family(kinds[j]) {
+                    match (hue(pens[i].colour), hue(pens[j].colour)) {
+                        (Some(a), Some(b)) => assert!((a - b).abs() < 1.5, "{i} {j}: {a} {b}"),
+                        (None, None) => {}
+                        other => panic!("{i} and {j} of one family: hues {other:?}"),
+                    }
+                } else if let (Some(a), Some(b)) = (hue(pens[i].colour), hue(pens[j].colour)) {
+                    let apart = (a - b).abs().min(360.0 - (a - b).abs());
+                    assert!(apart > 25.0, "families of {i} and {j}: hues {a} and {b}");
+                }
+            }
+        }
+        // The SAP-Net family: three solid then two dashed; a lone comparator is solid.
+        let dashes: Vec<Dash> = pens[..5].iter().map(|p| p.dash).collect();
+        use Dash::*;
+        assert_eq!(dashes, [Solid, Solid, Solid, Dashed, Dashed]);
+        assert_eq!(pens[7].dash, Solid);
+        // The two random selectors are one family: the second is its darker member.
+        assert_eq!(pens[6].colour, hsl(212.0, 0.65, 0.25));
+    }
+
+    #[test]
+    fn a_sixth_member_swaps_the_dash_of_the_first() {
+        let pens = method_pens(&[MethodKind::SapNet; 6]);
+        assert_eq!(pens[5].colour, pens[0].colour);
+        assert_eq!((pens[0].dash, pens[5].dash), (Dash::Solid, Dash::Dashed));
+    }
+
+    #[test]
+    fn twenty_sources_get_distinct_colours() {
+        for i in 0..SOURCE_COLOURS.len() {
+            for j in 0..i {
+                let apart = distance(source_colour(i), source_colour(j));
+                assert!(apart > 45.0, "sources {j} and {i}: {apart:.1} apart");
+            }
+        }
+        assert_eq!(source_colour(20), source_colour(0));
+    }
+}
