@@ -764,8 +764,15 @@ mod tests {
             judgment: Judgment::Episode,
             decay: 0.999,
             label: None,
+            exclusion: Some(Exclusion {
+                after: 3,
+                steps: 40,
+            }),
         };
-        assert_eq!(knobs.label(), "sapnet-tau-exp4-0.5-episode-decay0.999");
+        assert_eq!(
+            knobs.label(),
+            "sapnet-tau-exp4-0.5-episode-decay0.999-exclude3x40"
+        );
         let judged = |judgment| {
             SapNetKnobs {
                 judgment,
