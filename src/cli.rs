@@ -83,7 +83,7 @@ pub struct RunArgs {
 
     /// The dashboard draws a finished protocol's results (a `--headless` output folder)
     /// under the live curves: for each method on screen, the mean of its runs' moving
-    /// averages and a band of ± one standard deviation.
+    /// averages and its 95% bootstrap interval.
     #[arg(long, value_name = "DIR")]
     pub compare: Option<PathBuf>,
 

@@ -31,7 +31,7 @@ fn a_user_pauses_steps_teaches_and_quits() {
         "policies",
         "source-9",
         "RUNNING",
-        "episode reward",
+        "episode return, MA10",
     ]);
     session.keys("Space");
     session.wait_for(&["PAUSED"]);
