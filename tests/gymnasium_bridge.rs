@@ -5,6 +5,8 @@
 
 mod common;
 
+use common::library::copy_library;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -445,22 +447,6 @@ fn the_python_side_killed_fails_the_run_within_a_second() {
         "{message}"
     );
     assert!(message.contains("was killed by signal 9"), "{message}");
-}
-
-/// A copy of a shipped library, so that the chosen policies the runs add to it stay out of
-/// the checkout.
-fn copy_library(task: &str, library: &Path) {
-    let from = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("saved_policies")
-        .join(task);
-    let to = library.join(task);
-    std::fs::create_dir_all(&to).unwrap();
-    for entry in std::fs::read_dir(&from).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_file() {
-            std::fs::copy(&path, to.join(path.file_name().unwrap())).unwrap();
-        }
-    }
 }
 
 /// The shipped variants library is the one its config describes (the manifest's tasks and

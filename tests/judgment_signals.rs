@@ -4,22 +4,12 @@
 //! return once per update, the advantage once per acting step (one update per step here:
 //! the same count), each with positives and negatives.
 
+mod common;
+
+use common::library::copy_library;
+
 use std::path::Path;
 use std::process::Command;
-
-fn copy_library(task: &str, library: &Path) {
-    let from = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("saved_policies")
-        .join(task);
-    let to = library.join(task);
-    std::fs::create_dir_all(&to).unwrap();
-    for entry in std::fs::read_dir(&from).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_file() {
-            std::fs::copy(&path, to.join(path.file_name().unwrap())).unwrap();
-        }
-    }
-}
 
 fn sum(run: &serde_json::Value, key: &str) -> u64 {
     run[key]

@@ -12,6 +12,10 @@
 //! portable paths, checked with `SAPNET_KERNELS=avx2` and `=portable cargo test --test
 //! pinned_numbers`.
 
+mod common;
+
+use common::library::copy_library;
+
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
@@ -108,22 +112,6 @@ fn run_headless(config: &Path, library: &Path, out: &Path, quick: bool, kernels:
         "{}",
         String::from_utf8_lossy(&output.stderr)
     );
-}
-
-/// A copy of a shipped library, so that the chosen policies the runs add to it stay out of
-/// the checkout.
-fn copy_library(task: &str, library: &Path) {
-    let from = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("saved_policies")
-        .join(task);
-    let to = library.join(task);
-    std::fs::create_dir_all(&to).unwrap();
-    for entry in std::fs::read_dir(&from).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_file() {
-            std::fs::copy(&path, to.join(path.file_name().unwrap())).unwrap();
-        }
-    }
 }
 
 #[test]

@@ -1,5 +1,7 @@
 // Each test binary (and the render bench) uses a part of the script.
 #[allow(dead_code)]
+pub mod library;
+#[allow(dead_code)]
 pub mod signal;
 #[allow(dead_code)]
 pub mod tmux;
