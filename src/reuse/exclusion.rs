@@ -50,6 +50,9 @@ pub struct Exclusions {
     negatives: Vec<u32>,
     /// Per category, the learning step at which its exclusion ends.
     until: Vec<Option<u64>>,
+    /// Per policy, whether its category is excluded: `until` seen per policy, kept because
+    /// eq. 6's draw reads it at every step.
+    excluded: Vec<bool>,
     /// Exclusions made so far, per category.
     made: Vec<u64>,
 }
@@ -61,10 +64,11 @@ impl Exclusions {
         let categories = category.iter().max().map_or(0, |&c| c + 1);
         Self {
             rule,
-            category,
             negatives: vec![0; categories],
             until: vec![None; categories],
+            excluded: vec![false; category.len()],
             made: vec![0; categories],
+            category,
         }
     }
 
@@ -84,21 +88,34 @@ impl Exclusions {
         if others_stand {
             self.until[c] = Some(step + self.rule.steps);
             self.made[c] += 1;
+            self.mark();
         }
     }
 
     /// Learning step `step` began: exclusions whose time is up end.
     pub fn at_step(&mut self, step: u64) {
+        let mut ended = false;
         for until in &mut self.until {
             if until.is_some_and(|u| step >= u) {
                 *until = None;
+                ended = true;
             }
+        }
+        if ended {
+            self.mark();
+        }
+    }
+
+    /// Brings `excluded` up to date with `until`.
+    fn mark(&mut self) {
+        for (excluded, &c) in self.excluded.iter_mut().zip(&self.category) {
+            *excluded = self.until[c].is_some();
         }
     }
 
     /// Whether policy `i` is excluded now.
     pub fn is_excluded(&self, i: usize) -> bool {
-        self.until[self.category[i]].is_some()
+        self.excluded[i]
     }
 
     /// Whether any policy is excluded now.
@@ -107,10 +124,8 @@ impl Exclusions {
     }
 
     /// Per policy, whether it is excluded now.
-    pub fn excluded(&self) -> Vec<bool> {
-        (0..self.category.len())
-            .map(|i| self.is_excluded(i))
-            .collect()
+    pub fn excluded(&self) -> &[bool] {
+        &self.excluded
     }
 
     /// Exclusions made so far, over all categories.

@@ -240,7 +240,7 @@ impl SapNetSelector {
     /// Eq. 6's probabilities, over the candidates while a category is excluded.
     fn probabilities(&self) -> Vec<f64> {
         match &self.exclusions {
-            Some(e) if e.any() => self.net.candidate_probabilities(&e.excluded()),
+            Some(e) if e.any() => self.net.candidate_probabilities(e.excluded()),
             _ => self.net.probabilities(),
         }
     }
@@ -309,7 +309,7 @@ impl Selector for SapNetSelector {
     /// Eq. 6.
     fn act(&mut self, rng: &mut StdRng) -> Actor {
         let i = match &self.exclusions {
-            Some(e) if e.any() => self.net.select_candidate(&e.excluded(), rng),
+            Some(e) if e.any() => self.net.select_candidate(e.excluded(), rng),
             _ => self.net.select(rng),
         };
         self.acted[i] = true;
@@ -428,7 +428,7 @@ impl Selector for SapNetSelector {
             excluded: self
                 .exclusions
                 .as_ref()
-                .map_or_else(Vec::new, Exclusions::excluded),
+                .map_or_else(Vec::new, |e| e.excluded().to_vec()),
         }
     }
 

@@ -99,25 +99,32 @@ impl SelectionTerms {
 /// # Panics
 /// If `excluded` differs in length from `activations` or excludes every policy.
 pub fn candidate_probabilities(activations: &[f64], tau: f64, excluded: &[bool]) -> Vec<f64> {
-    let terms = candidate_terms(activations, tau, excluded);
-    let total: f64 = terms.iter().sum();
-    terms.iter().map(|t| t / total).collect()
+    let term = candidate_term(activations, tau, excluded);
+    let total: f64 = (0..activations.len()).map(&term).sum();
+    (0..activations.len()).map(|i| term(i) / total).collect()
 }
 
 /// As [`select`] over the candidates, with the probabilities of
-/// [`candidate_probabilities`]; one uniform number, as [`select`] draws.
+/// [`candidate_probabilities`]; one uniform number, as [`select`] draws, and no
+/// allocation (it runs at every step while a category is excluded).
 pub fn select_candidate(
     activations: &[f64],
     tau: f64,
     excluded: &[bool],
     rng: &mut impl Rng,
 ) -> usize {
-    let terms = candidate_terms(activations, tau, excluded);
-    let total = terms.iter().sum();
-    draw(terms.into_iter(), total, rng)
+    let term = candidate_term(activations, tau, excluded);
+    let total = (0..activations.len()).map(&term).sum();
+    draw((0..activations.len()).map(term), total, rng)
 }
 
-fn candidate_terms(activations: &[f64], tau: f64, excluded: &[bool]) -> Vec<f64> {
+/// Policy i's unnormalised term among the candidates: `exp((A_i − max_cand A)/τ)`, 0 for
+/// an excluded one.
+fn candidate_term<'a>(
+    activations: &'a [f64],
+    tau: f64,
+    excluded: &'a [bool],
+) -> impl Fn(usize) -> f64 + 'a {
     assert_eq!(activations.len(), excluded.len(), "one flag per policy");
     assert!(excluded.iter().any(|e| !e), "no candidate is left");
     let max = activations
@@ -126,11 +133,13 @@ fn candidate_terms(activations: &[f64], tau: f64, excluded: &[bool]) -> Vec<f64>
         .filter(|(_, &e)| !e)
         .map(|(&a, _)| a)
         .fold(f64::NEG_INFINITY, f64::max);
-    activations
-        .iter()
-        .zip(excluded)
-        .map(|(&a, &e)| if e { 0.0 } else { ((a - max) / tau).exp() })
-        .collect()
+    move |i| {
+        if excluded[i] {
+            0.0
+        } else {
+            ((activations[i] - max) / tau).exp()
+        }
+    }
 }
 
 fn draw(terms: impl Iterator<Item = f64>, total: f64, rng: &mut impl Rng) -> usize {

@@ -562,11 +562,10 @@ pub fn train(
     record.updates = learners.updates();
     record.source_steps = tally.run.clone();
     let view = selector.view();
-    (record.positive, record.negative) = (view.positive, view.negative);
+    (record.positive, record.negative) = (view.positive.clone(), view.negative.clone());
     record.exclusions = selector.exclusions_made();
     let net = match selector.chosen() {
         Some(chosen) => {
-            let view = selector.view();
             record.chosen = Some(ChosenPolicy {
                 index: chosen,
                 name: spec.sources[chosen].name.clone(),

@@ -100,18 +100,24 @@ struct Panels {
     trace: Rect,
 }
 
-/// Teach mode's panels in `area`: the call's and the edit's panels as tall as their
-/// wrapped text (at 80 columns both wrap to more lines than fixed heights held), the graph
-/// and the trace taking what is left.
+/// Teach mode's panels in `area`, for hit-testing a click (drawing lays them out from the
+/// paragraphs it draws, [`layout`]).
 fn panels(area: Rect, teach: &Teach) -> Panels {
-    let n = teach.net().len();
+    let call = call_paragraph(teach, Theme::plain());
+    let edits = edits_paragraph(teach, Theme::plain());
+    layout(area, teach.net().len(), &call, &edits)
+}
+
+/// Teach mode's panels in `area` for a net of `n` policies: the call's and the edit's
+/// panels as tall as their wrapped text (at 80 columns both wrap to more lines than fixed
+/// heights held), the graph and the trace taking what is left.
+fn layout(area: Rect, n: usize, call: &Paragraph, edits: &Paragraph) -> Panels {
     let [left, right] =
         Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)]).areas(area);
-    let rows = |paragraph: Paragraph, width: u16| {
+    let rows = |paragraph: &Paragraph, width: u16| {
         u16::try_from(paragraph.line_count(width.saturating_sub(2))).unwrap_or(u16::MAX)
     };
-    let call_rows = rows(call_paragraph(teach, Theme::plain()), left.width)
-        .clamp(9, left.height.saturating_sub(GRAPH_MIN_ROWS));
+    let call_rows = rows(call, left.width).clamp(9, left.height.saturating_sub(GRAPH_MIN_ROWS));
     let [graph, call] = Layout::vertical([
         Constraint::Min(GRAPH_MIN_ROWS),
         Constraint::Length(call_rows),
@@ -120,7 +126,7 @@ fn panels(area: Rect, teach: &Teach) -> Panels {
     let short = area.height < 30;
     let values_rows = (n as u16 + 3).min(right.height / 3);
     let stack_rows = if short { 5 } else { 7 };
-    let edit_rows = rows(edits_paragraph(teach, Theme::plain()), right.width).clamp(
+    let edit_rows = rows(edits, right.width).clamp(
         6,
         right
             .height
@@ -191,7 +197,9 @@ pub fn clicked(teach: &Teach, screen: Rect, column: u16, row: u16) -> Option<usi
 
 /// Teach mode's panels, in the dashboard or on their own.
 pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
-    let panels = panels(area, teach);
+    let call = call_paragraph(teach, theme);
+    let edits = edits_paragraph(teach, theme);
+    let panels = layout(area, teach.net().len(), &call, &edits);
 
     let walk = teach.walk();
     let next = walk.as_ref().and_then(|w| w.pending.last().copied());
@@ -223,8 +231,8 @@ pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         theme,
     );
 
-    frame.render_widget(call_paragraph(teach, theme), panels.call);
-    frame.render_widget(edits_paragraph(teach, theme), panels.edits);
+    frame.render_widget(call, panels.call);
+    frame.render_widget(edits, panels.edits);
     draw_values(frame, panels.values, teach, theme);
     draw_stack(frame, panels.stack, teach, theme);
     draw_trace(frame, panels.trace, teach, theme);
