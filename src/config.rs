@@ -177,6 +177,10 @@ pub struct SourceTaskConfig {
     /// defaults, e.g. `cartpole(length=1.0)`).
     #[serde(default)]
     pub label: Option<String>,
+    /// How a source of another agent (other observation or action space than the target's)
+    /// is reused: χ_X and χ_A (`crate::sources::mapping`, docs/FUTURE_WORK.md).
+    #[serde(default)]
+    pub mapping: Option<crate::sources::InterTaskMapping>,
 }
 
 /// A learner an experiment compares (`protocol.methods`). Each reusing method's selector is
@@ -673,6 +677,19 @@ impl Config {
                 "at least 1",
                 task.count,
             )?;
+            // A Gymnasium task's spaces are known once its Python side runs: loading the
+            // library checks them.
+            if let (Some(source), Some(target)) = (
+                crate::sources::native_spaces(&task.env),
+                crate::sources::native_spaces(&self.env),
+            ) {
+                crate::sources::check_fit(
+                    &format!("sources.tasks[{i}]"),
+                    task.mapping.as_ref(),
+                    source,
+                    target,
+                )?;
+            }
         }
         let total: usize = s.tasks.iter().map(|t| t.count).sum();
         check(

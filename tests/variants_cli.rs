@@ -134,8 +134,8 @@ fn a_library_of_other_tasks_or_sizes_is_refused_by_name() {
     );
     assert!(message.contains("cartpole(length=2.0) ×2"), "{message}");
 
-    // Two families in one library: it trains and loads, and the policies that do not fit
-    // the target's sizes are refused with their file named.
+    // Two families in one library: a task of other sizes than the target's, without a
+    // mapping, is refused at its field before anything trains.
     let mixed = tmp.path().join("mixed.ron");
     std::fs::write(
         &mixed,
@@ -145,21 +145,17 @@ fn a_library_of_other_tasks_or_sizes_is_refused_by_name() {
         ),
     )
     .unwrap();
-    assert!(train(&mixed, &library).status.success());
-    let refused = sapnet(
-        &[
-            "--headless",
-            "--config",
-            mixed.to_str().unwrap(),
-            "--out",
-            tmp.path().join("out2").to_str().unwrap(),
-        ],
-        &library,
-    );
+    let refused = train(&mixed, &library);
     assert_eq!(refused.status.code(), Some(2));
     let message = stderr(&refused);
-    assert!(message.contains("source-2.ron"), "{message}");
-    assert!(message.contains("does not fit"), "{message}");
+    assert!(
+        message.contains(
+            "field `sources.tasks[1]`: its agent has 2 observation values and 3 actions, the \
+             target's 4 observation values and 2 actions: give its `mapping"
+        ),
+        "{message}"
+    );
+    assert!(!library.join("mixed").exists());
 }
 
 #[test]

@@ -11,14 +11,17 @@ use super::{CartPoleParams, EnvError, Environment, Integrator, Step};
 const RESET_BOUND: f64 = 0.05;
 
 /// A pole hinged on a cart; push the cart left (action 0) or right (action 1) to keep the
-/// pole upright.
+/// pole upright (a three-action agent: 0 left, 1 no push, 2 right).
 ///
-/// State `[x, x_dot, theta, theta_dot]`; the observation is the state cast to `f32`.
+/// State `[x, x_dot, theta, theta_dot]`; the observation is the state cast to `f32`, in
+/// `observation_order`.
 /// Reward 1 on every step, the terminating one included. Until the first reset the state is
 /// all zeros and the generator is seeded with 0.
 #[derive(Debug, Clone)]
 pub struct CartPole {
     params: CartPoleParams,
+    /// `params.observation_order`, or `None` for the state's own order.
+    order: Option<[usize; 4]>,
     /// Gymnasium's `total_mass`, computed once as it does in `__init__`.
     total_mass: f64,
     /// Gymnasium's `polemass_length`.
@@ -37,8 +40,22 @@ pub struct CartPole {
 }
 
 impl CartPole {
+    /// # Panics
+    /// If `params.observation_order` is not a permutation of 0..4 (a validated config's is).
     pub fn new(params: CartPoleParams) -> Self {
+        let order: [usize; 4] = params
+            .observation_order
+            .as_slice()
+            .try_into()
+            .ok()
+            .filter(|o: &[usize; 4]| {
+                let mut sorted = *o;
+                sorted.sort_unstable();
+                sorted == super::params::CARTPOLE_ORDER
+            })
+            .expect("observation_order is a permutation of 0..4");
         Self {
+            order: (order != super::params::CARTPOLE_ORDER).then_some(order),
             total_mass: params.masspole + params.masscart,
             polemass_length: params.masspole * params.length,
             params,
@@ -49,6 +66,19 @@ impl CartPole {
             elapsed: 0,
             fell: false,
         }
+    }
+
+    fn observe(&mut self) {
+        self.obs = observation(self.order, &self.state);
+    }
+}
+
+/// The observation of `state`, in the agent's order.
+#[inline]
+fn observation(order: Option<[usize; 4]>, state: &[f64; 4]) -> [f32; 4] {
+    match order {
+        None => state.map(|v| v as f32),
+        Some(order) => order.map(|i| state[i] as f32),
     }
 }
 
@@ -66,7 +96,7 @@ impl Environment for CartPole {
     }
 
     fn action_count(&self) -> usize {
-        2
+        self.params.actions.count()
     }
 
     fn reset(&mut self, seed: Option<u64>) -> Result<&[f32], EnvError> {
@@ -77,7 +107,7 @@ impl Environment for CartPole {
             *v = self.rng.random_range(-RESET_BOUND..RESET_BOUND);
         }
         self.sin_cos_theta = self.state[2].sin_cos();
-        self.obs = self.state.map(|v| v as f32);
+        self.observe();
         self.elapsed = 0;
         self.fell = false;
         Ok(&self.obs)
@@ -87,17 +117,18 @@ impl Environment for CartPole {
     /// `float64` state bit for bit.
     ///
     /// # Panics
-    /// If `action` is not 0 or 1.
+    /// If `action` is not one of the agent's (0 or 1; 0, 1 or 2 with three actions).
     #[inline]
     fn step(&mut self, action: usize) -> Result<Step<'_>, EnvError> {
-        assert!(action < 2, "CartPole: action {action} is not 0 or 1");
+        let actions = self.params.actions.count();
+        assert!(
+            action < actions,
+            "CartPole: action {action} is not one of the agent's {actions}"
+        );
         let p = &self.params;
         let [mut x, mut x_dot, mut theta, mut theta_dot] = self.state;
-        let force = if action == 1 {
-            p.force_mag
-        } else {
-            -p.force_mag
-        };
+        // ±force_mag exactly (a product by ±1 is exact), 0 for a three-action agent's 1.
+        let force = p.actions.direction(action) * p.force_mag;
         let (sintheta, costheta) = self.sin_cos_theta;
 
         let temp =
@@ -121,7 +152,7 @@ impl Environment for CartPole {
             }
         }
         self.state = [x, x_dot, theta, theta_dot];
-        self.obs = self.state.map(|v| v as f32);
+        self.obs = observation(self.order, &self.state);
         self.sin_cos_theta = theta.sin_cos();
 
         let terminated = x < -p.x_threshold
@@ -150,7 +181,7 @@ impl Environment for CartPole {
 
     fn set_state(&mut self, state: &[f64]) -> Result<(), EnvError> {
         self.state = EnvError::check_length("CartPole", state)?;
-        self.obs = self.state.map(|v| v as f32);
+        self.observe();
         self.sin_cos_theta = self.state[2].sin_cos();
         Ok(())
     }
@@ -273,5 +304,45 @@ mod tests {
     #[should_panic(expected = "action 2")]
     fn out_of_range_action_panics() {
         env().step(2).unwrap();
+    }
+
+    #[test]
+    fn a_three_action_agent_pushes_left_not_at_all_or_right() {
+        let three = CartPoleParams {
+            actions: crate::env::ActionSet::LeftNoneRight,
+            ..CartPoleParams::default()
+        };
+        let start = [0.01, 0.02, 0.03, 0.04];
+        let after = |params: &CartPoleParams, action| {
+            let mut env = CartPole::new(params.clone());
+            env.set_state(&start).unwrap();
+            env.step(action).unwrap();
+            env.state().to_vec()
+        };
+        let two = CartPoleParams::default();
+        assert_eq!(after(&three, 0), after(&two, 0));
+        assert_eq!(after(&three, 2), after(&two, 1));
+        let coast = CartPoleParams {
+            force_mag: 0.0,
+            ..two
+        };
+        assert_eq!(after(&three, 1), after(&coast, 0));
+        assert_eq!(CartPole::new(three).action_count(), 3);
+    }
+
+    #[test]
+    fn a_permuted_agent_sees_the_state_in_its_order() {
+        let mut env = CartPole::new(CartPoleParams {
+            observation_order: vec![2, 3, 0, 1],
+            ..CartPoleParams::default()
+        });
+        let mut plain = CartPole::new(CartPoleParams::default());
+        let first = env.reset(Some(5)).unwrap().to_vec();
+        let own = plain.reset(Some(5)).unwrap().to_vec();
+        assert_eq!(first, [own[2], own[3], own[0], own[1]]);
+        let obs = env.step(1).unwrap().obs.to_vec();
+        let own = plain.step(1).unwrap().obs.to_vec();
+        assert_eq!(obs, [own[2], own[3], own[0], own[1]]);
+        assert_eq!(env.state(), plain.state(), "the physics is the same");
     }
 }

@@ -23,7 +23,8 @@ pub use acrobot::Acrobot;
 pub use cartpole::CartPole;
 pub use mountain_car::MountainCar;
 pub use params::{
-    AcrobotParams, CartPoleParams, EnvConfig, GymnasiumParams, Integrator, MountainCarParams,
+    AcrobotParams, ActionSet, CartPoleParams, EnvConfig, GymnasiumParams, Integrator,
+    MountainCarParams,
 };
 
 /// What one call of [`Environment::step`] returns (Gymnasium's 5-tuple without `info`).
@@ -116,8 +117,8 @@ pub fn make(config: &EnvConfig) -> Result<Box<dyn Environment>, EnvError> {
 /// stepping it (a Gymnasium task's are asked of it once per process and kept).
 pub fn spaces(config: &EnvConfig) -> Result<(usize, usize), EnvError> {
     Ok(match config {
-        EnvConfig::CartPole(_) => (4, 2),
-        EnvConfig::MountainCar(_) => (2, 3),
+        EnvConfig::CartPole(p) => (4, p.actions.count()),
+        EnvConfig::MountainCar(p) => (2, p.actions.count()),
         EnvConfig::Acrobot(_) => (6, 3),
         EnvConfig::Gymnasium(p) => gymnasium::spaces(p)?,
     })

@@ -11,7 +11,8 @@ use super::{EnvError, Environment, MountainCarParams, Step};
 const RESET_POSITION: std::ops::Range<f64> = -0.6..-0.4;
 
 /// An underpowered car in a valley that must rock back and forth to reach the flag on the
-/// right hill. Actions: 0 accelerate left, 1 do nothing, 2 accelerate right.
+/// right hill. Actions: 0 accelerate left, 1 do nothing, 2 accelerate right (a two-action
+/// agent: 0 left, 1 right).
 ///
 /// State `[position, velocity]`; the observation is the state cast to `f32`. Reward −1 on
 /// every step. Until the first reset the state is all zeros and the generator is seeded
@@ -48,7 +49,7 @@ impl Environment for MountainCar {
     }
 
     fn action_count(&self) -> usize {
-        3
+        self.params.actions.count()
     }
 
     fn reset(&mut self, seed: Option<u64>) -> Result<&[f32], EnvError> {
@@ -65,13 +66,18 @@ impl Environment for MountainCar {
     /// `float64` state bit for bit.
     ///
     /// # Panics
-    /// If `action` is not 0, 1 or 2.
+    /// If `action` is not one of the agent's (0, 1 or 2; 0 or 1 with two actions).
     #[inline]
     fn step(&mut self, action: usize) -> Result<Step<'_>, EnvError> {
-        assert!(action < 3, "MountainCar: action {action} is not 0, 1 or 2");
+        let actions = self.params.actions.count();
+        assert!(
+            action < actions,
+            "MountainCar: action {action} is not one of the agent's {actions}"
+        );
         let p = &self.params;
         let [mut position, mut velocity] = self.state;
-        velocity += (action as f64 - 1.0) * p.force + (3.0 * position).cos() * -p.gravity;
+        // Gymnasium's `(action - 1) * force`: −1, 0 or +1 times the force.
+        velocity += p.actions.direction(action) * p.force + (3.0 * position).cos() * -p.gravity;
         velocity = velocity.clamp(-p.max_speed, p.max_speed);
         position += velocity;
         position = position.clamp(p.min_position, p.max_position);
@@ -205,5 +211,23 @@ mod tests {
     #[should_panic(expected = "action 3")]
     fn out_of_range_action_panics() {
         env().step(3).unwrap();
+    }
+
+    #[test]
+    fn a_two_action_agent_pushes_left_or_right() {
+        let two = MountainCarParams {
+            actions: crate::env::ActionSet::LeftRight,
+            ..MountainCarParams::default()
+        };
+        let after = |params: &MountainCarParams, action| {
+            let mut env = MountainCar::new(params.clone());
+            env.set_state(&[-0.5, 0.01]).unwrap();
+            env.step(action).unwrap();
+            env.state().to_vec()
+        };
+        let three = MountainCarParams::default();
+        assert_eq!(after(&two, 0), after(&three, 0));
+        assert_eq!(after(&two, 1), after(&three, 2));
+        assert_eq!(MountainCar::new(two).action_count(), 2);
     }
 }

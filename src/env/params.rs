@@ -210,6 +210,16 @@ impl EnvConfig {
                 ] {
                     rules.positive(name, value);
                 }
+                let mut sorted = p.observation_order.clone();
+                sorted.sort_unstable();
+                rules.holds(
+                    "observation_order",
+                    sorted == CARTPOLE_ORDER,
+                    &format!(
+                        "each of the state's indices 0, 1, 2, 3 once, got {:?}",
+                        p.observation_order
+                    ),
+                );
             }
             EnvConfig::MountainCar(p) => {
                 rules.time_limit(p.max_episode_steps);
@@ -447,7 +457,59 @@ pub enum Integrator {
     SemiImplicitEuler,
 }
 
+/// What an agent's discrete actions do to a task that pushes left or right: the agent,
+/// rather than the physics, of an other agent's source policy (docs/FUTURE_WORK.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ActionSet {
+    /// 0 pushes left, 1 right (CartPole's).
+    LeftRight,
+    /// 0 pushes left, 1 not at all, 2 right (MountainCar's).
+    LeftNoneRight,
+}
+
+impl ActionSet {
+    pub fn count(self) -> usize {
+        match self {
+            ActionSet::LeftRight => 2,
+            ActionSet::LeftNoneRight => 3,
+        }
+    }
+
+    /// The push of `action`: −1 left, 0 none, +1 right.
+    ///
+    /// # Panics
+    /// If `action` is not below [`count`](Self::count): a bug in the caller.
+    #[inline]
+    pub fn direction(self, action: usize) -> f64 {
+        match (self, action) {
+            (ActionSet::LeftRight, 0) | (ActionSet::LeftNoneRight, 0) => -1.0,
+            (ActionSet::LeftRight, 1) | (ActionSet::LeftNoneRight, 2) => 1.0,
+            (ActionSet::LeftNoneRight, 1) => 0.0,
+            _ => panic!("action {action} is not one of {self:?}'s {}", self.count()),
+        }
+    }
+}
+
+fn is_left_right(actions: &ActionSet) -> bool {
+    *actions == ActionSet::LeftRight
+}
+
+fn is_left_none_right(actions: &ActionSet) -> bool {
+    *actions == ActionSet::LeftNoneRight
+}
+
+/// CartPole's own order of its observation, `[x, x_dot, theta, theta_dot]`.
+pub const CARTPOLE_ORDER: [usize; 4] = [0, 1, 2, 3];
+
+fn is_cartpole_order(order: &Vec<usize>) -> bool {
+    order.as_slice() == CARTPOLE_ORDER
+}
+
 /// CartPole (Barto, Sutton & Anderson). `max_episode_steps` 500 is v1, 200 is v0.
+/// `actions` and `observation_order` change the agent, not the physics: a three-action
+/// CartPole, or one whose agent sees its state variables in another order. Left at their
+/// defaults they are not written, so every file of the task as Gymnasium has it reads as
+/// before they existed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CartPoleParams {
@@ -470,6 +532,13 @@ pub struct CartPoleParams {
     pub theta_threshold_radians: f64,
     /// Cart position beyond which the episode terminates, m.
     pub x_threshold: f64,
+    /// `LeftRight` (Gymnasium's) or `LeftNoneRight` (a push of 0 N as action 1).
+    #[serde(skip_serializing_if = "is_left_right")]
+    pub actions: ActionSet,
+    /// The observation's k-th value is the state's `observation_order[k]`-th, e.g.
+    /// `[2, 3, 0, 1]` puts the pole first: a permutation of 0..4.
+    #[serde(skip_serializing_if = "is_cartpole_order")]
+    pub observation_order: Vec<usize>,
 }
 
 impl Default for CartPoleParams {
@@ -486,6 +555,8 @@ impl Default for CartPoleParams {
             // Same operation order as Gymnasium: 12 * 2 * math.pi / 360.
             theta_threshold_radians: 12.0 * 2.0 * PI / 360.0,
             x_threshold: 2.4,
+            actions: ActionSet::LeftRight,
+            observation_order: CARTPOLE_ORDER.to_vec(),
         }
     }
 }
@@ -504,6 +575,9 @@ pub struct MountainCarParams {
     /// Engine force per unit of action.
     pub force: f64,
     pub gravity: f64,
+    /// `LeftNoneRight` (Gymnasium's) or `LeftRight`: a two-action agent that cannot coast.
+    #[serde(skip_serializing_if = "is_left_none_right")]
+    pub actions: ActionSet,
 }
 
 impl Default for MountainCarParams {
@@ -517,6 +591,7 @@ impl Default for MountainCarParams {
             goal_velocity: 0.0,
             force: 0.001,
             gravity: 0.0025,
+            actions: ActionSet::LeftNoneRight,
         }
     }
 }

@@ -7,7 +7,7 @@ use std::sync::mpsc::Receiver;
 use anyhow::{bail, Context, Result};
 
 use super::manifest::{self, LibraryTraining};
-use super::{library_dir, plan, policy_files, train_library, SourceTask};
+use super::{library_dir, plan, policy_files, train_library, InterTaskMapping, SourceTask, Spaces};
 use crate::config::Config;
 use crate::policy_store;
 use crate::sapnet::PolicyDescription;
@@ -89,7 +89,10 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
     };
     let manifest_path = manifest::path(&dir);
     let wanted = LibraryTraining::of(config);
-    if found.training.tasks != wanted.tasks {
+    let trained = |tasks: &[SourceTask]| -> Vec<SourceTask> {
+        tasks.iter().map(SourceTask::trained).collect()
+    };
+    if trained(&found.training.tasks) != trained(&wanted.tasks) {
         let tasks = |t: &[SourceTask]| -> String {
             t.iter()
                 .map(|t| format!("{} ×{}", t.label, t.count))
@@ -103,6 +106,26 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
             tasks(&found.training.tasks),
             tasks(&wanted.tasks)
         );
+    }
+    // The mapping says how a source is reused, not how it was trained: a library and a
+    // config that declare different ones are told apart, and neither needs retraining.
+    for (i, (theirs, ours)) in found.training.tasks.iter().zip(&wanted.tasks).enumerate() {
+        if theirs.mapping != ours.mapping {
+            let text = |m: &Option<InterTaskMapping>| {
+                m.as_ref()
+                    .map_or("none".to_string(), InterTaskMapping::summary)
+            };
+            bail!(
+                "the library {} declares the mapping of {} as {} (training.tasks[{i}].mapping \
+                 in {}), the config's sources.tasks[{i}].mapping as {}: make them the same \
+                 (the mapping does not change the policies, so no retraining is needed)",
+                dir.display(),
+                ours.label,
+                text(&theirs.mapping),
+                manifest_path.display(),
+                text(&ours.mapping)
+            );
+        }
     }
     if !found.complete {
         let missing: Vec<String> = plan(config)
@@ -152,31 +175,62 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
     }
 
     let (observation_size, action_count) = crate::env::spaces(&config.env)?;
-    let plans = plan(config);
-    let load = |entry: &manifest::ManifestEntry| -> Result<policy_store::StoredPolicy> {
-        let stored =
-            policy_store::load_for_task(&dir, &entry.name, observation_size, action_count)?;
-        let metadata_path = policy_store::paths(&dir, &entry.name).1;
-        let metadata_sha256 = policy_store::sha256_hex(
-            &std::fs::read(&metadata_path)
-                .with_context(|| format!("reading {}", metadata_path.display()))?,
-        );
-        if stored.metadata.weights_sha256 != entry.weights_sha256
-            || metadata_sha256 != entry.metadata_sha256
-        {
-            bail!(
-                "policy {} is not the one {} records (its files changed after the library was \
-                 written); retrain the library with `sapnet sources --retrain`",
-                metadata_path.display(),
-                manifest_path.display()
-            );
-        }
-        Ok(stored)
+    let target = Spaces {
+        observation_size,
+        action_count,
     };
+    let plans = plan(config);
+    let load =
+        |entry: &manifest::ManifestEntry, spaces: Spaces| -> Result<policy_store::StoredPolicy> {
+            let stored = policy_store::load_for_task(
+                &dir,
+                &entry.name,
+                spaces.observation_size,
+                spaces.action_count,
+            )?;
+            let metadata_path = policy_store::paths(&dir, &entry.name).1;
+            let metadata_sha256 = policy_store::sha256_hex(
+                &std::fs::read(&metadata_path)
+                    .with_context(|| format!("reading {}", metadata_path.display()))?,
+            );
+            if stored.metadata.weights_sha256 != entry.weights_sha256
+                || metadata_sha256 != entry.metadata_sha256
+            {
+                bail!(
+                    "policy {} is not the one {} records (its files changed after the library was \
+                 written); retrain the library with `sapnet sources --retrain`",
+                    metadata_path.display(),
+                    manifest_path.display()
+                );
+            }
+            Ok(stored)
+        };
     let mut sources = Vec::with_capacity(found.policies.len() + found.imported.len());
+    // Each task's spaces and the mapping that takes them to the target's, checked once.
+    let mut fits = Vec::with_capacity(wanted.tasks.len());
+    for (i, task) in wanted.tasks.iter().enumerate() {
+        let spaces = match &task.mapping {
+            None => target,
+            Some(_) => {
+                let (observation_size, action_count) = crate::env::spaces(&task.env)?;
+                Spaces {
+                    observation_size,
+                    action_count,
+                }
+            }
+        };
+        super::check_fit(
+            &format!("sources.tasks[{i}]"),
+            task.mapping.as_ref(),
+            spaces,
+            target,
+        )
+        .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+        fits.push(spaces);
+    }
     for (entry, planned) in found.policies.iter().zip(&plans) {
         let task = &wanted.tasks[planned.task];
-        let stored = load(entry)?;
+        let mut stored = load(entry, fits[planned.task])?;
         let metadata_path = policy_store::paths(&dir, &entry.name).1;
         if entry.name != planned.name || stored.metadata.source_task != task.env.as_recorded() {
             bail!(
@@ -187,6 +241,11 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
                 planned.name,
                 task.label
             );
+        }
+        if let Some(mapping) = &task.mapping {
+            stored.net = mapping
+                .translate(&stored.net, target)
+                .with_context(|| format!("mapping {} to the target", metadata_path.display()))?;
         }
         sources.push(SourcePolicy {
             description: PolicyDescription {
@@ -202,7 +261,7 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
     // An imported policy's category is the task it was imported for, named as the config
     // names that task.
     for entry in &found.imported {
-        let stored = load(entry)?;
+        let stored = load(entry, target)?;
         let recorded = &stored.metadata.source_task;
         let label = wanted
             .tasks

@@ -23,11 +23,13 @@ use crate::seeds;
 mod import;
 mod load;
 pub mod manifest;
+pub mod mapping;
 mod train;
 
 pub use import::{import, Imported};
 pub use load::{ensure_library, evaluate, load_library, needs_training, Evaluation, LibraryRoot};
 pub use manifest::{LibraryTraining, Manifest, ManifestEntry};
+pub use mapping::{InterTaskMapping, Spaces};
 pub use train::train_library;
 
 /// Stream key of the source library's plan ([`seeds::library_v1`]), which no experiment uses.
@@ -51,6 +53,51 @@ pub struct SourceTask {
     pub count: usize,
     /// Its name in results, on the graph, and as SAP-Net's `SourceTask` category.
     pub label: String,
+    /// χ_X and χ_A, for a task of another agent than the target's ([`mapping`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mapping: Option<InterTaskMapping>,
+}
+
+impl SourceTask {
+    /// This task without its mapping: what its policies were trained on.
+    pub fn trained(&self) -> SourceTask {
+        SourceTask {
+            mapping: None,
+            ..self.clone()
+        }
+    }
+}
+
+/// The spaces of a native task, known without running it; `None` for a Gymnasium task.
+pub fn native_spaces(env: &EnvConfig) -> Option<Spaces> {
+    if matches!(env, EnvConfig::Gymnasium(_)) {
+        return None;
+    }
+    crate::env::spaces(env)
+        .ok()
+        .map(|(observation_size, action_count)| Spaces {
+            observation_size,
+            action_count,
+        })
+}
+
+/// Whether a source task of `source` spaces can be reused on a target of `target` spaces:
+/// with equal spaces and no mapping as it is, otherwise through a mapping that fits.
+/// `field` is the task's place (`sources.tasks[1]`).
+pub fn check_fit(
+    field: &str,
+    mapping: Option<&InterTaskMapping>,
+    source: Spaces,
+    target: Spaces,
+) -> Result<(), String> {
+    match mapping {
+        Some(mapping) => mapping.check(&format!("{field}.mapping"), source, target),
+        None if source == target => Ok(()),
+        None => Err(format!(
+            "field `{field}`: its agent has {source}, the target's {target}: give its \
+             `mapping: Some(state: [..], actions: [..])` (docs/FUTURE_WORK.md)"
+        )),
+    }
 }
 
 /// The source task: `sources.env` when given, else the target task. For a library over
@@ -72,6 +119,7 @@ pub fn tasks(config: &Config) -> Vec<SourceTask> {
             label: env.label(),
             env,
             count: s.count,
+            mapping: None,
         }];
     }
     s.tasks
@@ -80,6 +128,7 @@ pub fn tasks(config: &Config) -> Vec<SourceTask> {
             label: t.label.clone().unwrap_or_else(|| t.env.label()),
             env: t.env.clone(),
             count: t.count,
+            mapping: t.mapping.clone(),
         })
         .collect()
 }

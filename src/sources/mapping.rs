@@ -1,0 +1,374 @@
+//! Sources from other agents: a policy whose observation or action space differs from the
+//! target's, reused through a declared inter-task mapping (Taylor, Stone & Liu, "Transfer
+//! Learning via Inter-Task Mappings for Temporal Difference Learning", JMLR 8, 2007).
+//!
+//! - χ_X maps the target's state variables to the source's: the source's j-th input is the
+//!   target's `state[j]`-th observation value;
+//! - χ_A maps the source's actions to the target's: the source's a-th action is the
+//!   target's `actions[a]`, or `None` when the target has nothing like it (a three-action
+//!   CartPole's "no push").
+//!
+//! As the paper's transfer functional ρ does, the mapping is applied once, to the network:
+//! [`InterTaskMapping::translate`] writes the source's Q-network as a network of the
+//! target's spaces whose Q-values are the source's through the mapping,
+//! `Q_target(s, χ_A(a)) = Q_source(χ_X(s), a)`. From there the policy acts, learns from
+//! the shared replay buffer of the target's transitions, is judged and tested as any other
+//! source: nothing downstream knows it came from another agent.
+//!
+//! A target action that no source action maps to (a two-action MountainCar source's "no
+//! push") has no value in the source: its row starts as the mean of the mapped actions'
+//! rows, so its Q-value is the mean of theirs. It is never above their largest (the source's
+//! greedy choice stays its own) and is learned from the target's transitions that took it.
+
+use candle_core::{Device, Tensor};
+use serde::{Deserialize, Serialize};
+
+use crate::dqn::{Architecture, DqnError, QNet};
+
+/// χ_X and χ_A, as a library's RON declares them for a source task:
+/// `mapping: Some(state: [2, 3, 0, 1], actions: [Some(0), None, Some(1)])`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InterTaskMapping {
+    /// χ_X: for each of the source's state variables, the target's variable it reads.
+    pub state: Vec<usize>,
+    /// χ_A: for each of the source's actions, the target's action it is, if any.
+    pub actions: Vec<Option<usize>>,
+}
+
+/// An observation size and an action count.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Spaces {
+    pub observation_size: usize,
+    pub action_count: usize,
+}
+
+impl std::fmt::Display for Spaces {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} observation values and {} actions",
+            self.observation_size, self.action_count
+        )
+    }
+}
+
+impl InterTaskMapping {
+    /// Whether the mapping fits a source of `source` spaces reused on a target of `target`
+    /// spaces; the first misfit names its field under `field` (e.g.
+    /// `sources.tasks[1].mapping`) and what was expected.
+    pub fn check(&self, field: &str, source: Spaces, target: Spaces) -> Result<(), String> {
+        if self.state.len() != source.observation_size {
+            return Err(format!(
+                "field `{field}.state`: expected {} entries, one per state variable of the \
+                 source's agent (the target's variable it reads), got {}",
+                source.observation_size,
+                self.state.len()
+            ));
+        }
+        if let Some((j, &v)) = self
+            .state
+            .iter()
+            .enumerate()
+            .find(|(_, &v)| v >= target.observation_size)
+        {
+            return Err(format!(
+                "field `{field}.state[{j}]`: expected one of the target's state variables 0 to \
+                 {}, got {v}",
+                target.observation_size - 1
+            ));
+        }
+        if self.actions.len() != source.action_count {
+            let missing = self.actions.len();
+            return Err(if missing < source.action_count {
+                format!(
+                    "field `{field}.actions`: source action {missing} has no image: expected \
+                     {} entries, one per action of the source's agent (`Some(target action)`, \
+                     or `None` for one the target has nothing like), got {missing}",
+                    source.action_count
+                )
+            } else {
+                format!(
+                    "field `{field}.actions`: expected {} entries, one per action of the \
+                     source's agent, got {missing}",
+                    source.action_count
+                )
+            });
+        }
+        for (a, image) in self.actions.iter().enumerate() {
+            let Some(t) = *image else { continue };
+            if t >= target.action_count {
+                return Err(format!(
+                    "field `{field}.actions[{a}]`: expected one of the target's actions 0 to \
+                     {} or None, got Some({t})",
+                    target.action_count - 1
+                ));
+            }
+            if let Some(b) = self.actions[..a].iter().position(|&i| i == Some(t)) {
+                return Err(format!(
+                    "field `{field}.actions[{a}]`: target action {t} is already the image of \
+                     source action {b}; each target action may stand for one source action"
+                ));
+            }
+        }
+        if self.actions.iter().all(Option::is_none) {
+            return Err(format!(
+                "field `{field}.actions`: expected at least one source action mapped to a \
+                 target action, got none"
+            ));
+        }
+        Ok(())
+    }
+
+    /// The source's network `net` written in the target's spaces (module docs): the first
+    /// layer's column of each source input moves to the target variable χ_X reads (a target
+    /// variable no source input reads gets zeros, one read twice the sum), the last layer's
+    /// row of each source action to its image under χ_A (a source action without one is
+    /// dropped; a target action without a preimage gets the mapped rows' mean).
+    ///
+    /// The mapping must fit (`check`): `net`'s spaces are the source's.
+    pub fn translate(&self, net: &QNet, target: Spaces) -> Result<QNet, DqnError> {
+        let source = net.architecture();
+        let hidden = source.hidden.clone();
+        let mut values: Vec<Tensor> = net.named_parameters().into_iter().map(|(_, t)| t).collect();
+        let layers = values.len() / 2;
+
+        // χ_X on the first layer's weight [units, source inputs].
+        let first = values[0].to_vec2::<f32>()?;
+        let widened: Vec<Vec<f32>> = first
+            .iter()
+            .map(|row| {
+                let mut out = vec![0.0; target.observation_size];
+                for (j, &w) in row.iter().enumerate() {
+                    out[self.state[j]] += w;
+                }
+                out
+            })
+            .collect();
+        values[0] = matrix(widened)?;
+
+        // χ_A on the last layer's weight [source actions, units] and bias.
+        let (w, b) = (2 * (layers - 1), 2 * (layers - 1) + 1);
+        let weights = values[w].to_vec2::<f32>()?;
+        let biases = values[b].to_vec1::<f32>()?;
+        let mapped: Vec<usize> = (0..self.actions.len())
+            .filter(|&a| self.actions[a].is_some())
+            .collect();
+        let mean = |row: &dyn Fn(usize) -> Vec<f32>| -> Vec<f32> {
+            let n = mapped.len() as f32;
+            let mut sum = vec![0.0; row(mapped[0]).len()];
+            for &a in &mapped {
+                for (s, v) in sum.iter_mut().zip(row(a)) {
+                    *s += v;
+                }
+            }
+            sum.into_iter().map(|s| s / n).collect()
+        };
+        let preimage = |t: usize| self.actions.iter().position(|&i| i == Some(t));
+        let rows: Vec<Vec<f32>> = (0..target.action_count)
+            .map(|t| match preimage(t) {
+                Some(a) => weights[a].clone(),
+                None => mean(&|a| weights[a].clone()),
+            })
+            .collect();
+        let bias: Vec<f32> = (0..target.action_count)
+            .map(|t| match preimage(t) {
+                Some(a) => biases[a],
+                None => mean(&|a| vec![biases[a]])[0],
+            })
+            .collect();
+        values[w] = matrix(rows)?;
+        values[b] = Tensor::from_vec(bias, target.action_count, &Device::Cpu)?;
+
+        QNet::from_parameters(
+            Architecture::new(target.observation_size, &hidden, target.action_count),
+            values,
+        )
+    }
+
+    /// One line for a listing: `χ_X [2, 3, 0, 1] · χ_A [0, –, 1]`.
+    pub fn summary(&self) -> String {
+        let actions: Vec<String> = self
+            .actions
+            .iter()
+            .map(|a| a.map_or("–".to_string(), |t| t.to_string()))
+            .collect();
+        format!("χ_X {:?} · χ_A [{}]", self.state, actions.join(", "))
+    }
+}
+
+fn matrix(rows: Vec<Vec<f32>>) -> Result<Tensor, DqnError> {
+    let (n, m) = (rows.len(), rows.first().map_or(0, Vec::len));
+    let flat: Vec<f32> = rows.into_iter().flatten().collect();
+    Ok(Tensor::from_vec(flat, (n, m), &Device::Cpu)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    fn spaces(observation_size: usize, action_count: usize) -> Spaces {
+        Spaces {
+            observation_size,
+            action_count,
+        }
+    }
+
+    #[test]
+    fn a_mapping_that_does_not_fit_is_refused_at_its_field() {
+        let field = "sources.tasks[0].mapping";
+        let (source, target) = (spaces(4, 3), spaces(4, 2));
+        let ok = InterTaskMapping {
+            state: vec![0, 1, 2, 3],
+            actions: vec![Some(0), None, Some(1)],
+        };
+        assert_eq!(ok.check(field, source, target), Ok(()));
+        let cases = [
+            (
+                InterTaskMapping {
+                    state: vec![0, 1, 4, 3],
+                    ..ok.clone()
+                },
+                "`sources.tasks[0].mapping.state[2]`: expected one of the target's state \
+                 variables 0 to 3, got 4",
+            ),
+            (
+                InterTaskMapping {
+                    state: vec![0, 1, 2],
+                    ..ok.clone()
+                },
+                "`sources.tasks[0].mapping.state`: expected 4 entries",
+            ),
+            (
+                InterTaskMapping {
+                    actions: vec![Some(0), None],
+                    ..ok.clone()
+                },
+                "`sources.tasks[0].mapping.actions`: source action 2 has no image",
+            ),
+            (
+                InterTaskMapping {
+                    actions: vec![Some(0), None, Some(2)],
+                    ..ok.clone()
+                },
+                "`sources.tasks[0].mapping.actions[2]`: expected one of the target's actions \
+                 0 to 1 or None, got Some(2)",
+            ),
+            (
+                InterTaskMapping {
+                    actions: vec![Some(0), Some(0), Some(1)],
+                    ..ok.clone()
+                },
+                "`sources.tasks[0].mapping.actions[1]`: target action 0 is already the image \
+                 of source action 0",
+            ),
+            (
+                InterTaskMapping {
+                    actions: vec![None, None, None],
+                    ..ok.clone()
+                },
+                "at least one source action mapped",
+            ),
+        ];
+        for (mapping, expected) in cases {
+            let error = mapping.check(field, source, target).unwrap_err();
+            assert!(error.contains(expected), "{error}\nwanted: {expected}");
+        }
+    }
+
+    /// A random source net of `source` spaces.
+    fn net(source: Spaces, hidden: &[usize], seed: u64) -> QNet {
+        let arch = Architecture::new(source.observation_size, hidden, source.action_count);
+        QNet::new(arch, &mut StdRng::seed_from_u64(seed)).unwrap()
+    }
+
+    fn observations(n: usize, size: usize) -> Vec<Vec<f32>> {
+        let mut rng = StdRng::seed_from_u64(9);
+        (0..n)
+            .map(|_| (0..size).map(|_| rng.random_range(-2.0..2.0)).collect())
+            .collect()
+    }
+
+    fn close(a: f32, b: f32) -> bool {
+        (a - b).abs() <= 1e-5 * (1.0 + a.abs().max(b.abs()))
+    }
+
+    #[test]
+    fn a_permutation_maps_the_state_and_keeps_every_q_value() {
+        // The source sees [θ, θ̇, x, ẋ]: its j-th input is the target's state[j]-th.
+        let mapping = InterTaskMapping {
+            state: vec![2, 3, 0, 1],
+            actions: vec![Some(0), Some(1)],
+        };
+        let source = net(spaces(4, 2), &[7, 5], 1);
+        let target = mapping.translate(&source, spaces(4, 2)).unwrap();
+        for obs in observations(200, 4) {
+            let seen: Vec<f32> = mapping.state.iter().map(|&i| obs[i]).collect();
+            let (q, q_source) = (
+                target.q_values(&obs).unwrap(),
+                source.q_values(&seen).unwrap(),
+            );
+            assert!(
+                q.iter().zip(&q_source).all(|(&a, &b)| close(a, b)),
+                "{q:?} {q_source:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_source_action_without_image_is_dropped_and_the_greedy_choice_is_among_the_rest() {
+        // A three-action CartPole source (left, none, right) on the two-action target.
+        let mapping = InterTaskMapping {
+            state: vec![0, 1, 2, 3],
+            actions: vec![Some(0), None, Some(1)],
+        };
+        let source = net(spaces(4, 3), &[6], 2);
+        let target = mapping.translate(&source, spaces(4, 2)).unwrap();
+        assert_eq!(target.architecture().action_count, 2);
+        for obs in observations(200, 4) {
+            let (q, q_source) = (
+                target.q_values(&obs).unwrap(),
+                source.q_values(&obs).unwrap(),
+            );
+            assert!(close(q[0], q_source[0]) && close(q[1], q_source[2]));
+            let greedy = if q_source[2] > q_source[0] { 1 } else { 0 };
+            assert_eq!(target.greedy_action(&obs).unwrap(), greedy);
+        }
+    }
+
+    #[test]
+    fn a_target_action_without_preimage_starts_at_the_mean_of_the_mapped_ones() {
+        // A two-action MountainCar source (left, right) on the three-action target, and a
+        // source that reads velocity first: Q(s, none) = (Q(s, left) + Q(s, right)) / 2.
+        let mapping = InterTaskMapping {
+            state: vec![1, 0],
+            actions: vec![Some(0), Some(2)],
+        };
+        let source = net(spaces(2, 2), &[5, 4, 3], 3);
+        let target = mapping.translate(&source, spaces(2, 3)).unwrap();
+        for obs in observations(200, 2) {
+            let q = target.q_values(&obs).unwrap();
+            let q_source = source.q_values(&[obs[1], obs[0]]).unwrap();
+            assert!(close(q[0], q_source[0]) && close(q[2], q_source[1]));
+            assert!(close(q[1], (q_source[0] + q_source[1]) / 2.0), "{q:?}");
+            assert_ne!(target.greedy_action(&obs).unwrap(), 1, "{q:?}");
+        }
+    }
+
+    #[test]
+    fn a_target_variable_read_twice_or_never_is_summed_or_ignored() {
+        // A one-layer source reading the target's variable 0 twice, never 1 or 2.
+        let mapping = InterTaskMapping {
+            state: vec![0, 0],
+            actions: vec![Some(0)],
+        };
+        let w = Tensor::from_vec(vec![2.0f32, 3.0], (1, 2), &Device::Cpu).unwrap();
+        let b = Tensor::from_vec(vec![0.5f32], 1, &Device::Cpu).unwrap();
+        let source = QNet::from_parameters(Architecture::new(2, &[], 1), vec![w, b]).unwrap();
+        let target = mapping.translate(&source, spaces(3, 1)).unwrap();
+        // Q = 2·x0 + 3·x0 + 0.5, whatever x1 and x2 are.
+        assert_eq!(target.q_values(&[1.0, 7.0, -9.0]).unwrap(), vec![5.5]);
+    }
+}
