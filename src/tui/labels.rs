@@ -2,10 +2,13 @@
 //! characters for them.
 
 /// `cartpole(length=1.0)` → `length=1.0`: a source task's label without its family, for a
-/// library whose tasks are variants of one; other labels stay as they are.
+/// library whose tasks are variants of one; other labels (a label written in words, such
+/// as `sees (θ, dθ, x, dx)`) stay as they are.
 pub fn short_task(label: &str) -> &str {
     match label.split_once('(') {
-        Some((_, rest)) if rest.ends_with(')') => &rest[..rest.len() - 1],
+        Some((family, rest)) if !family.contains(' ') && rest.ends_with(')') => {
+            &rest[..rest.len() - 1]
+        }
         _ => label,
     }
 }
@@ -39,6 +42,14 @@ pub fn short_label(name: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_task_loses_its_family_but_a_label_in_words_stays_whole() {
+        assert_eq!(short_task("cartpole(length=1.0)"), "length=1.0");
+        assert_eq!(short_task("LunarLander-v3(gravity=-6.0)"), "gravity=-6.0");
+        assert_eq!(short_task("sees (θ, dθ, x, dx)"), "sees (θ, dθ, x, dx)");
+        assert_eq!(short_task("mirrored"), "mirrored");
+    }
 
     #[test]
     fn labels_keep_the_number_of_long_names() {
