@@ -22,6 +22,9 @@ pub struct CartPole {
     params: CartPoleParams,
     /// `params.observation_order`, or `None` for the state's own order.
     order: Option<[usize; 4]>,
+    /// The push of each action, N: `[−F, F]`, or `[−F, 0, F]` for a three-action agent.
+    /// Looked up, not computed, on every step: the step is CartPole's whole cost.
+    forces: [f64; 3],
     /// Gymnasium's `total_mass`, computed once as it does in `__init__`.
     total_mass: f64,
     /// Gymnasium's `polemass_length`.
@@ -54,8 +57,15 @@ impl CartPole {
                 sorted == super::params::CARTPOLE_ORDER
             })
             .expect("observation_order is a permutation of 0..4");
+        let f = params.force_mag;
+        // ±force_mag exactly, as Gymnasium's `force_mag if action == 1 else -force_mag`.
+        let forces = match params.actions {
+            crate::env::ActionSet::LeftRight => [-f, f, f],
+            crate::env::ActionSet::LeftNoneRight => [-f, 0.0, f],
+        };
         Self {
             order: (order != super::params::CARTPOLE_ORDER).then_some(order),
+            forces,
             total_mass: params.masspole + params.masscart,
             polemass_length: params.masspole * params.length,
             params,
@@ -127,8 +137,7 @@ impl Environment for CartPole {
         );
         let p = &self.params;
         let [mut x, mut x_dot, mut theta, mut theta_dot] = self.state;
-        // ±force_mag exactly (a product by ±1 is exact), 0 for a three-action agent's 1.
-        let force = p.actions.direction(action) * p.force_mag;
+        let force = self.forces[action];
         let (sintheta, costheta) = self.sin_cos_theta;
 
         let temp =
