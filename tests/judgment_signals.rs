@@ -6,10 +6,9 @@
 
 mod common;
 
-use common::library::copy_library;
+use common::library::quick_protocol;
 
 use std::path::Path;
-use std::process::Command;
 
 fn sum(run: &serde_json::Value, key: &str) -> u64 {
     run[key]
@@ -23,25 +22,8 @@ fn sum(run: &serde_json::Value, key: &str) -> u64 {
 #[test]
 fn the_quick_judgments_protocol_counts_every_new_judgment() {
     let dir = tempfile::tempdir().unwrap();
-    let (library, out) = (dir.path().join("library"), dir.path().join("out"));
-    copy_library("cartpole", &library);
     let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/judgments_cartpole.ron");
-    let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
-        .args(["--headless", "--quick", "--jobs", "2", "--config"])
-        .arg(&config)
-        .arg("--library")
-        .arg(&library)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let (out, summary) = quick_protocol(&config, "cartpole", dir.path());
     let runs = summary["runs"].as_array().unwrap();
     for method in [
         "sapnet",

@@ -13,7 +13,7 @@ use rand::{Rng, SeedableRng};
 use sapnet::config::Config;
 use sapnet::{env, policy_store, sources};
 
-use common::library::copy_library;
+use common::library::{copy_library, quick_protocol};
 
 fn asset(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -206,23 +206,7 @@ fn a_config_and_a_library_that_declare_other_mappings_are_told_apart() {
 #[test]
 fn the_quick_protocol_over_other_agents_runs_every_method_of_the_study() {
     let dir = tempfile::tempdir().unwrap();
-    let (library, out) = (dir.path().join("library"), dir.path().join("out"));
-    copy_library("cartpole-agents", &library);
-    let output = sapnet(&[
-        "--headless",
-        "--quick",
-        "--jobs",
-        "2",
-        "--config",
-        asset("agents_cartpole.ron").to_str().unwrap(),
-        "--library",
-        library.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(output.status.success(), "{}", stderr(&output));
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let (_, summary) = quick_protocol(&asset("agents_cartpole.ron"), "cartpole-agents", dir.path());
     let runs = summary["runs"].as_array().unwrap();
     for method in [
         "sapnet",

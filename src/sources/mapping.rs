@@ -151,32 +151,27 @@ impl InterTaskMapping {
         let (w, b) = (2 * (layers - 1), 2 * (layers - 1) + 1);
         let weights = values[w].to_vec2::<f32>()?;
         let biases = values[b].to_vec1::<f32>()?;
+        // A target action without preimage starts as the mapped rows' mean (module docs).
         let mapped: Vec<usize> = (0..self.actions.len())
             .filter(|&a| self.actions[a].is_some())
             .collect();
-        let mean = |row: &dyn Fn(usize) -> Vec<f32>| -> Vec<f32> {
-            let n = mapped.len() as f32;
-            let mut sum = vec![0.0; row(mapped[0]).len()];
-            for &a in &mapped {
-                for (s, v) in sum.iter_mut().zip(row(a)) {
-                    *s += v;
-                }
+        let n = mapped.len() as f32;
+        // Summed, then divided: the study's runs were made with this order.
+        let mut mean_row = vec![0.0; weights[mapped[0]].len()];
+        for &a in &mapped {
+            for (m, &v) in mean_row.iter_mut().zip(&weights[a]) {
+                *m += v;
             }
-            sum.into_iter().map(|s| s / n).collect()
-        };
+        }
+        mean_row.iter_mut().for_each(|m| *m /= n);
+        let mean_bias = mapped.iter().fold(0.0, |sum, &a| sum + biases[a]) / n;
         let preimage = |t: usize| self.actions.iter().position(|&i| i == Some(t));
-        let rows: Vec<Vec<f32>> = (0..target.action_count)
+        let (rows, bias): (Vec<Vec<f32>>, Vec<f32>) = (0..target.action_count)
             .map(|t| match preimage(t) {
-                Some(a) => weights[a].clone(),
-                None => mean(&|a| weights[a].clone()),
+                Some(a) => (weights[a].clone(), biases[a]),
+                None => (mean_row.clone(), mean_bias),
             })
-            .collect();
-        let bias: Vec<f32> = (0..target.action_count)
-            .map(|t| match preimage(t) {
-                Some(a) => biases[a],
-                None => mean(&|a| vec![biases[a]])[0],
-            })
-            .collect();
+            .unzip();
         values[w] = matrix(rows)?;
         values[b] = Tensor::from_vec(bias, target.action_count, &Device::Cpu)?;
 

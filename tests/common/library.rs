@@ -15,3 +15,31 @@ pub fn copy_library(task: &str, library: &Path) {
         }
     }
 }
+
+/// Runs `sapnet --headless --quick --jobs 2` on `config` over a copy of the shipped library
+/// `saved_policies/<task>` under `dir`; asserts it succeeded and returns its `--out` folder
+/// and parsed `summary.json`.
+pub fn quick_protocol(
+    config: &Path,
+    task: &str,
+    dir: &Path,
+) -> (std::path::PathBuf, serde_json::Value) {
+    let (library, out) = (dir.join("library"), dir.join("out"));
+    copy_library(task, &library);
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args(["--headless", "--quick", "--jobs", "2", "--config"])
+        .arg(config)
+        .arg("--library")
+        .arg(&library)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .expect("the binary runs");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    (out, serde_json::from_str(&summary).unwrap())
+}
