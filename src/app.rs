@@ -40,8 +40,7 @@ pub fn run(cli: Cli) -> Result<()> {
                     report.left_out.join(", ")
                 );
             }
-            print!("{}", report.table());
-            Ok(())
+            print_stdout(&report.table())
         }
         Some(Command::Plot(args)) => {
             let summary = results::replot(&args.dir)?;
@@ -92,7 +91,10 @@ fn refuse_unread_flags(cli: &Cli, command: &Command) -> Result<()> {
     let name = match command {
         Command::Env(_) => "env",
         Command::Teach(_) => "teach",
-        Command::Sources(_) => "sources",
+        Command::Sources(args) => match args.command {
+            Some(SourcesCommand::Import(_)) => "sources import",
+            None => "sources",
+        },
         Command::Plot(_) => "plot",
         Command::Pool(_) => "pool",
         Command::Sweep(args) => match args.command {
@@ -148,7 +150,22 @@ fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
     if let Some(runs) = cli.run.runs {
         config.protocol.runs = runs;
     }
+    config.run_with(&cli.run.python_settings());
+    // A Gymnasium id that does not exist (or a Python without Gymnasium) is said first,
+    // before a library or a folder is looked for under its name.
+    for (field, task) in config.tasks() {
+        env::spaces(task)
+            .with_context(|| format!("{label}: {field}", label = origin(cli, label)))?;
+    }
     Ok(config)
+}
+
+/// The config's file as the user named it, or the embedded one's `label`.
+fn origin(cli: &Cli, label: &str) -> String {
+    cli.run
+        .config
+        .as_ref()
+        .map_or(label.to_string(), |path| path.display().to_string())
 }
 
 fn run_env(cli: &Cli, args: &EnvArgs) -> Result<()> {
@@ -264,7 +281,13 @@ fn resume_experiment(cli: &Cli) -> Result<()> {
         .out
         .as_deref()
         .context("--resume needs --out DIR, the results to continue")?;
-    let summary = headless::resume(dir, cli.run.runs, &run_options(cli), &on_interrupt()?)?;
+    let summary = headless::resume(
+        dir,
+        cli.run.runs,
+        &cli.run.python_settings(),
+        &run_options(cli),
+        &on_interrupt()?,
+    )?;
     report(&summary, dir)
 }
 
@@ -547,6 +570,7 @@ fn run_sweep(cli: &Cli, command: &SweepCommand) -> Result<()> {
                 config: cli.run.config.clone(),
                 out: out.clone(),
                 library: cli.run.library_path(),
+                python: cli.run.python_settings(),
             })?;
             eprintln!(
                 "{} cells in {}: `sapnet sweep run {} --all` runs them here; slurm.sbatch and \
@@ -557,16 +581,19 @@ fn run_sweep(cli: &Cli, command: &SweepCommand) -> Result<()> {
             );
             Ok(())
         }
-        SweepCommand::Prepare { sweep } => {
-            sweep::run::prepare(sweep, cli.run.library.as_deref(), &on_interrupt()?)
-        }
+        SweepCommand::Prepare { sweep } => sweep::run::prepare(
+            sweep,
+            cli.run.library.as_deref(),
+            &cli.run.python_settings(),
+            &on_interrupt()?,
+        ),
         SweepCommand::Run { sweep, cell, all } => {
             let jobs = cli.run.jobs.unwrap_or_else(|| {
                 std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
             });
             if *all {
                 let _stop = on_interrupt()?;
-                let failed = sweep::run::run_all(sweep, jobs)?;
+                let failed = sweep::run::run_all(sweep, jobs, &cli.run.python_settings())?;
                 let states = sweep::status::states(sweep)?;
                 eprint!("{}", sweep::status::report(&states));
                 anyhow::ensure!(
@@ -584,7 +611,13 @@ fn run_sweep(cli: &Cli, command: &SweepCommand) -> Result<()> {
                      (or --all)",
                 )?,
             };
-            match sweep::run::run_cell(sweep, id, jobs, &on_interrupt()?)? {
+            match sweep::run::run_cell(
+                sweep,
+                id,
+                jobs,
+                &cli.run.python_settings(),
+                &on_interrupt()?,
+            )? {
                 sweep::run::CellRun::AlreadyDone => eprintln!("cell {id}: done already"),
                 sweep::run::CellRun::Finished => eprintln!("cell {id}: done"),
                 sweep::run::CellRun::Stopped => eprintln!("cell {id}: stopped; run it again"),
@@ -592,8 +625,7 @@ fn run_sweep(cli: &Cli, command: &SweepCommand) -> Result<()> {
             Ok(())
         }
         SweepCommand::Status { sweep } => {
-            print!("{}", sweep::status::report(&sweep::status::states(sweep)?));
-            Ok(())
+            print_stdout(&sweep::status::report(&sweep::status::states(sweep)?))
         }
         SweepCommand::Merge { sweep } => {
             let report = sweep::merge::merge(sweep)?;
@@ -626,6 +658,15 @@ fn run_sweep(cli: &Cli, command: &SweepCommand) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// Writes `text` to stdout; a reader that left (`| head`) is an error that `main` ends
+/// quietly on, where `print!` would panic.
+fn print_stdout(text: &str) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .context("writing to stdout")
 }
 
 /// The trainer's command channel, on which SIGINT (Ctrl-C), SIGTERM and SIGHUP ask it to

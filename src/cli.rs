@@ -23,8 +23,7 @@ pub struct Cli {
 #[derive(Debug, Args)]
 pub struct RunArgs {
     /// RON config file (see assets/). Without it, the embedded CartPole config (paper
-    /// values). For `teach`: a lesson file (assets/teach_*.ron), by default the paper's
-    /// Fig. 2.
+    /// values).
     #[arg(long, short, value_name = "FILE", global = true)]
     pub config: Option<PathBuf>,
 
@@ -114,6 +113,24 @@ pub struct RunArgs {
     #[arg(long, value_name = "DIR", global = true)]
     pub library: Option<PathBuf>,
 
+    /// The Python that runs Gymnasium tasks, instead of the config's `python` (without
+    /// either: the active virtualenv's, else python3). A results or sweep folder never
+    /// chooses it: resuming one, say it here.
+    #[arg(long, value_name = "PATH", global = true)]
+    pub python: Option<PathBuf>,
+
+    /// The folder of your own Gymnasium environment modules (a task id `my_envs:Maze-v0`
+    /// imports `my_envs` from it), instead of the config's `module_dir`. Nothing is ever
+    /// imported from the folder sapnet is started in.
+    #[arg(long, value_name = "DIR", global = true)]
+    pub module_dir: Option<PathBuf>,
+
+    /// A Python module that the task of a folder from elsewhere (a resumed protocol, a
+    /// sweep's cells) may import through its id `MODULE:Env-v0`: none may unless named
+    /// here. Repeat for several.
+    #[arg(long, value_name = "MODULE", global = true)]
+    pub allow_module: Vec<String>,
+
     /// Train the source library first if --library holds none (or finish one whose
     /// training was interrupted), as the default library is.
     #[arg(long)]
@@ -134,11 +151,14 @@ pub struct SubcommandFlags {
     pub library: Option<&'static str>,
 }
 
+/// `--library` for the commands that train or read one library.
+const SOURCES_LIBRARY: &str = "The policy library's root directory: the library is <LIBRARY>/<source task>/. Default: saved_policies";
+
 /// Every subcommand's flags, as [`SubcommandFlags`] says.
 pub const SUBCOMMANDS: &[SubcommandFlags] = &[
     SubcommandFlags {
         name: "env",
-        reads: &["--config", "--seed"],
+        reads: &["--config", "--seed", "--python", "--module-dir"],
         config: Some("RON config whose target task (`env`) is run. Default: the embedded CartPole config"),
         library: None,
     },
@@ -150,9 +170,15 @@ pub const SUBCOMMANDS: &[SubcommandFlags] = &[
     },
     SubcommandFlags {
         name: "sources",
-        reads: &["--config", "--seed", "--library"],
+        reads: &["--config", "--seed", "--library", "--python", "--module-dir"],
         config: Some("RON config whose `sources` section describes the library. Default: the embedded CartPole config"),
-        library: None,
+        library: Some(SOURCES_LIBRARY),
+    },
+    SubcommandFlags {
+        name: "sources import",
+        reads: &["--config", "--seed", "--library", "--python", "--module-dir"],
+        config: Some("RON config of the library the policy joins (its `sources` section and source task). Default: the embedded CartPole config"),
+        library: Some(SOURCES_LIBRARY),
     },
     SubcommandFlags {
         name: "plot",
@@ -167,20 +193,26 @@ pub const SUBCOMMANDS: &[SubcommandFlags] = &[
         library: None,
     },
     SubcommandFlags {
+        name: "sweep",
+        reads: &[],
+        config: None,
+        library: None,
+    },
+    SubcommandFlags {
         name: "sweep plan",
-        reads: &["--config", "--library"],
+        reads: &["--config", "--library", "--python", "--module-dir", "--allow-module"],
         config: Some("A RON config that replaces the grid's base config"),
         library: Some("The library root the cells reuse, read-only (`sweep prepare` trains what is missing). Default: saved_policies"),
     },
     SubcommandFlags {
         name: "sweep prepare",
-        reads: &["--library"],
+        reads: &["--library", "--python", "--module-dir", "--allow-module"],
         config: None,
         library: Some("The library root the cells reuse, as sweep.ron names it: a library that needs training is trained only when named here (a sweep folder may come from elsewhere)"),
     },
     SubcommandFlags {
         name: "sweep run",
-        reads: &["--jobs"],
+        reads: &["--jobs", "--python", "--module-dir", "--allow-module"],
         config: None,
         library: None,
     },
@@ -285,6 +317,9 @@ impl RunArgs {
             ("--jobs", self.jobs.is_some()),
             ("--library", self.library.is_some()),
             ("--train-library", self.train_library),
+            ("--python", self.python.is_some()),
+            ("--module-dir", self.module_dir.is_some()),
+            ("--allow-module", !self.allow_module.is_empty()),
         ]
         .into_iter()
         .filter_map(|(flag, given)| given.then_some(flag))
@@ -296,6 +331,15 @@ impl RunArgs {
         self.library
             .clone()
             .unwrap_or_else(|| PathBuf::from(DEFAULT_LIBRARY))
+    }
+
+    /// How this machine runs Gymnasium tasks, as the flags say.
+    pub fn python_settings(&self) -> crate::env::PythonSettings {
+        crate::env::PythonSettings {
+            interpreter: self.python.clone(),
+            module_dir: self.module_dir.clone(),
+            allowed_modules: self.allow_module.clone(),
+        }
     }
 
     /// Where runs find their library, and whether they may train a missing one: the
@@ -434,7 +478,7 @@ pub struct ImportArgs {
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
 
-    /// The policy's name in the library (a plain file name, e.g. `sb3-64x64`).
+    /// The policy's name in the library: letters, digits, `.`, `-` and `_` (e.g. `sb3-64x64`).
     #[arg(long, value_name = "NAME")]
     pub name: String,
 

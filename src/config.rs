@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::dqn::Init;
-use crate::env::{CartPoleParams, EnvConfig};
+use crate::env::{CartPoleParams, EnvConfig, PythonSettings};
 use crate::reuse::prql::PrqlKnobs;
 use crate::reuse::sapnet::SapNetKnobs;
 use crate::safe_io::Links;
@@ -323,26 +323,10 @@ impl Method {
     }
 }
 
-/// The most training episodes a run (or a source) may ask for: 1,000 times the paper's
-/// longest protocol. Each episode keeps a return in memory and a row on disk.
-pub const MAX_EPISODES: u32 = 10_000_000;
-
-/// The most greedy test episodes per run.
-pub const MAX_TEST_EPISODES: u32 = 100_000;
-
-/// The most source policies a library may hold (the paper's has 10).
-pub const MAX_SOURCES: usize = 10_000;
-
-/// The most gradient updates per round: each is a minibatch, and signals are read between
-/// them.
-pub const MAX_GRADIENT_STEPS: u32 = 10_000;
-
-/// The largest minibatch.
-pub const MAX_BATCH: usize = 1 << 16;
-
-/// The most runs per method a protocol may ask for: far beyond what a comparison needs
-/// (hundreds separate the closest methods), and refused before anything is planned.
-pub const MAX_RUNS: u32 = 10_000;
+pub use crate::limits::{
+    MAX_BATCH, MAX_EPISODES, MAX_GRADIENT_STEPS, MAX_HIDDEN_LAYERS, MAX_RUNS, MAX_SOURCES,
+    MAX_STEPS, MAX_TEST_EPISODES,
+};
 
 /// What an experiment runs and how often (paper III-B).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -421,10 +405,6 @@ pub enum ConfigError {
     #[error("config {}: {message}", origin)]
     Invalid { origin: String, message: String },
 }
-
-/// Most hidden layers a network may have: far deeper than these tasks need, and a bound on
-/// the names that results derive from a method's layers.
-pub const MAX_HIDDEN_LAYERS: usize = 64;
 
 /// The largest RON file read (configs, teach lessons, policy metadata, manifests): 16 MiB,
 /// room for a lesson listing every edge of a 1,000-policy graph, so that `--config
@@ -616,7 +596,69 @@ impl Config {
     /// Reads and validates a config file.
     pub fn from_file(path: &Path) -> Result<Self, ConfigError> {
         let text = read_text(path)?;
-        Self::from_ron(&text, &path.display().to_string())
+        let mut config = Self::from_ron(&text, &path.display().to_string())?;
+        // A task's module folder is the config's to name, relative to the config itself:
+        // never to the folder sapnet happens to be started in.
+        let folder = path.parent().unwrap_or(Path::new(""));
+        for (_, task) in config.tasks_mut() {
+            if let EnvConfig::Gymnasium(p) = task {
+                if let Some(dir) = &mut p.module_dir {
+                    let joined = folder.join(&*dir);
+                    *dir = std::path::absolute(&joined).unwrap_or(joined);
+                }
+            }
+        }
+        Ok(config)
+    }
+
+    /// Every task of the config, with its field: the target, the sources' task, each of
+    /// the library's tasks.
+    pub fn tasks(&self) -> Vec<(String, &EnvConfig)> {
+        let mut tasks = vec![("env".to_string(), &self.env)];
+        if let Some(env) = &self.sources.env {
+            tasks.push(("sources.env".into(), env));
+        }
+        for (i, task) in self.sources.tasks.iter().enumerate() {
+            tasks.push((format!("sources.tasks[{i}].env"), &task.env));
+        }
+        tasks
+    }
+
+    fn tasks_mut(&mut self) -> Vec<(String, &mut EnvConfig)> {
+        let mut tasks = vec![("env".to_string(), &mut self.env)];
+        if let Some(env) = &mut self.sources.env {
+            tasks.push(("sources.env".into(), env));
+        }
+        for (i, task) in self.sources.tasks.iter_mut().enumerate() {
+            tasks.push((format!("sources.tasks[{i}].env"), &mut task.env));
+        }
+        tasks
+    }
+
+    /// The config as results record it: every task without how this machine runs it
+    /// ([`EnvConfig::as_recorded`]), so that a folder never names a program to run.
+    pub fn as_recorded(&self) -> Config {
+        let mut recorded = self.clone();
+        for (_, task) in recorded.tasks_mut() {
+            *task = task.as_recorded();
+        }
+        recorded
+    }
+
+    /// Runs every Gymnasium task with the user's `--python` and `--module-dir`.
+    pub fn run_with(&mut self, python: &PythonSettings) {
+        for (_, task) in self.tasks_mut() {
+            task.run_with(python);
+        }
+    }
+
+    /// Checks a config read from a folder the user may have received: none of its tasks
+    /// chooses code to run ([`EnvConfig::check_received`]).
+    pub fn check_received(&self, python: &PythonSettings) -> Result<(), String> {
+        for (field, task) in self.tasks() {
+            task.check_received(&format!("{field}.Gymnasium"), python)?;
+        }
+        Ok(())
     }
 
     /// Reads and validates a config from RON text; `origin` names it in errors.
@@ -648,9 +690,12 @@ impl Config {
         let s = &self.sources;
         if let Some(name) = &s.name {
             check(
-                crate::policy_store::is_plain_name(name) && name != "chosen",
+                crate::safe_io::is_portable_name(name) && name != "chosen",
                 "sources.name",
-                "a plain folder name (not `chosen`, no `/`, not starting with `.`)",
+                &format!(
+                    "a folder name of {} (not `chosen`)",
+                    crate::safe_io::PORTABLE_NAME
+                ),
                 format!("{name:?}"),
             )?;
         }
@@ -726,6 +771,15 @@ impl Config {
                  with it has no scores (BestSource cannot pick)"
                     .to_string(),
             );
+        }
+        for (field, task) in self.tasks() {
+            if let Some(module) = task.imported_module() {
+                said.push(format!(
+                    "{field}: the Gymnasium id {:?} imports the Python module {module} (from \
+                     the task's module_dir, your PYTHONPATH or the interpreter's packages)",
+                    task.gym_id()
+                ));
+            }
         }
         said
     }
@@ -820,10 +874,10 @@ impl Config {
         }
         if let Some(steps) = p.max_steps {
             check(
-                steps > 0,
+                (1..=MAX_STEPS).contains(&steps),
                 "protocol.max_steps",
-                "None or Some(n) with n ≥ 1",
-                "Some(0)",
+                &format!("None or Some(n) with 1 ≤ n ≤ {MAX_STEPS}"),
+                format!("Some({steps})"),
             )?;
         }
         check(

@@ -28,6 +28,7 @@ pub mod failpoint;
 pub mod folder_lock;
 pub mod headless;
 pub mod import;
+pub mod limits;
 pub mod policy_store;
 pub mod progress;
 pub mod random_episodes;

@@ -141,7 +141,10 @@ pub enum StoreError {
         path: PathBuf,
         cause: std::io::Error,
     },
-    #[error("policy name {name:?} is not a plain file name (nor {RESERVED_NAME:?})")]
+    #[error(
+        "policy name {name:?}: expected {} (and not {RESERVED_NAME:?})",
+        crate::safe_io::PORTABLE_NAME
+    )]
     InvalidName { name: String },
     /// Reading or parsing a RON file of the store (its message names the file and what it is).
     #[error("{0}")]
@@ -454,17 +457,8 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
         .collect()
 }
 
-/// Whether `name` can be a file of its own in a folder: not empty, not hidden, no path
-/// separators. What names policies, libraries and methods' labels are checked against.
-pub fn is_plain_name(name: &str) -> bool {
-    !name.is_empty()
-        && !name.starts_with('.')
-        && !name.contains(['/', '\\'])
-        && Path::new(name).file_name() == Some(name.as_ref())
-}
-
 fn check_name(name: &str) -> Result<(), StoreError> {
-    if is_plain_name(name) && name != RESERVED_NAME {
+    if crate::safe_io::is_portable_name(name) && name != RESERVED_NAME {
         Ok(())
     } else {
         Err(StoreError::InvalidName {
@@ -473,16 +467,26 @@ fn check_name(name: &str) -> Result<(), StoreError> {
     }
 }
 
+/// The hidden `*.tmp` files a save that never finished (a killed process) left in `dir`.
+pub fn temporaries(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut found = Vec::new();
+    for entry in fs::read_dir(dir)? {
+        let entry = entry?;
+        let path = entry.path();
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name.starts_with('.') && name.ends_with(".tmp") && entry.file_type()?.is_file() {
+            found.push(path);
+        }
+    }
+    Ok(found)
+}
+
 /// Removes the hidden `*.tmp` files a save that never finished (a killed process) left in
 /// `dir`. For a folder no other process is writing to: a resumed run's, a library being
 /// trained again.
 pub fn remove_temporaries(dir: &Path) -> std::io::Result<()> {
-    for entry in fs::read_dir(dir)? {
-        let path = entry?.path();
-        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
-        if name.starts_with('.') && name.ends_with(".tmp") && path.is_file() {
-            fs::remove_file(&path)?;
-        }
+    for path in temporaries(dir)? {
+        fs::remove_file(&path)?;
     }
     Ok(())
 }

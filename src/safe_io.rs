@@ -13,6 +13,10 @@
 //! - a folder written into is a real directory, not a link to somewhere else
 //!   ([`real_dir`]).
 //!
+//! - a **name** that becomes a file name or a column of a CSV file (a policy, a library, a
+//!   method's own label) is portable: letters, digits, `.`, `-` and `_`, not starting with
+//!   a dot ([`is_portable_name`]).
+//!
 //! Paths the user names on the command line (`--config FILE`) may be links: the user
 //! chose them. They are still read only if they are regular files.
 
@@ -29,6 +33,26 @@ pub enum Links {
     /// A path inside a folder: a link there was planted, and is refused.
     Refuse,
 }
+
+/// The longest portable name: a file name's limit on every common file system.
+pub const MAX_NAME_BYTES: usize = 255;
+
+/// Whether `name` may name a file in a shared folder and a column of a CSV file: not empty,
+/// at most [`MAX_NAME_BYTES`], only ASCII letters, digits, `.`, `-` and `_`, not starting
+/// with a dot (hidden files are temporaries). So no name can leave its folder, shift a
+/// CSV column (`,` `"` a newline) or differ between systems.
+pub fn is_portable_name(name: &str) -> bool {
+    !name.is_empty()
+        && name.len() <= MAX_NAME_BYTES
+        && !name.starts_with('.')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_'))
+}
+
+/// What [`is_portable_name`] expects, for messages.
+pub const PORTABLE_NAME: &str =
+    "letters, digits, `.`, `-` and `_`, not starting with `.`, at most 255 of them";
 
 /// Opens `path` for reading if it is a regular file of at most `limit` bytes.
 pub fn open(path: &Path, links: Links, limit: u64) -> io::Result<File> {

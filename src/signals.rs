@@ -42,6 +42,8 @@ pub fn stop_on_signals() -> Result<Receiver<Command>> {
         .spawn(move || {
             for signal in signals.forever() {
                 if RECEIVED.swap(signal, Ordering::SeqCst) == 0 {
+                    // A run waiting for a Gymnasium worker stops waiting.
+                    crate::env::gymnasium::interrupt_waits();
                     // stderr may be a terminal that is gone: never panic on it.
                     let _ = writeln!(
                         std::io::stderr(),

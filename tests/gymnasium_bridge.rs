@@ -7,45 +7,13 @@ mod common;
 
 use common::library::copy_library;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use sapnet::env::{self, EnvConfig, Environment, GymnasiumParams};
-
-/// The Python to test with, if it has Gymnasium with Box2D.
-fn python() -> Option<PathBuf> {
-    let python = std::env::var_os("SAPNET_TEST_PYTHON")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("VIRTUAL_ENV").map(|v| PathBuf::from(v).join("bin/python")))?;
-    let ok = Command::new(&python)
-        .args(["-c", "import gymnasium, Box2D"])
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    if !ok {
-        eprintln!(
-            "{} has no gymnasium[box2d]: the bridge tests are skipped",
-            python.display()
-        );
-        return None;
-    }
-    Some(python)
-}
-
-macro_rules! python_or_skip {
-    () => {
-        match python() {
-            Some(p) => p,
-            None => {
-                eprintln!("no Python with Gymnasium (SAPNET_TEST_PYTHON): skipped");
-                return;
-            }
-        }
-    };
-}
 
 fn gymnasium(
     python: &Path,
@@ -399,16 +367,16 @@ fn the_python_side_killed_fails_the_run_within_a_second() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // The worker is a child of the sapnet process whose command line holds the bridge's
-    // script (its first comment names it); the planning's short-lived one (asked for the
-    // task's spaces) has gone by the time training has run a moment.
+    // The worker is a child of the sapnet process whose command line names the bridge's
+    // script; the planning's short-lived one (asked for the task's spaces) has gone by the
+    // time training has run a moment.
     let workers = || {
         let found = Command::new("pgrep")
             .args([
                 "-P",
                 &child.id().to_string(),
                 "-f",
-                "sapnet's Gymnasium bridge",
+                sapnet::env::gymnasium::SCRIPT_NAME,
             ])
             .output()
             .unwrap();
@@ -614,7 +582,7 @@ fn the_python_side_killed_under_the_dashboard_is_said_and_the_terminal_restored(
     );
     session.keys("q");
     let screen = session.wait_for(&["SAPNET-EXITED", "icanon"]);
-    assert!(screen.contains("stopped answering"), "{screen}");
+    assert!(screen.contains("ended during a step"), "{screen}");
     assert!(
         !screen.contains("SAPNET-EXITED 0"),
         "a failed run exits 0:\n{screen}"

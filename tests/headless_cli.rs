@@ -433,7 +433,7 @@ fn flags_a_subcommand_would_ignore_are_refused() {
     let cases: [(&[&str], &str); 5] = [
         (
             &["env", "--library", "/nonexistent", "--jobs", "5"],
-            "`sapnet env` does not read --jobs, --library: leave them out (it reads --config, --seed)",
+            "`sapnet env` does not read --jobs, --library: leave them out (it reads --config, --seed, --python, --module-dir)",
         ),
         (
             &["plot", "--seed", "3", "/nonexistent"],

@@ -121,7 +121,7 @@ fn a_doctored_summary_cannot_make_a_resume_write_outside_its_folder() {
         .arg(&out)
         .output()
         .unwrap();
-    refused(output, "expected a plain name");
+    refused(output, "expected a name of letters, digits");
     // A library name that does.
     json["config"]["protocol"]["methods"] = serde_json::json!([{"Dqn": {"hidden": [16]}}]);
     json["config"]["sources"]["name"] = "../victim".into();

@@ -478,8 +478,8 @@ fn malformed_and_unrepresentable_files_are_refused_by_name_and_change_nothing() 
     for (name, reason) in [
         ("source-0", "belong to the sources a config plans"),
         ("source-77", "belong to the sources a config plans"),
-        ("library", "plain file name"),
-        ("../x", "plain file name"),
+        ("library", "expected a policy name of letters, digits"),
+        ("../x", "expected a policy name of letters, digits"),
     ] {
         let output = import(tmp.path(), &good, name, &[]);
         assert_eq!(output.status.code(), Some(2), "{}", stderr(&output));

@@ -24,7 +24,7 @@ pub use cartpole::CartPole;
 pub use mountain_car::MountainCar;
 pub use params::{
     AcrobotParams, ActionSet, CartPoleParams, EnvConfig, GymnasiumParams, Integrator,
-    MountainCarParams,
+    MountainCarParams, PythonSettings, WorkerTimeouts,
 };
 
 /// What one call of [`Environment::step`] returns (Gymnasium's 5-tuple without `info`).
@@ -61,6 +61,9 @@ pub enum EnvError {
     },
     #[error("{0}")]
     Gymnasium(String),
+    /// A wait for a Gymnasium worker ended because the process is stopping (a signal).
+    #[error("stopped while waiting for the Python side")]
+    Interrupted,
 }
 
 impl EnvError {

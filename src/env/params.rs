@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
@@ -49,10 +49,77 @@ impl EnvConfig {
         match self {
             EnvConfig::Gymnasium(p) => EnvConfig::Gymnasium(GymnasiumParams {
                 python: None,
+                module_dir: None,
                 ..p.clone()
             }),
             native => native.clone(),
         }
+    }
+
+    /// Sets how this machine runs the task from the user's own invocation (`--python`,
+    /// `--module-dir`): a Gymnasium task's interpreter and module folder, where given.
+    pub fn run_with(&mut self, python: &PythonSettings) {
+        if let EnvConfig::Gymnasium(p) = self {
+            if let Some(interpreter) = &python.interpreter {
+                p.python = Some(interpreter.clone());
+            }
+            if let Some(dir) = &python.module_dir {
+                p.module_dir = Some(dir.clone());
+            }
+        }
+    }
+
+    /// The Python module a Gymnasium id imports before making its task (`"my_envs:Maze-v0"`
+    /// imports `my_envs`), if it names one.
+    pub fn imported_module(&self) -> Option<&str> {
+        match self {
+            EnvConfig::Gymnasium(p) => p.id.split_once(':').map(|(module, _)| module),
+            _ => None,
+        }
+    }
+
+    /// Checks a task read from a folder the user may have received (a results folder's
+    /// `summary.json`, a sweep's cell): it may not choose code to run. A program
+    /// (`python`), a folder to import from (`module_dir`) or a module to import (an id
+    /// `module:Env`) is refused unless the user's own invocation names the same one
+    /// (`--python`, `--module-dir`, `--allow-module`). `field` is the task's path in the
+    /// config, for the message.
+    pub fn check_received(&self, field: &str, python: &PythonSettings) -> Result<(), String> {
+        let EnvConfig::Gymnasium(p) = self else {
+            return Ok(());
+        };
+        let refuse = |name: &str, stored: &Path, flag: &str, given: &Option<PathBuf>| {
+            let given = given.as_ref().map_or(String::new(), |g| {
+                format!(" (you gave {flag} {})", g.display())
+            });
+            Err(format!(
+                "field `{field}.{name}` names {}{given}: a folder from elsewhere does not choose \
+                 what sapnet runs (sapnet records none; this folder was written by hand or by an \
+                 older sapnet). Give your own with {flag} PATH, the same path if you trust it",
+                stored.display()
+            ))
+        };
+        if let Some(stored) = &p.python {
+            if python.interpreter.as_ref() != Some(stored) {
+                return refuse("python", stored, "--python", &python.interpreter);
+            }
+        }
+        if let Some(stored) = &p.module_dir {
+            if python.module_dir.as_ref() != Some(stored) {
+                return refuse("module_dir", stored, "--module-dir", &python.module_dir);
+            }
+        }
+        if let Some(module) = self.imported_module() {
+            if !python.allowed_modules.iter().any(|m| m == module) {
+                return Err(format!(
+                    "field `{field}.id` is {:?}, which imports the Python module {module}: a \
+                     folder from elsewhere does not choose code to run. Give --allow-module \
+                     {module} if you trust it",
+                    p.id
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Gymnasium's id of the task (`CartPole-v1`, `LunarLander-v3`), without starting it.
@@ -356,7 +423,58 @@ pub struct GymnasiumParams {
     /// PRQ-learning and pooled reports; required unless [`known`] has them for `id`.
     pub return_range: Option<Vec<f64>>,
     /// The Python that has Gymnasium; `None`: the active virtualenv's, else `python3`.
+    /// How this machine runs the task, not the task: never recorded with results or a
+    /// library ([`EnvConfig::as_recorded`]), and `--python` overrides it.
     pub python: Option<PathBuf>,
+    /// A folder the worker adds to Python's path, for an id that names a module of the
+    /// user's own (`"my_envs:Maze-v0"` imports `my_envs` from it). Relative to the config
+    /// file's folder. Like `python`, never recorded; nothing else is imported from the
+    /// folder sapnet runs in.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub module_dir: Option<PathBuf>,
+    /// How long the Python side may take to make the environment, and each step or reset.
+    #[serde(skip_serializing_if = "WorkerTimeouts::is_default")]
+    pub timeouts: WorkerTimeouts,
+}
+
+/// How this machine runs Gymnasium tasks, from the user's own invocation (flags), never
+/// from a folder: the interpreter (`--python`), the folder of the user's own environment
+/// modules (`--module-dir`), and the modules a received folder's task ids may import
+/// (`--allow-module`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PythonSettings {
+    pub interpreter: Option<PathBuf>,
+    pub module_dir: Option<PathBuf>,
+    pub allowed_modules: Vec<String>,
+}
+
+/// Seconds the Python side of a Gymnasium task may take before it is killed and the run
+/// fails: `timeouts: (start: 120, step: 60)`, each at most [`WorkerTimeouts::MAX`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct WorkerTimeouts {
+    /// Importing Gymnasium and making the environment.
+    pub start: u32,
+    /// One step, reset or state exchange.
+    pub step: u32,
+}
+
+impl WorkerTimeouts {
+    /// A day: longer is a hang, not a slow task.
+    pub const MAX: u32 = 86_400;
+
+    fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
+impl Default for WorkerTimeouts {
+    fn default() -> Self {
+        Self {
+            start: 120,
+            step: 60,
+        }
+    }
 }
 
 impl GymnasiumParams {
@@ -386,6 +504,19 @@ impl GymnasiumParams {
         }
         if let Some(steps) = self.max_episode_steps {
             rules.time_limit(steps);
+        }
+        for (field, seconds) in [
+            ("timeouts.start", self.timeouts.start),
+            ("timeouts.step", self.timeouts.step),
+        ] {
+            rules.holds(
+                field,
+                (1..=WorkerTimeouts::MAX).contains(&seconds),
+                &format!(
+                    "seconds from 1 to {} (a day), got {seconds}",
+                    WorkerTimeouts::MAX
+                ),
+            );
         }
         match self.return_range.as_deref() {
             Some(range) => rules.holds(

@@ -21,10 +21,24 @@ pub struct LibraryCopies {
 
 impl LibraryCopies {
     pub fn new(config: &Config, out_dir: &Path, library: &Path) -> Self {
-        // A policy's name may not start with a dot (hidden files are the store's temporaries).
+        // A policy's name is portable (`crate::safe_io::is_portable_name`): the folder's
+        // name with anything else as `-`, and no leading dot (hidden files are the store's
+        // temporaries).
         let prefix = out_dir
             .file_name()
-            .map(|n| n.to_string_lossy().trim_start_matches('.').to_string())
+            .map(|n| {
+                n.to_string_lossy()
+                    .chars()
+                    .map(|c| match c {
+                        'a'..='z' | 'A'..='Z' | '0'..='9' | '.' | '-' | '_' => c,
+                        _ => '-',
+                    })
+                    .collect::<String>()
+                    .trim_start_matches('.')
+                    .chars()
+                    .take(200)
+                    .collect::<String>()
+            })
             .filter(|n| !n.is_empty())
             .unwrap_or_else(|| "results".into());
         Self {

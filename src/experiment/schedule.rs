@@ -8,6 +8,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 
+use crate::env::EnvError;
 use crate::trainer::{self, Command, Event, RunHandle, RunOutcome, RunSpec, TrainerError};
 
 /// How often the scheduler drains the runs' events and checks for a stop.
@@ -95,6 +96,14 @@ pub fn schedule(
                 )
             })?;
             match outcome {
+                // A signal ended its wait for a Gymnasium worker: stopped, not failed (it
+                // runs again from its seeds on a resume, as any stopped run).
+                Err(TrainerError::Env(EnvError::Interrupted)) => {
+                    stopping = true;
+                    for other in &active {
+                        let _ = other.handle.commands.send(Command::Stop);
+                    }
+                }
                 Ok(outcome) => {
                     stopping |= outcome.record.stopped;
                     observer.on_finished(run.order, &run.spec, outcome)?;

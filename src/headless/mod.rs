@@ -41,6 +41,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 
 use crate::config::{Config, MethodKind};
+use crate::env::PythonSettings;
 use crate::experiment::{self, LibraryCopies};
 use crate::progress::{Progress, Unit};
 use crate::report::LibraryEntry;
@@ -120,6 +121,7 @@ pub fn run(
 pub fn resume(
     dir: &Path,
     runs: Option<u32>,
+    python: &PythonSettings,
     options: &RunOptions,
     commands: &Receiver<Command>,
 ) -> Result<Summary> {
@@ -132,6 +134,14 @@ pub fn resume(
     let _lock = crate::folder_lock::FolderLock::acquire(dir, "a resume")?;
     output::finish_replacement(dir)?;
     let mut header = results::read_header(dir)?;
+    // The folder says what to train, never what program or module runs it.
+    header.config.check_received(python).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: the stored config: {e}",
+            dir.join("summary.json").display()
+        )
+    })?;
+    header.config.run_with(python);
     if let Some(runs) = runs {
         let had = header.config.protocol.runs;
         if runs < had {

@@ -8,6 +8,13 @@
 //! rather than copied when a memo entry is fetched, so a small pickle cannot grow
 //! exponentially by fetching a container into itself (candle's reader clones them), and
 //! nesting is bounded so that dropping a value cannot overflow the stack.
+//!
+//! Sharing makes a bound on nesting subtle: a list memoised, fetched and then grown would
+//! leave every earlier copy of its depth stale. So a list or dict is *sealed* once it is
+//! put inside another container (as `pickle.dump` writes them: filled, then used), a sealed
+//! one cannot grow, and a container keeps its depth itself, where every alias sees it.
+//! With no container growing after it is nested, no cycle can be made and every depth is
+//! exact.
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -90,8 +97,8 @@ pub enum Value {
     Float(f64),
     Str(Rc<str>),
     Tuple(Rc<Vec<Value>>),
-    List(Rc<RefCell<Vec<Value>>>),
-    Dict(Rc<RefCell<Vec<(Value, Value)>>>),
+    List(Shared<Vec<Value>>),
+    Dict(Shared<Vec<(Value, Value)>>),
     Global(Global),
     Storage(Rc<StorageRef>),
     Tensor(Rc<TensorRef>),
@@ -99,7 +106,38 @@ pub enum Value {
     Mark,
 }
 
+/// A list or dict as the memo shares it: every alias sees it grow.
+pub type Shared<T> = Rc<RefCell<Container<T>>>;
+
+/// A list's or dict's items, with what the machine keeps of it: how deeply it nests, and
+/// whether it sits inside another container already (then it may not grow).
+#[derive(Debug, Default)]
+pub struct Container<T> {
+    pub items: T,
+    depth: usize,
+    sealed: bool,
+}
+
 impl Value {
+    /// How deeply the value nests: a container's own depth, which its aliases share; a
+    /// tuple's, which never changes, is kept beside it on the stack (`recorded`).
+    fn depth(&self, recorded: usize) -> usize {
+        match self {
+            Value::List(list) => list.borrow().depth,
+            Value::Dict(dict) => dict.borrow().depth,
+            _ => recorded,
+        }
+    }
+
+    /// Marks a list or dict as put inside another container.
+    fn seal(&self) {
+        match self {
+            Value::List(list) => list.borrow_mut().sealed = true,
+            Value::Dict(dict) => dict.borrow_mut().sealed = true,
+            _ => {}
+        }
+    }
+
     fn kind(&self) -> &'static str {
         match self {
             Value::None => "None",
@@ -362,28 +400,22 @@ impl Machine {
     }
 
     fn push_tuple(&mut self, items: Vec<(Value, usize)>) -> Result<(), String> {
-        let depth = 1 + items.iter().map(|(_, d)| *d).max().unwrap_or(0);
+        let depth = 1 + nested(&items)?;
         let values = items.into_iter().map(|(v, _)| v).collect();
         self.push(Value::Tuple(Rc::new(values)), depth)
     }
 
-    fn top_container(&mut self, children: usize) -> Result<&mut (Value, usize), String> {
-        let top = self.stack.last_mut().ok_or("the stack is empty")?;
-        top.1 = top.1.max(children + 1);
-        if top.1 > MAX_DEPTH {
-            return Err(format!("containers nested more than {MAX_DEPTH} deep"));
-        }
-        Ok(top)
-    }
-
     fn extend_list(&mut self, items: Vec<(Value, usize)>) -> Result<(), String> {
-        let depth = items.iter().map(|(_, d)| *d).max().unwrap_or(0);
-        match &self.top_container(depth)?.0 {
-            Value::List(list) => {
-                list.borrow_mut().extend(items.into_iter().map(|(v, _)| v));
+        let depth = 1 + nested(&items)?;
+        match self.stack.last() {
+            Some((Value::List(list), _)) => {
+                let mut list = list.borrow_mut();
+                list.grow(depth)?;
+                list.items.extend(items.into_iter().map(|(v, _)| v));
                 Ok(())
             }
-            other => Err(format!("APPEND to {}", other.kind())),
+            Some((other, _)) => Err(format!("APPEND to {}", other.kind())),
+            None => Err("the stack is empty".into()),
         }
     }
 
@@ -391,17 +423,19 @@ impl Machine {
         if !items.len().is_multiple_of(2) {
             return Err("SETITEMS with a key and no value".into());
         }
-        let depth = items.iter().map(|(_, d)| *d).max().unwrap_or(0);
-        match &self.top_container(depth)?.0 {
-            Value::Dict(dict) => {
+        let depth = 1 + nested(&items)?;
+        match self.stack.last() {
+            Some((Value::Dict(dict), _)) => {
                 let mut dict = dict.borrow_mut();
+                dict.grow(depth)?;
                 let mut items = items.into_iter().map(|(v, _)| v);
                 while let (Some(k), Some(v)) = (items.next(), items.next()) {
-                    dict.push((k, v));
+                    dict.items.push((k, v));
                 }
                 Ok(())
             }
-            other => Err(format!("SETITEM on {}", other.kind())),
+            Some((other, _)) => Err(format!("SETITEM on {}", other.kind())),
+            None => Err("the stack is empty".into()),
         }
     }
 
@@ -412,6 +446,31 @@ impl Machine {
             .ok_or("MEMOIZE on an empty stack")?
             .clone();
         self.memo.insert(id, top);
+        Ok(())
+    }
+}
+
+/// The deepest of `items`, which are about to be put inside a container: each list or dict
+/// among them is sealed first, so that one put inside itself is refused as sealed.
+fn nested(items: &[(Value, usize)]) -> Result<usize, String> {
+    items.iter().for_each(|(v, _)| v.seal());
+    Ok(items.iter().map(|(v, d)| v.depth(*d)).max().unwrap_or(0))
+}
+
+impl<T> Container<T> {
+    /// The container receives items that make it `needed` deep.
+    fn grow(&mut self, needed: usize) -> Result<(), String> {
+        if self.sealed {
+            return Err(
+                "a list or dict grown after it was put inside another container (pickle.dump \
+             fills a container before using it): not a state dict"
+                    .into(),
+            );
+        }
+        self.depth = self.depth.max(needed);
+        if self.depth > MAX_DEPTH {
+            return Err(format!("containers nested more than {MAX_DEPTH} deep"));
+        }
         Ok(())
     }
 }
@@ -507,9 +566,9 @@ mod tests {
             panic!("not a dict")
         };
         let dict = dict.borrow();
-        assert_eq!(dict.len(), 1);
-        let (Value::Str(key), Value::Tensor(t)) = &dict[0] else {
-            panic!("{:?}", dict[0])
+        assert_eq!(dict.items.len(), 1);
+        let (Value::Str(key), Value::Tensor(t)) = &dict.items[0] else {
+            panic!("{:?}", dict.items[0])
         };
         assert_eq!(&**key, "w");
         assert_eq!(
@@ -555,5 +614,28 @@ mod tests {
         // Nesting grows by one per round: refused past the bound, never exponential.
         let err = read(&p).unwrap_err();
         assert!(err.contains("nested more than"), "{err}");
+    }
+
+    /// Issue 34, item 5: `] q1 h0 a` repeated, 3.3 MB of it, overflowed the stack: each new
+    /// list, memoised, received the one before it, fetched from the memo with the depth it
+    /// had when stored. Now a list put into another is sealed, so the chain is refused at
+    /// its second link, and memo depths cannot be stale.
+    #[test]
+    fn a_chain_through_the_memo_is_refused_however_long() {
+        let mut p = b"\x80\x02]q\x00".to_vec();
+        for _ in 0..400_000 {
+            p.extend(b"]q\x01h\x00aq\x00");
+        }
+        p.push(b'.');
+        let err = read(&p).unwrap_err();
+        assert!(
+            err.contains("nested more than") || err.contains("grown after"),
+            "{err}"
+        );
+        // A container appended into itself, directly or through another, is refused too.
+        let err = read(b"\x80\x02]q\x00h\x00a.").unwrap_err();
+        assert!(err.contains("grown after"), "{err}");
+        let err = read(b"\x80\x02]q\x00]q\x01h\x00ah\x00h\x01a.").unwrap_err();
+        assert!(err.contains("grown after"), "{err}");
     }
 }

@@ -48,13 +48,19 @@ pub fn entry(zip: &mut Archive, name: &str, limit: u64) -> Result<Vec<u8>, Strin
             file.size()
         ));
     }
-    let mut bytes = Vec::with_capacity(file.size() as usize);
+    // The declared size is the file's word, not its bytes: a header may declare 2^62. The
+    // buffer grows with what is actually read, from a start no larger than a megabyte.
+    let declared = file.size();
+    let mut bytes = Vec::with_capacity(declared.min(1 << 20) as usize);
     file.by_ref()
         .take(limit + 1)
         .read_to_end(&mut bytes)
         .map_err(|e| format!("reading entry {name}: {e}"))?;
-    if bytes.len() as u64 > limit {
-        return Err(format!("entry {name} is larger than its header says"));
+    if bytes.len() as u64 != declared {
+        return Err(format!(
+            "entry {name} holds {} bytes where its header says {declared}",
+            bytes.len()
+        ));
     }
     Ok(bytes)
 }
@@ -106,8 +112,8 @@ pub fn state_dict_in(zip: &mut Archive) -> Result<Vec<NamedTensor>, String> {
         ));
     };
     let dict = dict.borrow();
-    let mut tensors = Vec::with_capacity(dict.len());
-    for (key, value) in dict.iter() {
+    let mut tensors = Vec::with_capacity(dict.items.len());
+    for (key, value) in dict.items.iter() {
         let Value::Str(key) = key else {
             return Err(format!(
                 "{pickle_name}: a key of the state dict is not a string"
@@ -185,4 +191,85 @@ fn row_major_strides(shape: &[usize]) -> Vec<usize> {
         strides[i] = strides[i + 1] * shape[i + 1];
     }
     strides
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A zip of one stored entry `data/0` holding `data`, whose local and central headers
+    /// declare `declared` bytes (through the zip64 extra field, as a file may lie).
+    fn lying_zip(data: &[u8], declared: u64) -> Vec<u8> {
+        let name = b"data/0";
+        // CRC-32 (IEEE), bit by bit: a test's few bytes.
+        let crc = !data.iter().fold(!0u32, |mut crc, &byte| {
+            crc ^= u32::from(byte);
+            for _ in 0..8 {
+                crc = (crc >> 1) ^ (0xEDB8_8320 & (crc & 1).wrapping_neg());
+            }
+            crc
+        });
+        // The zip64 extra field: the uncompressed size only (the 32-bit field is 0xFFFFFFFF).
+        let extra = [
+            &1u16.to_le_bytes()[..],
+            &8u16.to_le_bytes(),
+            &declared.to_le_bytes(),
+        ]
+        .concat();
+        let mut zip = Vec::new();
+        let header = |zip: &mut Vec<u8>, signature: u32, central: bool| {
+            zip.extend(signature.to_le_bytes());
+            if central {
+                zip.extend(45u16.to_le_bytes()); // made by
+            }
+            zip.extend(45u16.to_le_bytes()); // needed
+            zip.extend([0u8; 2]); // flags
+            zip.extend([0u8; 2]); // stored
+            zip.extend([0u8; 4]); // time, date
+            zip.extend(crc.to_le_bytes());
+            zip.extend((data.len() as u32).to_le_bytes()); // compressed
+            zip.extend(u32::MAX.to_le_bytes()); // uncompressed: see the extra field
+            zip.extend((name.len() as u16).to_le_bytes());
+            zip.extend((extra.len() as u16).to_le_bytes());
+            if central {
+                zip.extend([0u8; 2]); // comment
+                zip.extend([0u8; 2]); // disk
+                zip.extend([0u8; 2]); // internal attributes
+                zip.extend([0u8; 4]); // external attributes
+                zip.extend(0u32.to_le_bytes()); // the local header's offset
+            }
+            zip.extend(name);
+            zip.extend(&extra);
+        };
+        header(&mut zip, 0x0403_4b50, false);
+        zip.extend(data);
+        let central = zip.len();
+        header(&mut zip, 0x0201_4b50, true);
+        let size = zip.len() - central;
+        zip.extend(0x0605_4b50u32.to_le_bytes());
+        zip.extend([0u8; 4]); // disks
+        zip.extend(1u16.to_le_bytes());
+        zip.extend(1u16.to_le_bytes());
+        zip.extend((size as u32).to_le_bytes());
+        zip.extend((central as u32).to_le_bytes());
+        zip.extend([0u8; 2]);
+        zip
+    }
+
+    /// Issue 34, item 6: an entry of 128 bytes declaring 2^62 aborted the import (the
+    /// declared size was allocated before reading); it is refused for what it holds.
+    #[test]
+    fn an_entry_is_read_for_the_bytes_it_holds_not_the_size_it_declares() {
+        let bytes = lying_zip(&[7u8; 128], 1 << 62);
+        let mut zip = archive(&bytes).unwrap();
+        let err = entry(&mut zip, "data/0", u64::MAX).unwrap_err();
+        assert!(
+            err.contains("data/0") && err.contains("header says"),
+            "{err}"
+        );
+        // The same entry telling the truth reads back.
+        let honest = lying_zip(&[7u8; 128], 128);
+        let mut zip = archive(&honest).unwrap();
+        assert_eq!(entry(&mut zip, "data/0", 1024).unwrap(), vec![7u8; 128]);
+    }
 }

@@ -37,6 +37,9 @@ struct TestRow {
 /// replacing those there, and returns the summary. A protocol whose process was killed
 /// (`summary.json` still `running`) is marked `interrupted`.
 pub fn replot(dir: &Path) -> Result<Summary> {
+    read_header(dir)?;
+    // A folder whose protocol still runs is that process's to write: refused, naming it.
+    let _lock = crate::folder_lock::FolderLock::acquire(dir, "sapnet plot")?;
     let header = read_header(dir)?;
     super::require_records(dir, &header)?;
     let status = match header.status {

@@ -84,7 +84,8 @@ impl Summary {
             status: Status::Running,
             unfinished: Vec::new(),
             crate_version: env!("CARGO_PKG_VERSION"),
-            config: config.clone(),
+            // Without how this machine runs its tasks: a folder never names a program.
+            config: config.as_recorded(),
             trace,
             library: None,
             runs: Vec::new(),

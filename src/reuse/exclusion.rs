@@ -31,9 +31,11 @@ impl Exclusion {
                 "field `{field}.after`: expected at least 1 negative judgment, got 0"
             ));
         }
-        if self.steps == 0 {
+        if !(1..=crate::limits::MAX_STEPS).contains(&self.steps) {
             return Err(format!(
-                "field `{field}.steps`: expected at least 1 step, got 0"
+                "field `{field}.steps`: expected 1 to {} steps, got {}",
+                crate::limits::MAX_STEPS,
+                self.steps
             ));
         }
         Ok(())
@@ -79,14 +81,14 @@ impl Exclusions {
             self.negatives[c] = 0;
             return;
         }
-        self.negatives[c] += 1;
+        self.negatives[c] = self.negatives[c].saturating_add(1);
         if self.negatives[c] < self.rule.after || self.until[c].is_some() {
             return;
         }
         self.negatives[c] = 0;
         let others_stand = (0..self.until.len()).any(|k| k != c && self.until[k].is_none());
         if others_stand {
-            self.until[c] = Some(step + self.rule.steps);
+            self.until[c] = Some(step.saturating_add(self.rule.steps));
             self.made[c] += 1;
             self.mark();
         }
@@ -199,5 +201,13 @@ mod tests {
             Err("field `protocol.methods[1].SapNetWith.exclusion.after`: expected at least 1 negative judgment, got 0".into())
         );
         assert!(Exclusion { after: 2, steps: 0 }.validate("x").is_err());
+        // Issue 34, item 8: "for ever" wrapped around to the next step.
+        let err = Exclusion {
+            after: 1,
+            steps: u64::MAX,
+        }
+        .validate("x")
+        .unwrap_err();
+        assert!(err.contains("expected 1 to 1000000000000 steps"), "{err}");
     }
 }

@@ -274,12 +274,13 @@ pub(crate) fn argmax(values: &[f64]) -> usize {
 /// that cannot be a file name would fail the protocol after training, so it is refused
 /// with its field first.
 pub fn check_label(field: &str, label: &str) -> Result<(), String> {
-    if crate::policy_store::is_plain_name(label) {
+    if crate::safe_io::is_portable_name(label) {
         Ok(())
     } else {
         Err(format!(
-            "field `{field}.label`: expected a plain name (it names the run's files: not \
-             empty, no '/' or '\\', not starting with '.'), got {label:?}"
+            "field `{field}.label`: expected a name of {} (it names the run's files and \
+             columns), got {label:?}",
+            crate::safe_io::PORTABLE_NAME
         ))
     }
 }

@@ -357,7 +357,7 @@ mod tests {
         assert!(slash
             .validate("protocol.methods[4]")
             .unwrap_err()
-            .starts_with("field `protocol.methods[4].label`: expected a plain name"));
+            .starts_with("field `protocol.methods[4].label`: expected a name of letters, digits"));
     }
 
     #[test]

@@ -787,14 +787,16 @@ mod tests {
 
     #[test]
     fn a_label_that_cannot_name_a_file_is_refused() {
-        for label in ["my/slash", "", ".hidden", "back\\slash"] {
+        for label in ["my/slash", "", ".hidden", "back\\slash", "a,b", "new\nline"] {
             let knobs = SapNetKnobs {
                 label: Some(label.to_string()),
                 ..SapNetKnobs::default()
             };
             let err = knobs.validate("protocol.methods[1]").unwrap_err();
             assert!(
-                err.starts_with("field `protocol.methods[1].label`: expected a plain name"),
+                err.starts_with(
+                    "field `protocol.methods[1].label`: expected a name of letters, digits"
+                ),
                 "{label}: {err}"
             );
         }

@@ -36,8 +36,11 @@ impl Schedule {
                 ));
             }
         }
-        if steps == 0 {
-            return Err(format!("field `{field}.steps`: expected at least 1, got 0"));
+        if !(1..=crate::limits::MAX_STEPS).contains(&steps) {
+            return Err(format!(
+                "field `{field}.steps`: expected 1 to {}, got {steps}",
+                crate::limits::MAX_STEPS
+            ));
         }
         Ok(())
     }

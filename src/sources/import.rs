@@ -2,6 +2,7 @@
 //! finished library, written as every library policy is and listed in the manifest's
 //! `imported`, so that every run, comparison, screen and sweep reuses it as a source.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
@@ -40,10 +41,10 @@ pub fn import(
     prefix: Option<&str>,
 ) -> Result<Imported> {
     let dir = library_dir(library, config);
-    if !policy_store::is_plain_name(name) || name == policy_store::RESERVED_NAME {
+    if !crate::safe_io::is_portable_name(name) || name == policy_store::RESERVED_NAME {
         bail!(
-            "--name {name:?}: expected a plain file name for the policy (no `/`, not hidden, not \
-             {:?})",
+            "--name {name:?}: expected a policy name of {} (not {:?})",
+            crate::safe_io::PORTABLE_NAME,
             policy_store::RESERVED_NAME
         );
     }
@@ -77,6 +78,7 @@ pub fn import(
     }
     // Read again under the lock: a training or another import may have written it since.
     let _lock = crate::folder_lock::FolderLock::acquire(&dir, "library import")?;
+    recover_locked(&dir)?;
     let mut found = manifest::read(&dir)?
         .ok_or_else(|| anyhow::anyhow!("{}'s manifest went away", dir.display()))?;
     if !found.complete {
@@ -121,8 +123,15 @@ pub fn import(
         reused: None,
         origin: Some(foreign.origin.clone()),
     };
+    // The journal first: from here until the manifest lists the policy, a kill leaves a
+    // record of what to take back (`recover`).
+    let journal = dir.join(JOURNAL);
+    crate::safe_io::write_atomically(&journal, |out| out.write_all(name.as_bytes()))
+        .with_context(|| format!("writing {}", journal.display()))?;
+    crate::failpoint::point("import-journal-written");
     policy_store::save(&dir, name, &foreign.net, &info)
         .with_context(|| format!("writing {name} to {}", dir.display()))?;
+    crate::failpoint::point("import-policy-written");
     let listed = ManifestEntry::of_policy(&dir, name)
         .map_err(anyhow::Error::from)
         .and_then(|(entry, _)| {
@@ -139,6 +148,8 @@ pub fn import(
             manifest::path(&dir).display()
         )));
     }
+    crate::failpoint::point("import-listed");
+    std::fs::remove_file(&journal).with_context(|| format!("removing {}", journal.display()))?;
     Ok(Imported {
         dir,
         architecture: foreign.net.architecture().clone(),
@@ -147,4 +158,83 @@ pub fn import(
         score,
         test_episodes: episodes,
     })
+}
+
+/// An import in progress, in the library's folder: the name of the policy being added.
+/// Written before the policy's files, removed once the manifest lists them.
+const JOURNAL: &str = ".import-in-progress";
+
+/// What a killed import or save left in the library `dir`, finished by the next command
+/// that reads it: taken back if the manifest does not list its policy (the library as it
+/// was), its journal dropped if it does (the import had finished), a save's hidden
+/// temporaries removed. Takes the library's lock if there is anything to do; returns what
+/// was done, one sentence each, also said on stderr.
+pub fn recover(dir: &Path) -> Result<Vec<String>> {
+    let temporaries = policy_store::temporaries(dir).unwrap_or_default();
+    if !dir.join(JOURNAL).exists() && temporaries.is_empty() {
+        return Ok(Vec::new());
+    }
+    let _lock = crate::folder_lock::FolderLock::acquire(dir, "a library repair")?;
+    recover_locked(dir)
+}
+
+/// [`recover`], the lock held by the caller.
+pub fn recover_locked(dir: &Path) -> Result<Vec<String>> {
+    let mut done = Vec::new();
+    let journal = dir.join(JOURNAL);
+    if std::fs::symlink_metadata(&journal).is_ok() {
+        let name = crate::safe_io::read_text(&journal, crate::safe_io::Links::Refuse, 1024)
+            .with_context(|| format!("reading {}", journal.display()))?;
+        if !crate::safe_io::is_portable_name(&name) {
+            bail!(
+                "{}: names the policy {name:?}, expected {}; remove the file",
+                journal.display(),
+                crate::safe_io::PORTABLE_NAME
+            );
+        }
+        let listed =
+            manifest::read(dir)?.is_some_and(|m| m.imported.iter().any(|e| e.name == name));
+        if listed {
+            done.push(format!(
+                "the import of {name} had finished: its journal is removed"
+            ));
+        } else {
+            let (weights, metadata) = policy_store::paths(dir, &name);
+            for file in [metadata, weights] {
+                match std::fs::remove_file(&file) {
+                    Ok(()) => {}
+                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                    Err(e) => {
+                        return Err(e).with_context(|| format!("removing {}", file.display()))
+                    }
+                }
+            }
+            done.push(format!(
+                "the import of {name} was stopped before the manifest listed it: its files are \
+                 removed, the library is as before"
+            ));
+        }
+        std::fs::remove_file(&journal)
+            .with_context(|| format!("removing {}", journal.display()))?;
+    }
+    let temporaries =
+        policy_store::temporaries(dir).with_context(|| format!("listing {}", dir.display()))?;
+    if !temporaries.is_empty() {
+        policy_store::remove_temporaries(dir).with_context(|| {
+            format!("removing a killed save's leftovers from {}", dir.display())
+        })?;
+        done.push(format!(
+            "{} leftover temporary {} of a killed save removed",
+            temporaries.len(),
+            if temporaries.len() == 1 {
+                "file"
+            } else {
+                "files"
+            }
+        ));
+    }
+    for said in &done {
+        eprintln!("{}: {said}", dir.display());
+    }
+    Ok(done)
 }

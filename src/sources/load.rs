@@ -68,6 +68,9 @@ pub struct LibraryRoot {
 /// imported into it (`sapnet sources import`) come after the planned ones.
 pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>> {
     let dir = library_dir(library, config);
+    if dir.is_dir() {
+        super::import::recover(&dir)?;
+    }
     let Some(found) = manifest::read(&dir)? else {
         let on_disk = policy_files(&dir)?;
         if on_disk.is_empty() {

@@ -222,11 +222,24 @@ pub fn read(dir: &Path) -> Result<Option<Manifest>, StoreError> {
         return Ok(None);
     }
     let text = crate::config::read_folder_text(&path)?;
-    Ok(Some(parse_ron_as(
-        &text,
-        &path.display().to_string(),
-        "library manifest",
-    )?))
+    let manifest: Manifest = parse_ron_as(&text, &path.display().to_string(), "library manifest")?;
+    // A library may come from elsewhere: every name it lists becomes a file name and a
+    // column of activations.csv.
+    let entries = manifest.policies.iter().chain(&manifest.imported);
+    if let Some(entry) = entries
+        .into_iter()
+        .find(|e| !crate::safe_io::is_portable_name(&e.name))
+    {
+        return Err(StoreError::Invalid {
+            path,
+            message: format!(
+                "the library manifest lists a policy named {:?}: expected {}",
+                entry.name,
+                crate::safe_io::PORTABLE_NAME
+            ),
+        });
+    }
+    Ok(Some(manifest))
 }
 
 /// Replaces `dir`'s manifest in one rename, so a reader sees the old one or the new one.

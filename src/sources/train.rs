@@ -38,6 +38,8 @@ pub fn train_library(
     // One trainer per library: a second `sapnet sources` (or a run training a missing
     // library) into the same folder is refused while this one trains.
     let _lock = crate::folder_lock::FolderLock::acquire(&dir, "library training")?;
+    // What a killed import or save left is finished first, and said.
+    super::import::recover_locked(&dir)?;
     // Policies imported from elsewhere are not the config's to replace: they stay, listed
     // as they were, whatever is trained again.
     let imported = manifest::read(&dir)?

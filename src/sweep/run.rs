@@ -15,6 +15,7 @@ use super::{
     cell_config, cell_failure, cell_lock, cell_name, cell_partial, cell_results, Manifest,
 };
 use crate::config::Config;
+use crate::env::PythonSettings;
 use crate::folder_lock::FolderLock;
 use crate::headless::{self, OutputOptions, RunOptions};
 use crate::policy_store::sha256_hex;
@@ -53,6 +54,7 @@ pub fn run_cell(
     sweep: &Path,
     id: usize,
     jobs: usize,
+    python: &PythonSettings,
     stop: &Receiver<TrainerCommand>,
 ) -> Result<CellRun> {
     let manifest = Manifest::read(sweep)?;
@@ -75,7 +77,7 @@ pub fn run_cell(
     if state(sweep, id) == CellState::Done {
         return Ok(CellRun::AlreadyDone);
     }
-    let outcome = attempt(sweep, &manifest, entry, jobs, stop);
+    let outcome = attempt(sweep, &manifest, entry, jobs, python, stop);
     let failure = cell_failure(sweep, id);
     match &outcome {
         Err(err) => {
@@ -100,6 +102,7 @@ fn attempt(
     manifest: &Manifest,
     entry: &super::CellEntry,
     jobs: usize,
+    python: &PythonSettings,
     stop: &Receiver<TrainerCommand>,
 ) -> Result<CellRun> {
     let id = entry.id;
@@ -113,7 +116,7 @@ fn attempt(
             path.display()
         );
     }
-    let config = Config::from_ron(&text, &path.display().to_string())?;
+    let config = received_cell(&text, &path, python)?;
     let partial = cell_partial(sweep, id);
     if std::fs::symlink_metadata(&partial).is_ok() {
         std::fs::remove_dir_all(&partial)
@@ -165,6 +168,37 @@ fn attempt(
     Ok(CellRun::Finished)
 }
 
+/// A cell's config, read from a sweep folder that may come from elsewhere: it names what to
+/// train, never the program or module that runs it ([`Config::check_received`]); the
+/// user's own `--python` and `--module-dir` run it.
+fn received_cell(text: &str, path: &Path, python: &PythonSettings) -> Result<Config> {
+    let mut config = Config::from_ron(text, &path.display().to_string())?;
+    config
+        .check_received(python)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    config.run_with(python);
+    Ok(config)
+}
+
+/// The flags that give `python` to a cell's own process.
+fn python_flags(python: &PythonSettings) -> Vec<std::ffi::OsString> {
+    let mut flags = Vec::new();
+    for (flag, path) in [
+        ("--python", &python.interpreter),
+        ("--module-dir", &python.module_dir),
+    ] {
+        if let Some(path) = path {
+            flags.push(flag.into());
+            flags.push(path.into());
+        }
+    }
+    for module in &python.allowed_modules {
+        flags.push("--allow-module".into());
+        flags.push(module.into());
+    }
+    flags
+}
+
 /// Trains every library the cells reuse that is missing or unfinished, one after the other.
 /// Training writes a library where `sweep.ron` says, and a sweep folder may come from
 /// elsewhere: so a library that needs training is trained only into the `library` the
@@ -172,6 +206,7 @@ fn attempt(
 pub fn prepare(
     sweep: &Path,
     library: Option<&Path>,
+    python: &PythonSettings,
     stop: &Receiver<TrainerCommand>,
 ) -> Result<()> {
     let manifest = Manifest::read(sweep)?;
@@ -195,7 +230,8 @@ pub fn prepare(
     };
     let mut seen = Vec::new();
     for entry in &manifest.cells {
-        let config = Config::from_file(&cell_config(sweep, entry.id))?;
+        let path = cell_config(sweep, entry.id);
+        let config = received_cell(&crate::config::read_folder_text(&path)?, &path, python)?;
         if !config.protocol.methods.iter().any(|m| m.kind().reuses()) {
             continue;
         }
@@ -236,7 +272,7 @@ pub fn prepare(
 /// Runs every cell not done yet on this machine, `jobs` cells at a time, each a `sapnet
 /// sweep run --cell K` process of its own (as under Slurm or parallel) logging to
 /// `logs/NNNN.{out,err}`; a line of progress over cells on stderr. Returns how many failed.
-pub fn run_all(sweep: &Path, jobs: usize) -> Result<usize> {
+pub fn run_all(sweep: &Path, jobs: usize, python: &PythonSettings) -> Result<usize> {
     let manifest = Manifest::read(sweep)?;
     let exe = std::env::current_exe().context("finding the sapnet binary")?;
     let todo: Vec<usize> = manifest
@@ -266,6 +302,7 @@ pub fn run_all(sweep: &Path, jobs: usize) -> Result<usize> {
                 .args(["sweep", "run"])
                 .arg(sweep)
                 .args(["--cell", &id.to_string(), "--jobs", "1"])
+                .args(python_flags(python))
                 .stdout(Stdio::from(log("out")?))
                 .stderr(Stdio::from(log("err")?))
                 .spawn()

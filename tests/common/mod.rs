@@ -2,6 +2,8 @@
 #[allow(dead_code)]
 pub mod library;
 #[allow(dead_code)]
+pub mod python;
+#[allow(dead_code)]
 pub mod signal;
 #[allow(dead_code)]
 pub mod tmux;

@@ -1,36 +1,68 @@
-# The Python side of sapnet's Gymnasium bridge (src/env/gymnasium.rs): one Gymnasium
-# environment, stepped on request over stdin/stdout. Run as `python -c <this> <spec>`,
-# where <spec> is JSON: {"id", "kwargs", "attributes", "max_episode_steps"}.
+# sapnet-gymnasium-worker: the Python side of sapnet's Gymnasium bridge (src/env/gymnasium/).
+# One Gymnasium environment, stepped on request. sapnet writes this file into a private
+# folder of its own and runs `python <that file> <spec>`, the worker's current directory
+# being that folder, where <spec> is JSON: {"id", "kwargs", "attributes",
+# "max_episode_steps", "module_dir"}.
 #
-# The first line on stdout is JSON: {"obs": n, "actions": k, "max_episode_steps": m,
-# "gymnasium": version} once the environment is made and its spaces fit, else
-# {"error": message}. Then each request, 13 bytes (an opcode, a u32, a u64, little-endian;
-# set-state requests are followed by the state's f64s), is answered by one write:
+# Requests arrive on fd 3 and replies leave on fd 4: the environment's own prints (stdout)
+# go, with stderr, to sapnet's log of the worker and can never be read as a reply. Every
+# reply is one frame: a status byte (0 ok, 1 error), a u32 length, that many bytes.
 #
-#   ok:    0, the observation (n f32), the reward (f64), terminated (u8), truncated (u8)
-#   error: 1, a u32 length and that many bytes of UTF-8, padded to the ok reply's size
+#   start:     the spaces, JSON {"obs": n, "actions": k, "max_episode_steps": m,
+#              "gymnasium": version}; or an error
+#   request:   13 bytes: an opcode, a u32, a u64, little-endian; a set-state request is
+#              followed by the state's f64s
+#   step, reset, set-state: the observation (n f32), the reward (f64), terminated (u8),
+#              truncated (u8)
+#   get-state: the state's f64s
+#   error:     UTF-8 text
 #
-# and for get-state: 0, a u32 count and that many f64. End of stdin ends the worker.
-import json
+# End of fd 3 ends the worker.
 import os
-import struct
 import sys
+
+# Nothing is imported from the folder this script is in or from a current directory: only
+# the interpreter's own paths, the user's PYTHONPATH and the task's `module_dir`.
+_here = os.path.dirname(os.path.abspath(__file__))
+sys.path[:] = [p for p in sys.path if p not in ("", ".", _here, os.getcwd())]
+
+import json
+import signal
+import struct
 import traceback
+
+# Ctrl-C at the terminal is sapnet's to handle: it ends the worker by closing fd 3.
+signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+REQUESTS = 3
+REPLIES = 4
+frame_head = struct.Struct("<BI")
+
+
+def write_all(data):
+    view = memoryview(data)
+    while view:
+        view = view[os.write(REPLIES, view):]
+
+
+def send(status, payload):
+    write_all(frame_head.pack(status, len(payload)) + payload)
 
 
 def fail(message):
-    sys.stdout.write(json.dumps({"error": message}) + "\n")
-    sys.stdout.flush()
+    send(1, message.encode())
     sys.exit(0)
 
 
 spec = json.loads(sys.argv[1])
 env_id = spec["id"]
+if spec.get("module_dir"):
+    sys.path.insert(0, spec["module_dir"])
 try:
     import numpy as np
     import gymnasium
 except ImportError as e:
-    fail(f"Gymnasium is not installed for {sys.executable} ({e}): pip install gymnasium")
+    fail(f"Gymnasium is not installed for {sys.executable} ({e}): pip install {spec['pip']}")
 
 kwargs = dict(spec.get("kwargs") or {})
 if spec.get("max_episode_steps") is not None:
@@ -58,30 +90,28 @@ if not isinstance(observation_space, gymnasium.spaces.Box) or len(observation_sp
     fail(f"{env_id}: the observation space is {observation_space}: sapnet's Q-networks read a 1-D Box")
 n = int(observation_space.shape[0])
 time_limit = env.spec.max_episode_steps if env.spec is not None else None
-sys.stdout.write(json.dumps({
+send(0, json.dumps({
     "obs": n,
     "actions": int(action_space.n),
     "max_episode_steps": time_limit,
     "gymnasium": gymnasium.__version__,
-}) + "\n")
-sys.stdout.flush()
+}).encode())
 
 read = os.read
-write = os.write
 request = struct.Struct("<BIQ")
 tail = struct.Struct("<d??")
-ok_size = 1 + 4 * n + tail.size
+ok_size = 4 * n + tail.size
 zero_tail = tail.pack(0.0, False, False)
 step = env.step
 reset = env.reset
 
 
 def read_exactly(count):
-    data = read(0, count)
+    data = read(REQUESTS, count)
     if len(data) == count:
         return data
     while len(data) < count:
-        chunk = read(0, count - len(data))
+        chunk = read(REQUESTS, count - len(data))
         if not chunk:
             sys.exit(0)
         data += chunk
@@ -89,15 +119,15 @@ def read_exactly(count):
 
 
 def error(message):
-    body = f"{env_id}: {message}".encode()
-    reply = b"\x01" + struct.pack("<I", len(body)) + body
-    write(1, reply + bytes(max(0, ok_size - len(reply))))
+    send(1, f"{env_id}: {message}".encode())
 
 
 f32 = np.dtype(np.float32)
 # The ok reply of a step, written in place: one buffer, one write, no bytes joined.
-reply = bytearray(ok_size)
-obs_end = 1 + 4 * n
+reply = bytearray(frame_head.size + ok_size)
+frame_head.pack_into(reply, 0, 0, ok_size)
+obs_start = frame_head.size
+obs_end = obs_start + 4 * n
 pack_into = tail.pack_into
 
 
@@ -117,22 +147,21 @@ while True:
     try:
         if op == 0x53:  # 'S': step
             obs, reward, terminated, truncated, _ = step(word)
-            reply[1:obs_end] = observation(obs)
+            reply[obs_start:obs_end] = observation(obs)
             pack_into(reply, obs_end, reward, terminated, truncated)
-            write(1, reply)
+            write_all(reply)
         elif op == 0x52:  # 'R': reset, with a seed if the word is 1
             obs, _ = reset(seed=seed if word == 1 else None)
-            write(1, b"\x00" + observation(obs) + zero_tail)
+            send(0, observation(obs) + zero_tail)
         elif op == 0x54:  # 'T': set the state to `word` f64s that follow
             state = np.frombuffer(read_exactly(8 * word), dtype="<f8").copy()
             unwrapped.state = state
             get = getattr(unwrapped, "_get_ob", None)
             obs = get() if get is not None else state
-            write(1, b"\x00" + observation(obs) + zero_tail)
+            send(0, observation(obs) + zero_tail)
         elif op == 0x47:  # 'G': get the state
             state = getattr(unwrapped, "state", None)
-            values = b"" if state is None else np.asarray(state, dtype="<f8").tobytes()
-            write(1, b"\x00" + struct.pack("<I", len(values) // 8) + values)
+            send(0, b"" if state is None else np.asarray(state, dtype="<f8").tobytes())
         else:
             error(f"unknown request {op}")
     except Exception as e:

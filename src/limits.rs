@@ -1,0 +1,32 @@
+//! The bounds every count and duration read from a config or a folder is checked against
+//! before it is used: far beyond what an experiment needs, so that a typo or a hostile
+//! file is refused with its field instead of allocating, wrapping or running for ever.
+
+/// The most training episodes a run (or a source) may ask for: 1,000 times the paper's
+/// longest protocol. Each episode keeps a return in memory and a row on disk.
+pub const MAX_EPISODES: u32 = 10_000_000;
+
+/// The most greedy test episodes per run.
+pub const MAX_TEST_EPISODES: u32 = 100_000;
+
+/// The most source policies a library may hold (the paper's has 10).
+pub const MAX_SOURCES: usize = 10_000;
+
+/// The most gradient updates per round: each is a minibatch, and signals are read between
+/// them.
+pub const MAX_GRADIENT_STEPS: u32 = 10_000;
+
+/// The largest minibatch.
+pub const MAX_BATCH: usize = 1 << 16;
+
+/// The most runs per method a protocol may ask for: far beyond what a comparison needs
+/// (hundreds separate the closest methods), and refused before anything is planned.
+pub const MAX_RUNS: u32 = 10_000;
+
+/// The most environment steps a run, an exclusion or a schedule may count: 10^12, a
+/// million times the paper's longest run. Step arithmetic below it cannot overflow a u64.
+pub const MAX_STEPS: u64 = 1_000_000_000_000;
+
+/// Most hidden layers a network may have: far deeper than these tasks need, and a bound on
+/// the names that results derive from a method's layers.
+pub const MAX_HIDDEN_LAYERS: usize = 64;
