@@ -14,6 +14,7 @@
 pub mod aggregate;
 pub mod bootstrap;
 pub mod improvement;
+pub mod normal;
 pub mod profile;
 pub mod proportion;
 
