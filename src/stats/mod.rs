@@ -7,8 +7,10 @@
 //! reached a level ([`proportion`]).
 //!
 //! Beside the intervals, what a separation rule needs: rank tests of "X's runs score
-//! like Y's" ([`rank_test`]: Mann–Whitney on one task, van Elteren over several), with
-//! the standard normal's tail and quantile they use ([`normal`]).
+//! like Y's" ([`rank_test`]: Mann–Whitney on one task, van Elteren over several), Holm's
+//! adjustment of their p-values for the number of comparisons ([`multiplicity`]), the runs
+//! per method that would detect an observed effect ([`power`]), and the standard normal's
+//! tail and quantile they use ([`normal`]).
 //!
 //! Pure functions over plain numbers: no I/O, no candle, no threads. A method's scores are
 //! one list of runs per task ([`Scores`]); a protocol on one task has one list, a sweep
@@ -18,6 +20,7 @@
 pub mod aggregate;
 pub mod bootstrap;
 pub mod improvement;
+pub mod multiplicity;
 pub mod normal;
 pub mod profile;
 pub mod proportion;
