@@ -22,6 +22,7 @@ pub mod bootstrap;
 pub mod improvement;
 pub mod multiplicity;
 pub mod normal;
+pub mod power;
 pub mod profile;
 pub mod proportion;
 pub mod rank_test;
