@@ -48,8 +48,9 @@ pub enum Method {
 ///
 /// With midranks R over the pooled runs, `U = Σ_{x} R(x_i) − n(n+1)/2` and, for the
 /// larger of the two U's, `U* = max(U, n·m − U)`:
-/// - *exact* when min(n, m) ≤ 8 and no value appears twice (scipy's rule): `p = 2·P(U ≥
-///   U*)` under the exact null distribution of U ([`arrangements_by_u`]);
+/// - *exact* when min(n, m) ≤ 8 and no value appears twice (scipy's rule):
+///   `p = 2·P(U ≥ U*)` under U's exact null distribution, counted by Mann and Whitney's
+///   recurrence rather than by listing the C(n + m, n) orderings;
 /// - *asymptotic* otherwise: `z = (U* − n·m/2 − ½) / σ`, with
 ///   `σ² = n·m/12 · ((N + 1) − Σ(t³ − t)/(N(N − 1)))` over the groups of t tied values
 ///   among the N = n + m runs, and `p = 2·Q(z)`.
