@@ -60,7 +60,7 @@ pub enum Method {
 ///
 /// Preconditions: both samples hold runs; no score is NaN.
 pub fn mann_whitney(x: &[f64], y: &[f64]) -> MannWhitney {
-    let ranked = RankSum::of(x, y);
+    let ranked = RankedTask::of(x, y);
     let pairs = ranked.n * ranked.m;
     let larger_u = ranked.u.max(pairs as f64 - ranked.u);
     let exact = ranked.n.min(ranked.m) <= EXACT_AT_MOST && ranked.tied_cubes == 0.0;
@@ -99,8 +99,8 @@ pub struct VanElteren {
 /// International Statistical Institute 37, 351–361, 1960; Lehmann, *Nonparametrics:
 /// Statistical Methods Based on Ranks*, 1975, pp. 132–141): runs are ranked within their
 /// task only, so a task with larger scores cannot outweigh another, and the tasks' rank
-/// sums are combined with van Elteren's weights `1/(N_t + 1)`, N_t = n_t + m_t, which
-/// make the test locally most powerful when X is shifted by a like amount on every task:
+/// sums are combined with van Elteren's weights `1/(N_t + 1)`, N_t = n_t + m_t, the most
+/// efficient weights when X is shifted by a like amount on every task:
 ///
 /// `V = Σ_t U_t/(N_t + 1)`, `E₀V = Σ_t (n_t·m_t/2)/(N_t + 1)`,
 /// `Var₀V = Σ_t σ_t²/(N_t + 1)²` with each task's tie-corrected
@@ -121,7 +121,7 @@ pub fn van_elteren(x: &Scores, y: &Scores) -> VanElteren {
     );
     let (mut statistic, mut deviation, mut variance) = (0.0, 0.0, 0.0);
     for (x, y) in x.tasks().iter().zip(y.tasks()) {
-        let ranked = RankSum::of(x, y);
+        let ranked = RankedTask::of(x, y);
         let weight = 1.0 / (ranked.n + ranked.m + 1) as f64;
         statistic += weight * ranked.u;
         deviation += weight * (ranked.u - ranked.null_mean());
@@ -151,7 +151,7 @@ pub fn p_value(x: &Scores, y: &Scores) -> f64 {
 }
 
 /// One task's two samples, ranked together.
-struct RankSum {
+struct RankedTask {
     /// Runs of x.
     n: usize,
     /// Runs of y.
@@ -162,7 +162,7 @@ struct RankSum {
     tied_cubes: f64,
 }
 
-impl RankSum {
+impl RankedTask {
     fn of(x: &[f64], y: &[f64]) -> Self {
         assert!(
             !x.is_empty() && !y.is_empty(),
@@ -190,7 +190,7 @@ impl RankSum {
             start += group.len();
         }
         let n = x.len();
-        RankSum {
+        RankedTask {
             n,
             m: y.len(),
             u: x_rank_sum - (n * (n + 1)) as f64 / 2.0,
