@@ -6,6 +6,12 @@
 //! ([`improvement`]), performance profiles ([`profile`]), and the share of runs that
 //! reached a level ([`proportion`]).
 //!
+//! Beside the intervals, what a separation rule needs: rank tests of "X's runs score
+//! like Y's" ([`rank_test`]: Mann–Whitney on one task, van Elteren over several), Holm's
+//! adjustment of their p-values for the number of comparisons ([`multiplicity`]), the runs
+//! per method that would detect an observed effect ([`power`]), and the standard normal's
+//! tail and quantile they use ([`normal`]).
+//!
 //! Pure functions over plain numbers: no I/O, no candle, no threads. A method's scores are
 //! one list of runs per task ([`Scores`]); a protocol on one task has one list, a sweep
 //! over tasks one per task, and the bootstrap resamples runs within each task (the
@@ -14,8 +20,12 @@
 pub mod aggregate;
 pub mod bootstrap;
 pub mod improvement;
+pub mod multiplicity;
+pub mod normal;
+pub mod power;
 pub mod profile;
 pub mod proportion;
+pub mod rank_test;
 
 use serde::Serialize;
 
