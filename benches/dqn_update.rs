@@ -13,7 +13,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use rand_distr::StandardNormal;
-use sapnet::config::DqnConfig;
+use sapnet::dqn::DqnConfig;
 use sapnet::dqn::{Architecture, Batch, DqnAgent, QNet, Transition};
 
 #[global_allocator]

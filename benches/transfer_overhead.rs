@@ -19,8 +19,8 @@ use rand::SeedableRng;
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
 use sapnet::config::Config;
-use sapnet::config::Method;
 use sapnet::dqn::{Architecture, QNet};
+use sapnet::reuse::Method;
 use sapnet::sapnet::PolicyDescription;
 use sapnet::trainer::{self, Event, MethodId, RunSpec, SourcePolicy, StreamOptions};
 use sapnet::tui::dashboard::Dashboard;
@@ -135,7 +135,7 @@ fn specs(stream: StreamOptions, steps: u64) -> (RunSpec, RunSpec) {
         0,
         "dqn[100]",
         config.env.clone(),
-        sapnet::config::DqnConfig {
+        sapnet::dqn::DqnConfig {
             replay_start_size: config.dqn.replay_start_size * 10,
             ..config.dqn.clone()
         },
@@ -215,7 +215,7 @@ fn overhead(c: &mut Criterion) {
     // One source, warming up as long as the others: SAP-Net's bookkeeping without the
     // cost of keeping ten networks warm in the caches.
     let single = RunSpec {
-        dqn: sapnet::config::DqnConfig {
+        dqn: sapnet::dqn::DqnConfig {
             replay_start_size: config.dqn.replay_start_size * 10,
             ..config.dqn.clone()
         },
@@ -263,7 +263,7 @@ fn main() {
         };
         let (dqn, mut transfer) = specs(stream, STEPS);
         if !matches!(case.as_str(), "dqn" | "sapnet" | "live") {
-            let method: Method = sapnet::config::parse_ron(&case, "SAPNET_RUN_ONCE")
+            let method: Method = sapnet::ron_file::parse_ron(&case, "SAPNET_RUN_ONCE")
                 .unwrap_or_else(|e| panic!("{e}"));
             transfer.method = MethodId::new(0, &method);
             transfer.reuse = method;

@@ -8,9 +8,10 @@ use std::time::{SystemTime, UNIX_EPOCH};
 use anyhow::{Context, Result};
 
 use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, SourcesCommand, SweepCommand, TeachArgs};
-use crate::config::{Config, MethodKind};
+use crate::config::Config;
 use crate::experiment;
 use crate::headless::{self, OutputOptions, RunOptions};
+use crate::ron_file::{parse_ron, ConfigError};
 use crate::teach::config::TeachConfig;
 use crate::trainer::{RunSpec, StreamOptions};
 use crate::tui::{self, teach::Teach};
@@ -132,7 +133,7 @@ fn refuse_unread_flags(cli: &Cli, command: &Command) -> Result<()> {
 /// wins over `--quick`'s).
 fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
     let mut config = match &cli.run.config {
-        Some(path) => Config::from_file(path)?,
+        Some(path) => training_config(path)?,
         None => Config::from_ron(embedded, label)?,
     };
     for warning in config.warnings() {
@@ -158,6 +159,26 @@ fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
             .with_context(|| format!("{label}: {field}", label = origin(cli, label)))?;
     }
     Ok(config)
+}
+
+/// The training config at `path`; a lesson given instead is said to be one, with what
+/// each reads.
+fn training_config(path: &Path) -> Result<Config> {
+    Config::from_file(path).map_err(|err| {
+        let lesson = matches!(err, ConfigError::Parse(_))
+            && crate::ron_file::read_text(path)
+                .is_ok_and(|text| parse_ron::<TeachConfig>(&text, "").is_ok());
+        if lesson {
+            anyhow::anyhow!(
+                "config {}: this is a lesson, for `sapnet teach --config`; runs, `env` and \
+                 `sources` read a training config (e.g. assets/cartpole.ron, \
+                 assets/mountain_car.ron)",
+                path.display()
+            )
+        } else {
+            err.into()
+        }
+    })
 }
 
 /// The config's file as the user named it, or the embedded one's `label`.
@@ -418,7 +439,7 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
                 );
             };
             anyhow::ensure!(
-                id.kind.reuses(),
+                id.kind.reuses,
                 "--follow {label}: the dashboard follows a method that reuses the library; \
                  the DQN baseline runs beside it anyway"
             );
@@ -426,8 +447,8 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
         }
         None => ids
             .iter()
-            .find(|m| m.kind == MethodKind::SapNet)
-            .or_else(|| ids.iter().find(|m| m.kind.reuses()))
+            .find(|m| m.kind.spreads)
+            .or_else(|| ids.iter().find(|m| m.kind.reuses))
             .cloned(),
     };
     // Read before training starts, so that a wrong folder is said at once.
@@ -472,7 +493,7 @@ fn dashboard_specs(specs: &[RunSpec], run: u32) -> Result<(Vec<RunSpec>, Option<
     );
     let followable = specs
         .iter()
-        .filter(|s| s.run == run && s.method.kind.reuses())
+        .filter(|s| s.run == run && s.method.kind.reuses)
         .map(|s| {
             let mut spec = s.clone();
             spec.stream = StreamOptions::live();
@@ -481,7 +502,7 @@ fn dashboard_specs(specs: &[RunSpec], run: u32) -> Result<(Vec<RunSpec>, Option<
         .collect();
     let baseline = specs
         .iter()
-        .find(|s| s.run == run && s.method.kind == MethodKind::Dqn)
+        .find(|s| s.run == run && !s.method.kind.reuses)
         .cloned();
     Ok((followable, baseline))
 }
@@ -690,7 +711,7 @@ fn default_out_dir(config: Option<&Path>) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::DqnConfig;
+    use crate::dqn::DqnConfig;
     use crate::env::EnvConfig;
 
     /// Two runs of a reusing method and of a DQN baseline, as a plan lists them.
@@ -712,11 +733,23 @@ mod tests {
         (0..2)
             .flat_map(|run| {
                 [
-                    spec(run, "sapnet", MethodKind::SapNet),
-                    spec(run, "dqn[4]", MethodKind::Dqn),
+                    spec(run, "sapnet", crate::reuse::sapnet::KIND),
+                    spec(run, "dqn[4]", crate::reuse::scratch::KIND),
                 ]
             })
             .collect()
+    }
+
+    #[test]
+    fn a_lesson_given_as_a_training_config_is_named_as_such() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("fig2.ron");
+        std::fs::write(&path, include_str!("../assets/teach_fig2.ron")).unwrap();
+        let err = training_config(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("fig2.ron: this is a lesson, for `sapnet teach --config`"),
+            "{err}"
+        );
     }
 
     #[test]

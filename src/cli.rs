@@ -94,7 +94,7 @@ pub struct RunArgs {
     /// Runs per method, overriding the config's `protocol.runs`. Run r's seeds do not
     /// depend on how many runs there are, so the first N runs of a longer protocol are
     /// exactly these. With --resume: extend a finished protocol to N runs (its runs kept).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=crate::config::MAX_RUNS as i64))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=crate::limits::MAX_RUNS as i64))]
     pub runs: Option<u32>,
 
     /// With --headless: also write trace.csv, every spread call (eq. 9-11) of every

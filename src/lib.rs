@@ -35,6 +35,7 @@ pub mod random_episodes;
 pub mod report;
 pub mod results;
 pub mod reuse;
+pub mod ron_file;
 pub mod safe_io;
 pub mod sapnet;
 pub mod seeds;

@@ -20,9 +20,9 @@ use candle_core::{DType, Device};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use crate::config::{parse_ron_as, ron_options, ConfigError};
 use crate::dqn::{Architecture, DqnError, QNet};
 use crate::env::EnvConfig;
+use crate::ron_file::{parse_ron_as, ron_options, ConfigError};
 
 /// Not a policy name: `library.ron` is a source library's manifest.
 pub const RESERVED_NAME: &str = "library";
@@ -276,7 +276,7 @@ pub fn load(dir: &Path, name: &str) -> Result<StoredPolicy, StoreError> {
             path: metadata_path,
         });
     }
-    let text = crate::config::read_folder_text(&metadata_path)?;
+    let text = crate::ron_file::read_folder_text(&metadata_path)?;
     let metadata: PolicyMetadata = parse_ron_as(
         &text,
         &metadata_path.display().to_string(),

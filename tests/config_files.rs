@@ -2,8 +2,9 @@
 
 use std::path::Path;
 
-use sapnet::config::{Config, ConfigError};
+use sapnet::config::Config;
 use sapnet::env::EnvConfig;
+use sapnet::ron_file::ConfigError;
 
 fn asset(name: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

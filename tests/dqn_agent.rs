@@ -2,8 +2,8 @@
 //! and learning a small task.
 
 use rand::{rngs::StdRng, Rng, SeedableRng};
-use sapnet::config::{DqnConfig, Exploration};
 use sapnet::dqn::{huber, Architecture, Batch, DqnAgent, DqnError, QNet, ReplayBuffer, Transition};
+use sapnet::dqn::{DqnConfig, Exploration};
 use sapnet::env::{self, EnvConfig, EnvError, Environment, Step};
 
 fn agent(hidden: &[usize], seed: u64, config: &DqnConfig) -> DqnAgent {

@@ -4,7 +4,8 @@
 use std::path::Path;
 use std::sync::mpsc;
 
-use sapnet::config::{Config, Method};
+use sapnet::config::Config;
+use sapnet::reuse::Method;
 use sapnet::trainer::{self, Event, RunSpec};
 
 #[test]

@@ -152,7 +152,7 @@ fn the_shipped_mountain_car_config_gives_the_pinned_numbers() {
     config.protocol.episodes = 12;
     config.protocol.runs = 1;
     let cut = tmp.path().join("mountain_car_cut.ron");
-    let text = sapnet::config::ron_options().to_string(&config).unwrap();
+    let text = sapnet::ron_file::ron_options().to_string(&config).unwrap();
     std::fs::write(&cut, text).unwrap();
     let out = tmp.path().join("out");
     run_headless(&cut, &tmp.path().join("lib"), &out, false, None);

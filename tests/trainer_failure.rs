@@ -3,7 +3,7 @@
 
 use std::sync::mpsc;
 
-use sapnet::config::DqnConfig;
+use sapnet::dqn::DqnConfig;
 use sapnet::env::{CartPoleParams, EnvConfig};
 use sapnet::trainer::{self, Event, RunSpec, TrainerError};
 

@@ -4,7 +4,7 @@
 use std::sync::mpsc;
 use std::thread;
 
-use sapnet::config::DqnConfig;
+use sapnet::dqn::DqnConfig;
 use sapnet::env::{CartPoleParams, EnvConfig};
 use sapnet::trainer::{self, Command, Event, RunSpec};
 

@@ -6,8 +6,9 @@ use std::sync::Arc;
 
 use rand::rngs::StdRng;
 use rand::SeedableRng;
-use sapnet::config::{Config, Method};
+use sapnet::config::Config;
 use sapnet::dqn::{Architecture, QNet};
+use sapnet::reuse::Method;
 use sapnet::sapnet::PolicyDescription;
 use sapnet::trainer::{self, Command, Event, MethodId, RunSpec, SourcePolicy, StreamOptions};
 

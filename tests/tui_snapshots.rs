@@ -251,7 +251,7 @@ fn another_selector_is_drawn_under_its_own_scores() {
     // UCB1 followed instead of SAP-Net: the graph and table name its scores.
     let mut start = tui_script::sapnet_start();
     if let sapnet::trainer::Event::RunStarted { method, sapnet, .. } = &mut start {
-        *method = sapnet::trainer::MethodId::new(7, &sapnet::config::Method::Ucb1);
+        *method = sapnet::trainer::MethodId::new(7, &sapnet::reuse::Method::Ucb1);
         sapnet.as_mut().unwrap().score_name = "mean";
     }
     let mut d = Dashboard::new("CartPole-v1");

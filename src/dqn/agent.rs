@@ -6,7 +6,7 @@ use super::backprop::Workspace;
 use super::kernels::Isa;
 use super::scratch::{with_scratch, UpdateWork};
 use super::{td_huber_loss, Adam, Batch, DqnError, EpsilonGreedy, QNet, ReplayBuffer, Transition};
-use crate::config::DqnConfig;
+use crate::dqn::DqnConfig;
 
 /// What one round of learning did, for SAP-Net's judgment `T_a = E_{t+1} − E_t` (eq. 7).
 #[derive(Debug, Clone, Copy, PartialEq)]

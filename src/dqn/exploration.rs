@@ -2,7 +2,7 @@
 
 use rand::Rng;
 
-use crate::config::Exploration;
+use crate::dqn::Exploration;
 
 /// Chooses a uniformly random action with probability ε, else the greedy one.
 #[derive(Debug, Clone, PartialEq)]

@@ -9,6 +9,7 @@
 
 mod agent;
 mod backprop;
+mod config;
 mod error;
 mod exploration;
 pub mod kernels;
@@ -20,6 +21,7 @@ mod scratch;
 
 pub use agent::{DqnAgent, TdError, UpdateReport};
 pub use backprop::Gradients;
+pub use config::{DqnConfig, Exploration};
 pub use error::DqnError;
 pub use exploration::EpsilonGreedy;
 pub use loss::{huber, td_huber_loss};

@@ -22,7 +22,7 @@ use candle_core::{bail, CpuStorage, InplaceOp1, Layout, Result, Var};
 
 use super::kernels::{adam_rows, AdamStep, Buffer, Isa, Rows};
 use super::Gradients;
-use crate::config::DqnConfig;
+use crate::dqn::DqnConfig;
 
 /// Adam state for one list of parameters.
 #[derive(Debug, Clone)]

@@ -16,6 +16,7 @@
 mod acrobot;
 mod cartpole;
 pub mod gymnasium;
+pub mod mapping;
 mod mountain_car;
 mod params;
 

@@ -39,7 +39,7 @@ pub fn run_bytes(spec: &RunSpec) -> Result<f64, crate::env::EnvError> {
     let (networks, learners) = match spec.reuse.learner_hidden() {
         // DQN from scratch, PRQ-learning: one learner; the sources only act.
         Some(hidden) => {
-            let learner = parameter_bytes(&Architecture::new(obs, hidden, actions));
+            let learner = parameter_bytes(&Architecture::new(obs, &hidden, actions));
             (learner * LEARNER_COPIES + sources.sum::<f64>(), 1.0)
         }
         // Selectors whose acting source learns: every source is a learner.

@@ -47,7 +47,7 @@ pub fn plan(
     stop: &Receiver<Command>,
 ) -> Result<Plan> {
     memory::check(&run_specs(config, None), jobs)?;
-    let reuses = config.protocol.methods.iter().any(|m| m.kind().reuses());
+    let reuses = config.protocol.methods.iter().any(|m| m.kind().reuses);
     let sources = if reuses {
         Some(Arc::new(sources::ensure_library(config, library, stop)?))
     } else {
@@ -57,10 +57,7 @@ pub fn plan(
     memory::check(&specs, jobs)?;
     // A selector that cannot be built fails every run of its method: say so before any
     // run trains.
-    for spec in specs
-        .iter()
-        .filter(|s| s.run == 0 && s.method.kind.reuses())
-    {
+    for spec in specs.iter().filter(|s| s.run == 0 && s.method.kind.reuses) {
         crate::trainer::selector(spec).map_err(|error| refused_method(spec, error))?;
     }
     Ok(Plan { specs, sources })
@@ -103,7 +100,7 @@ pub fn run_specs(config: &Config, sources: Option<&Arc<Vec<SourcePolicy>>>) -> V
     let mut specs = Vec::new();
     for run in 0..config.protocol.runs {
         for (m, method) in config.protocol.methods.iter().enumerate() {
-            let sources = match (method.kind().reuses(), sources) {
+            let sources = match (method.kind().reuses, sources) {
                 (true, Some(sources)) => Arc::clone(sources),
                 _ => Arc::clone(&none),
             };

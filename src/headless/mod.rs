@@ -40,7 +40,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 
-use crate::config::{Config, MethodKind};
+use crate::config::Config;
 use crate::env::PythonSettings;
 use crate::experiment::{self, LibraryCopies};
 use crate::progress::{Progress, Unit};
@@ -239,7 +239,7 @@ fn protocol(
         );
     }
     for spec in &mut plan.specs {
-        spec.stream.trace = options.trace && spec.method.kind == MethodKind::SapNet;
+        spec.stream.trace = options.trace && spec.method.kind.spreads;
     }
 
     // On disk before the first run, so that even a killed protocol says what it was.

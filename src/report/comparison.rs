@@ -16,7 +16,7 @@ use serde::Serialize;
 
 use super::runs::LibraryEntry;
 use super::{MethodRuns, Units};
-use crate::config::MethodKind;
+use crate::reuse::MethodKind;
 use crate::seeds::{self, Part};
 use crate::stats::{aggregate, bootstrap, proportion, Estimate, Scores};
 
@@ -26,7 +26,7 @@ pub struct MethodComparison {
     pub method: String,
     pub kind: MethodKind,
     pub runs: usize,
-    /// What its runs hand over to be tested ([`crate::config::Tested`]).
+    /// What its runs hand over to be tested ([`crate::reuse::Tested`]).
     pub tested: &'static str,
     /// Per threshold of the moving average (one task only: tasks have their own levels).
     pub thresholds: Vec<ThresholdReached>,
@@ -131,7 +131,7 @@ fn measures(m: &MethodRuns, units: Units) -> MethodComparison {
         method: m.label.clone(),
         kind: m.kind,
         runs: m.runs,
-        tested: m.kind.tested().name(),
+        tested: m.kind.tested.name(),
         thresholds,
         training: aggregates(&m.training, "training"),
         test: aggregates(&m.test, "test"),
@@ -141,7 +141,7 @@ fn measures(m: &MethodRuns, units: Units) -> MethodComparison {
         ranks: m.ranks.clone(),
         lock_in_median: median(&m.lock_in_steps),
         locked_runs: m.lock_in_steps.len(),
-        lock_in_measured: m.kind.picks_by_probability(),
+        lock_in_measured: m.kind.picks_by_probability,
     }
 }
 

@@ -17,7 +17,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
-use crate::config::{Config, Method, MethodKind};
+use crate::config::Config;
+use crate::reuse::{Method, MethodKind};
 use crate::stats::{profile, Estimate, Scores};
 use crate::trainer::MethodId;
 

@@ -102,7 +102,7 @@ mod tests {
     fn the_best_window_is_dated_by_its_last_episode() {
         let record = RunRecord {
             run: 0,
-            method: MethodId::new(0, &crate::config::Method::Dqn { hidden: vec![4] }),
+            method: MethodId::new(0, &crate::reuse::Method::Dqn { hidden: vec![4] }),
             seed: 0,
             episodes: 5,
             steps: 0,

@@ -68,7 +68,7 @@ pub fn normalise(x: f64, (low, high): (f64, f64)) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::Method;
+    use crate::reuse::Method;
     use crate::trainer::{MethodId, RunRecord};
 
     fn summary(tests: Vec<f64>) -> RunSummary {

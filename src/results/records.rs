@@ -79,7 +79,7 @@ impl RunWriter {
                 .with_context(|| format!("removing the partial record {}", partial.display()))?;
         }
         std::fs::create_dir(&partial).with_context(|| format!("creating {}", partial.display()))?;
-        let activations = if method.kind.reuses() && !names.is_empty() {
+        let activations = if method.kind.reuses && !names.is_empty() {
             Some(files::ActivationsWriter::create(
                 &partial.join("activations.csv"),
                 names,

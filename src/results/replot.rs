@@ -12,7 +12,6 @@ use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 
 use super::summary::{read_header, Status, Summary};
-use crate::config::MethodKind;
 use crate::report::plots::{Curve, PlotData, SelectionHistory};
 
 #[derive(Deserialize)]
@@ -114,7 +113,7 @@ pub fn read(dir: &Path) -> Result<PlotData> {
     };
     let activations = methods
         .iter()
-        .find(|m| m.kind == MethodKind::SapNet)
+        .find(|m| m.kind.spreads)
         .map(|m| {
             of_method(m.label())
                 .into_iter()
@@ -124,7 +123,7 @@ pub fn read(dir: &Path) -> Result<PlotData> {
         .unwrap_or_default();
     let acted = methods
         .iter()
-        .filter(|m| m.kind.reuses())
+        .filter(|m| m.kind.reuses)
         .map(|m| {
             let runs: Vec<Vec<Vec<u64>>> = of_method(m.label())
                 .into_iter()

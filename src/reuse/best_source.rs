@@ -3,7 +3,9 @@
 
 use rand::rngs::StdRng;
 
-use super::{Actor, Learning, ReuseError, Selector, SelectorView};
+use super::method::{MethodKind, ReuseMethod, Tested};
+use super::{Actor, Learning, Library, ReuseError, Selector, SelectorView};
+use crate::sapnet::SapNetParams;
 
 /// Always the source with the highest recorded score (the lowest index on a tie).
 #[derive(Debug)]
@@ -67,6 +69,38 @@ impl Selector for BestSource {
 
     fn chosen(&self) -> Option<usize> {
         Some(self.best)
+    }
+}
+
+/// The oracle in `protocol.methods` (`BestSource`), in the palette's orange.
+pub struct Oracle;
+
+/// What the oracle is: its one source has probability 1 from the start.
+pub const KIND: MethodKind = MethodKind {
+    family: "BestSource",
+    hue: 30,
+    saturation: 80,
+    reuses: true,
+    tested: Tested::BestRecorded,
+    picks_by_probability: true,
+    spreads: false,
+};
+
+impl ReuseMethod for Oracle {
+    fn label(&self) -> String {
+        "best-source".into()
+    }
+
+    fn kind(&self) -> MethodKind {
+        KIND
+    }
+
+    fn selector(
+        &self,
+        library: Library<'_>,
+        _: &SapNetParams,
+    ) -> Result<Box<dyn Selector>, ReuseError> {
+        Ok(Box::new(BestSource::new(library.scores)?))
     }
 }
 

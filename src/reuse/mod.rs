@@ -17,11 +17,12 @@
 //! acts).
 //!
 //! One file per method: [`sapnet`], [`random`], [`ucb1`], [`prql`], [`best_source`],
-//! [`scratch`]. Adding one is a new file here, a variant of [`crate::config::Method`] and
-//! an arm in [`build`].
+//! [`scratch`], each defining its [`ReuseMethod`]. Adding one is a new file here, a variant
+//! of [`Method`] and its arm in [`Method::definition`]; the compiler points at the rest.
 
 pub mod best_source;
 pub mod exclusion;
+mod method;
 pub mod prql;
 pub mod random;
 pub mod sapnet;
@@ -33,8 +34,8 @@ use std::fmt;
 
 use rand::rngs::StdRng;
 
-use crate::config::Method;
-use crate::dqn::UpdateReport;
+pub use method::{check_label, Method, MethodKind, ReuseMethod, Tested};
+
 use crate::sapnet::{PolicyDescription, SapNetError, SapNetParams, TraceStep};
 
 /// Who chooses this step's action.
@@ -78,12 +79,34 @@ pub struct EpisodeEnd {
     pub discounted_return: f64,
 }
 
+/// What one round of a source's learning did, as a selector judges it (eq. 7): filled by
+/// the run from the learner's own report.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Feedback {
+    /// The raw loss of the last gradient update of the round.
+    pub loss: f64,
+    /// The statistic loss `E_t` before the round.
+    pub previous_statistic_loss: f64,
+    /// The statistic loss `E_{t+1}` after it.
+    pub statistic_loss: f64,
+    /// The TD error of the step's transition before and after the round, when the selector
+    /// asked for it ([`Needs::td_error`]).
+    pub td: Option<TdError>,
+}
+
+/// The TD error of one transition before and after a round of updates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TdError {
+    pub before: f64,
+    pub after: f64,
+}
+
 /// What a selector asks the run to measure beyond what every method hears, each costing a
 /// forward pass or a few: off by default, so that other methods' runs do neither.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Needs {
-    /// Every [`UpdateReport`] carries the TD error of the step's transition before and
-    /// after the round ([`crate::dqn::TdError`]).
+    /// Every [`Feedback`] carries the TD error of the step's transition before and after
+    /// the round.
     pub td_error: bool,
     /// [`Selector::on_acted`] hears every acting step with the source's value estimate,
     /// and [`Selector::on_truncated`] the sources' values where a time limit cut an
@@ -144,7 +167,7 @@ pub trait Selector: Send + fmt::Debug {
     /// The report of the update `source` just made on its step
     /// ([`Learning::ActingSource`] only); returns the judgment it made of it, if it made
     /// one now (`None` also when the judgment waits for the episode's end).
-    fn on_update(&mut self, _source: usize, _report: &UpdateReport) -> Option<bool> {
+    fn on_update(&mut self, _source: usize, _feedback: &Feedback) -> Option<bool> {
         None
     }
 
@@ -182,7 +205,7 @@ pub trait Selector: Send + fmt::Debug {
     }
 
     /// The source the run ends with (tested and written to the library), or `None` when
-    /// the run's result is its learner: the method's [`crate::config::Tested`] rule.
+    /// the run's result is its learner: the method's [`Tested`] rule.
     fn chosen(&self) -> Option<usize>;
 
     /// The SAP-Net behind the selector, if it is one: its graph, for drawing and teaching.
@@ -228,35 +251,7 @@ pub fn build(
     library: Library<'_>,
     sapnet: &SapNetParams,
 ) -> Result<Box<dyn Selector>, ReuseError> {
-    Ok(match method {
-        Method::SapNet => Box::new(sapnet::SapNetSelector::new(
-            library.descriptions,
-            sapnet.clone(),
-            &sapnet::SapNetKnobs::default(),
-            library.gamma,
-        )?),
-        Method::SapNetWith(knobs) => Box::new(sapnet::SapNetSelector::new(
-            library.descriptions,
-            sapnet.clone(),
-            knobs,
-            library.gamma,
-        )?),
-        Method::Random => Box::new(random::Random::per_step(library.descriptions.len())),
-        Method::RandomPerEpisode => {
-            Box::new(random::Random::per_episode(library.descriptions.len()))
-        }
-        Method::Ucb1 => Box::new(ucb1::Ucb1::new(
-            library.descriptions.len(),
-            library.return_range,
-        )),
-        Method::Prql(knobs) => Box::new(prql::Prql::new(
-            library.descriptions.len(),
-            knobs,
-            library.discounted_return_range,
-        )),
-        Method::BestSource => Box::new(best_source::BestSource::new(library.scores)?),
-        Method::Dqn { .. } => Box::new(scratch::Scratch),
-    })
+    method.definition().selector(library, sapnet)
 }
 
 /// Index of the largest value, the lowest on a tie.
@@ -268,19 +263,4 @@ pub(crate) fn argmax(values: &[f64]) -> usize {
         }
     }
     best
-}
-
-/// A method's own `label` names its run's files and its chosen policy in the library: one
-/// that cannot be a file name would fail the protocol after training, so it is refused
-/// with its field first.
-pub fn check_label(field: &str, label: &str) -> Result<(), String> {
-    if crate::safe_io::is_portable_name(label) {
-        Ok(())
-    } else {
-        Err(format!(
-            "field `{field}.label`: expected a name of {} (it names the run's files and \
-             columns), got {label:?}",
-            crate::safe_io::PORTABLE_NAME
-        ))
-    }
 }

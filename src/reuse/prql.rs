@@ -16,12 +16,14 @@
 //! discounted returns (up to ≈ 99) the same Δτ made one source hold P > 0.99 within a few
 //! episodes of every run; UCB1 scales its rewards the same way.
 
-use crate::config::Shown;
 use rand::rngs::StdRng;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use super::{Actor, EpisodeEnd, Learning, Selector, SelectorView};
+use super::method::{check_label, MethodKind, ReuseMethod, Tested};
+use super::{Actor, EpisodeEnd, Learning, Library, ReuseError, Selector, SelectorView};
+use crate::ron_file::Got;
+use crate::sapnet::SapNetParams;
 
 /// PRQ-learning's parameters (`Prql(...)` in `protocol.methods`). Defaults: the paper's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -54,10 +56,21 @@ impl Default for PrqlKnobs {
     }
 }
 
-impl PrqlKnobs {
+/// PRQ-learning in `protocol.methods`, in the palette's purple.
+pub const KIND: MethodKind = MethodKind {
+    family: "Prql",
+    hue: 280,
+    saturation: 50,
+    reuses: true,
+    tested: Tested::Learner,
+    picks_by_probability: true,
+    spreads: false,
+};
+
+impl ReuseMethod for PrqlKnobs {
     /// The given label, else `prql` with what differs from the paper's knobs:
     /// `prql[64,64]` for another learner, `-psi0.5`, `-upsilon0.9`, `-tau0.5`, `-dtau0.1`.
-    pub fn label(&self) -> String {
+    fn label(&self) -> String {
         if let Some(label) = &self.label {
             return label.clone();
         }
@@ -80,12 +93,20 @@ impl PrqlKnobs {
         label
     }
 
+    fn kind(&self) -> MethodKind {
+        KIND
+    }
+
+    fn learner_hidden(&self) -> Option<&[usize]> {
+        Some(&self.hidden)
+    }
+
     /// The ranges serde cannot check; `field` is where the knobs sit in the config.
-    pub fn validate(&self, field: &str) -> Result<(), String> {
-        let fail = |name: &str, expected: &str, got: &dyn Shown| {
+    fn validate(&self, field: &str) -> Result<(), String> {
+        let fail = |name: &str, expected: &str, got: &dyn Got| {
             Err(format!(
                 "field `{field}.{name}`: expected {expected}, got {}",
-                got.shown()
+                got.got()
             ))
         };
         if self.hidden.is_empty() || self.hidden.contains(&0) {
@@ -108,9 +129,21 @@ impl PrqlKnobs {
             return fail("delta_tau", "a finite Δτ ≥ 0", &self.delta_tau);
         }
         if let Some(label) = &self.label {
-            super::check_label(field, label)?;
+            check_label(field, label)?;
         }
         Ok(())
+    }
+
+    fn selector(
+        &self,
+        library: Library<'_>,
+        _sapnet: &SapNetParams,
+    ) -> Result<Box<dyn Selector>, ReuseError> {
+        Ok(Box::new(Prql::new(
+            library.descriptions.len(),
+            self,
+            library.discounted_return_range,
+        )))
     }
 }
 

@@ -1,12 +1,14 @@
 //! The chance baselines: a uniformly random source, drawn every step or once per episode.
 //! The acting source fine-tunes as in SAP-Net; only the choice differs. What a run hands
 //! over for testing is drawn uniformly too, at its first choice
-//! ([`crate::config::Tested::DrawnAtStart`]), so that nothing the run saw selects it.
+//! ([`crate::reuse::Tested::DrawnAtStart`]), so that nothing the run saw selects it.
 
 use rand::rngs::StdRng;
 use rand::Rng;
 
-use super::{Actor, EpisodeEnd, Learning, Selector, SelectorView};
+use super::method::{MethodKind, ReuseMethod, Tested};
+use super::{Actor, EpisodeEnd, Learning, Library, ReuseError, Selector, SelectorView};
+use crate::sapnet::SapNetParams;
 
 /// A uniform draw over the sources.
 #[derive(Debug)]
@@ -85,6 +87,64 @@ impl Selector for Random {
     /// a run with a library always does after its warm-up).
     fn chosen(&self) -> Option<usize> {
         Some(self.handover.unwrap_or(0))
+    }
+}
+
+/// The chance baselines in `protocol.methods`, in the palette's blue.
+const KIND: MethodKind = MethodKind {
+    family: "Random",
+    hue: 212,
+    saturation: 65,
+    reuses: true,
+    tested: Tested::DrawnAtStart,
+    picks_by_probability: true,
+    spreads: false,
+};
+
+/// `Random`: a random source every step.
+pub struct PerStep;
+
+/// `RandomPerEpisode`: a random source every episode; its draw is a rule, not a
+/// probability that could lock in.
+pub struct PerEpisode;
+
+impl ReuseMethod for PerStep {
+    fn label(&self) -> String {
+        "random".into()
+    }
+
+    fn kind(&self) -> MethodKind {
+        KIND
+    }
+
+    fn selector(
+        &self,
+        library: Library<'_>,
+        _: &SapNetParams,
+    ) -> Result<Box<dyn Selector>, ReuseError> {
+        Ok(Box::new(Random::per_step(library.descriptions.len())))
+    }
+}
+
+impl ReuseMethod for PerEpisode {
+    fn label(&self) -> String {
+        "random-episode".into()
+    }
+
+    fn kind(&self) -> MethodKind {
+        MethodKind {
+            family: "RandomPerEpisode",
+            picks_by_probability: false,
+            ..KIND
+        }
+    }
+
+    fn selector(
+        &self,
+        library: Library<'_>,
+        _: &SapNetParams,
+    ) -> Result<Box<dyn Selector>, ReuseError> {
+        Ok(Box::new(Random::per_episode(library.descriptions.len())))
     }
 }
 

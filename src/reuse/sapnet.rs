@@ -8,9 +8,12 @@ use rand::rngs::StdRng;
 use serde::{Deserialize, Serialize};
 
 use super::exclusion::{Exclusion, Exclusions};
+use super::method::{check_label, MethodKind, ReuseMethod, Tested};
 use super::schedule::Schedule;
-use super::{Activation, Actor, Deposit, EpisodeEnd, Learning, Needs, Selector, SelectorView};
-use crate::dqn::UpdateReport;
+use super::{
+    Activation, Actor, Deposit, EpisodeEnd, Feedback, Learning, Library, Needs, ReuseError,
+    Selector, SelectorView,
+};
 use crate::sapnet::{self, PolicyDescription, SapNet, SapNetError, SapNetParams, TraceStep};
 
 /// When a source's learning is judged positive or negative, and by what. Each positive
@@ -83,9 +86,20 @@ impl Default for SapNetKnobs {
     }
 }
 
-impl SapNetKnobs {
+/// SAP-Net in `protocol.methods`, in the palette's red.
+pub const KIND: MethodKind = MethodKind {
+    family: "SapNet",
+    hue: 0,
+    saturation: 72,
+    reuses: true,
+    tested: Tested::HighestActivation,
+    picks_by_probability: true,
+    spreads: true,
+};
+
+impl ReuseMethod for SapNetKnobs {
     /// The label of results: the given one, or one built from the knobs.
-    pub fn label(&self) -> String {
+    fn label(&self) -> String {
         if let Some(label) = &self.label {
             return label.clone();
         }
@@ -114,8 +128,12 @@ impl SapNetKnobs {
         label
     }
 
+    fn kind(&self) -> MethodKind {
+        KIND
+    }
+
     /// The ranges serde cannot check; `field` is where the knobs sit in the config.
-    pub fn validate(&self, field: &str) -> Result<(), String> {
+    fn validate(&self, field: &str) -> Result<(), String> {
         if let Some(schedule) = &self.temperature {
             schedule.validate_positive(&format!("{field}.temperature"))?;
         }
@@ -134,9 +152,22 @@ impl SapNetKnobs {
             exclusion.validate(&format!("{field}.exclusion"))?;
         }
         if let Some(label) = &self.label {
-            super::check_label(field, label)?;
+            check_label(field, label)?;
         }
         Ok(())
+    }
+
+    fn selector(
+        &self,
+        library: Library<'_>,
+        sapnet: &SapNetParams,
+    ) -> Result<Box<dyn Selector>, ReuseError> {
+        Ok(Box::new(SapNetSelector::new(
+            library.descriptions,
+            sapnet.clone(),
+            self,
+            library.gamma,
+        )?))
     }
 }
 
@@ -323,7 +354,7 @@ impl Selector for SapNetSelector {
         }
     }
 
-    fn on_update(&mut self, source: usize, report: &UpdateReport) -> Option<bool> {
+    fn on_update(&mut self, source: usize, report: &Feedback) -> Option<bool> {
         let positive = match self.knobs.judgment {
             Judgment::Step => sapnet::judge(report.previous_statistic_loss, report.statistic_loss),
             Judgment::Episode | Judgment::Advantage => return None,
@@ -463,10 +494,11 @@ impl Selector for SapNetSelector {
 
 #[cfg(test)]
 mod tests {
+    use super::super::TdError;
     use super::*;
 
-    fn report(before: f64, after: f64) -> UpdateReport {
-        UpdateReport {
+    fn report(before: f64, after: f64) -> Feedback {
+        Feedback {
             loss: 0.0,
             previous_statistic_loss: before,
             statistic_loss: after,
@@ -597,9 +629,9 @@ mod tests {
         assert_eq!(s.mean_return[0].1, 3);
     }
 
-    fn td_report(before: f64, after: f64) -> UpdateReport {
-        UpdateReport {
-            td: Some(crate::dqn::TdError { before, after }),
+    fn td_report(before: f64, after: f64) -> Feedback {
+        Feedback {
+            td: Some(TdError { before, after }),
             ..report(0.0, 0.0)
         }
     }

@@ -5,7 +5,9 @@
 
 use rand::rngs::StdRng;
 
-use super::{Actor, EpisodeEnd, Learning, Selector, SelectorView};
+use super::method::{MethodKind, ReuseMethod, Tested};
+use super::{Actor, EpisodeEnd, Learning, Library, ReuseError, Selector, SelectorView};
+use crate::sapnet::SapNetParams;
 
 #[derive(Debug)]
 pub struct Ucb1 {
@@ -101,6 +103,41 @@ impl Selector for Ucb1 {
             .map(|(&m, &p)| if p == most { m } else { f64::NEG_INFINITY })
             .collect();
         Some(super::argmax(&candidates))
+    }
+}
+
+/// UCB1 in `protocol.methods` (`Ucb1`), in the palette's green.
+pub struct Bandit;
+
+/// What UCB1 is: its pick is a rule (the highest index), so no lock-in is measured.
+pub const KIND: MethodKind = MethodKind {
+    family: "Ucb1",
+    hue: 125,
+    saturation: 55,
+    reuses: true,
+    tested: Tested::MostPlayed,
+    picks_by_probability: false,
+    spreads: false,
+};
+
+impl ReuseMethod for Bandit {
+    fn label(&self) -> String {
+        "ucb1".into()
+    }
+
+    fn kind(&self) -> MethodKind {
+        KIND
+    }
+
+    fn selector(
+        &self,
+        library: Library<'_>,
+        _: &SapNetParams,
+    ) -> Result<Box<dyn Selector>, ReuseError> {
+        Ok(Box::new(Ucb1::new(
+            library.descriptions.len(),
+            library.return_range,
+        )))
     }
 }
 

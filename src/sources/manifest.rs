@@ -12,8 +12,10 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::SourceTask;
-use crate::config::{parse_ron_as, ron_options, Config, DqnConfig};
+use crate::config::Config;
+use crate::dqn::DqnConfig;
 use crate::policy_store::{self, PolicyMetadata, StoreError};
+use crate::ron_file::{parse_ron_as, ron_options};
 
 /// The manifest's file name inside `<library>/<task>/`.
 pub const FILE: &str = "library.ron";
@@ -221,7 +223,7 @@ pub fn read(dir: &Path) -> Result<Option<Manifest>, StoreError> {
     if !path.exists() {
         return Ok(None);
     }
-    let text = crate::config::read_folder_text(&path)?;
+    let text = crate::ron_file::read_folder_text(&path)?;
     let manifest: Manifest = parse_ron_as(&text, &path.display().to_string(), "library manifest")?;
     // A library may come from elsewhere: every name it lists becomes a file name and a
     // column of activations.csv.

@@ -26,10 +26,10 @@ pub mod manifest;
 pub mod mapping;
 mod train;
 
+pub use crate::env::mapping::{check_fit, native_spaces, InterTaskMapping, Spaces};
 pub use import::{import, Imported};
 pub use load::{ensure_library, evaluate, load_library, needs_training, Evaluation, LibraryRoot};
 pub use manifest::{LibraryTraining, Manifest, ManifestEntry};
-pub use mapping::{InterTaskMapping, Spaces};
 pub use train::train_library;
 
 /// Stream key of the source library's plan ([`seeds::library_v1`]), which no experiment uses.
@@ -65,38 +65,6 @@ impl SourceTask {
             mapping: None,
             ..self.clone()
         }
-    }
-}
-
-/// The spaces of a native task, known without running it; `None` for a Gymnasium task.
-pub fn native_spaces(env: &EnvConfig) -> Option<Spaces> {
-    if matches!(env, EnvConfig::Gymnasium(_)) {
-        return None;
-    }
-    crate::env::spaces(env)
-        .ok()
-        .map(|(observation_size, action_count)| Spaces {
-            observation_size,
-            action_count,
-        })
-}
-
-/// Whether a source task of `source` spaces can be reused on a target of `target` spaces:
-/// with equal spaces and no mapping as it is, otherwise through a mapping that fits.
-/// `field` is the task's place (`sources.tasks[1]`).
-pub fn check_fit(
-    field: &str,
-    mapping: Option<&InterTaskMapping>,
-    source: Spaces,
-    target: Spaces,
-) -> Result<(), String> {
-    match mapping {
-        Some(mapping) => mapping.check(&format!("{field}.mapping"), source, target),
-        None if source == target => Ok(()),
-        None => Err(format!(
-            "field `{field}`: its agent has {source}, the target's {target}: give its \
-             `mapping: Some(state: [..], actions: [..])` (docs/FUTURE_WORK.md)"
-        )),
     }
 }
 

@@ -23,7 +23,8 @@ use ron::value::RawValue;
 use serde::Deserialize;
 use serde_json::Value;
 
-use crate::config::{parse_ron, read_text, Config};
+use crate::config::Config;
+use crate::ron_file::{parse_ron, read_text};
 
 /// The most cells a grid may expand into.
 pub const MAX_CELLS: usize = 100_000;

@@ -21,10 +21,11 @@ use std::path::Path;
 use anyhow::{Context, Result};
 
 use super::{cell_name, cell_results, Manifest};
-use crate::config::{Config, Method};
+use crate::config::Config;
 use crate::experiment::method_ids;
 use crate::report::{self, comparison, improvement, Curve, PlotData, Report, RunSummary, TaskRuns};
 use crate::results::{self, Results};
+use crate::reuse::Method;
 use crate::trainer::MethodId;
 
 /// What a merge found.

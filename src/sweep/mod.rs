@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::config::{parse_ron_as, read_folder_text, ron_options};
+use crate::ron_file::{parse_ron_as, read_folder_text, ron_options};
 
 /// `SWEEP/sweep.ron`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

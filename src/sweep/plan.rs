@@ -7,9 +7,9 @@ use anyhow::{bail, Context, Result};
 
 use super::grid::{describe, Grid};
 use super::{cell_config, CellEntry, Manifest};
-use crate::config::ron_options;
 use crate::env::PythonSettings;
 use crate::policy_store::{sha256_hex, write_atomically};
+use crate::ron_file::ron_options;
 
 /// What to plan.
 pub struct PlanOptions {

@@ -107,7 +107,7 @@ fn attempt(
 ) -> Result<CellRun> {
     let id = entry.id;
     let path = cell_config(sweep, id);
-    let text = crate::config::read_folder_text(&path)?;
+    let text = crate::ron_file::read_folder_text(&path)?;
     if sha256_hex(text.as_bytes()) != entry.config_sha256 {
         bail!(
             "{} changed after the sweep was planned (its SHA-256 differs from sweep.ron): \
@@ -136,7 +136,7 @@ fn attempt(
         trace: false,
         copy_chosen: false,
     };
-    let reuses = config.protocol.methods.iter().any(|m| m.kind().reuses());
+    let reuses = config.protocol.methods.iter().any(|m| m.kind().reuses);
     if reuses && sources::needs_training(&config, &manifest.library)? {
         bail!(
             "cell {}: the source library {} is missing or unfinished; `sapnet sweep prepare \
@@ -231,8 +231,8 @@ pub fn prepare(
     let mut seen = Vec::new();
     for entry in &manifest.cells {
         let path = cell_config(sweep, entry.id);
-        let config = received_cell(&crate::config::read_folder_text(&path)?, &path, python)?;
-        if !config.protocol.methods.iter().any(|m| m.kind().reuses()) {
+        let config = received_cell(&crate::ron_file::read_folder_text(&path)?, &path, python)?;
+        if !config.protocol.methods.iter().any(|m| m.kind().reuses) {
             continue;
         }
         let training = sources::LibraryTraining::of(&config);

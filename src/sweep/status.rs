@@ -39,7 +39,7 @@ pub fn state(sweep: &Path, id: usize) -> CellState {
     let failure = crate::safe_io::read_text(
         &cell_failure(sweep, id),
         crate::safe_io::Links::Refuse,
-        crate::config::MAX_TEXT_BYTES,
+        crate::ron_file::MAX_TEXT_BYTES,
     );
     match failure {
         Ok(text) => CellState::Failed(

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::config::{parse_ron, sapnet_field, ConfigError};
+use crate::ron_file::{parse_ron, sapnet_field, ConfigError};
 use crate::sapnet::{
     BaseGraph, Graph, Paths, PolicyDescription, Prototype, SapNet, SapNetError, SapNetParams,
     WeightedPrototype,
@@ -90,7 +90,7 @@ impl TeachConfig {
     pub fn load(path: Option<&Path>) -> Result<Lesson, ConfigError> {
         match path {
             Some(path) => {
-                let text = crate::config::read_text(path)?;
+                let text = crate::ron_file::read_text(path)?;
                 Self::lesson_from_ron(&text, &path.display().to_string())
             }
             None => Self::lesson_from_ron(FIG2, "teach_fig2.ron (embedded)"),

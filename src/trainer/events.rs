@@ -16,9 +16,9 @@ use std::borrow::Cow;
 
 use serde::{Deserialize, Serialize, Serializer};
 
-use crate::config::{Method, MethodKind};
 use crate::dqn::UpdateReport;
 pub use crate::reuse::Deposit;
+use crate::reuse::{Method, MethodKind};
 use crate::sapnet::{PolicyDescription, SapNet, TraceStep};
 
 /// Which learner a run trains: its place in `protocol.methods`, its kind and its label in

@@ -34,10 +34,11 @@ use super::events::{
     SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
 };
 use super::{Divergence, RunOutcome, TrainerError};
-use crate::config::{DqnConfig, Method};
-use crate::dqn::{Architecture, DqnAgent, DqnError, QNet, ReplayBuffer, Transition};
+use crate::dqn::DqnConfig;
+use crate::dqn::{Architecture, DqnAgent, DqnError, QNet, ReplayBuffer, Transition, UpdateReport};
 use crate::env::{self, EnvConfig, Environment};
-use crate::reuse::{self, Actor, EpisodeEnd, Learning, Selector};
+use crate::reuse::Method;
+use crate::reuse::{self, Actor, EpisodeEnd, Feedback, Learning, Selector, TdError};
 use crate::sapnet::{PolicyDescription, SapNetParams};
 use crate::seeds;
 
@@ -294,7 +295,7 @@ pub fn train(
     let learner = match spec.reuse.learner_hidden() {
         Some(hidden) => {
             let architecture =
-                Architecture::new(env.observation_size(), hidden, env.action_count());
+                Architecture::new(env.observation_size(), &hidden, env.action_count());
             let net = QNet::with_init(
                 architecture,
                 spec.dqn.init,
@@ -470,7 +471,7 @@ pub fn train(
                 // A round without an update (update_interval > 1) has nothing to judge.
                 if let (Some(report), Some(i)) = (&report, name) {
                     selector.set_tracing(control.trace());
-                    judgment = selector.on_update(i, report);
+                    judgment = selector.on_update(i, &feedback(report));
                     if judgment == Some(true) {
                         deposit = selector.last_deposit();
                     }
@@ -593,6 +594,19 @@ pub fn train(
     record.wall_s = started.elapsed().as_secs_f64();
     let _ = events.send(Event::RunEnded(record.clone()));
     Ok(RunOutcome { record, net })
+}
+
+/// What a selector hears of a learner's round of updates.
+fn feedback(report: &UpdateReport) -> Feedback {
+    Feedback {
+        loss: report.loss,
+        previous_statistic_loss: report.previous_statistic_loss,
+        statistic_loss: report.statistic_loss,
+        td: report.td.map(|td| TdError {
+            before: td.before,
+            after: td.after,
+        }),
+    }
 }
 
 /// Returns of `episodes` greedy episodes (the paper's "Number of test").

@@ -11,7 +11,6 @@ use std::time::{Duration, Instant};
 
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
-use crate::config::MethodKind;
 use crate::sapnet::{PolicyDescription, Prototype, SapNet};
 use crate::trainer::{
     ActivationSnapshot, Command, Event, MethodId, RunRecord, StepRecord, LOCK_IN,
@@ -154,7 +153,7 @@ pub struct SapNetView {
     pub spread: Option<(usize, u64)>,
     /// The policy that has held P > [`LOCK_IN`] since the step given, while it does: the
     /// softmax has collapsed onto it. Never for a method that picks by rule (as in the
-    /// headless comparison, [`MethodKind::picks_by_probability`]).
+    /// headless comparison, [`crate::reuse::MethodKind::picks_by_probability`]).
     pub locked: Option<(usize, u64)>,
     /// The scores at the end of each of the last [`HISTORY`] episodes, oldest first: the
     /// table's sparklines.
@@ -452,7 +451,7 @@ impl Dashboard {
                     None => {
                         let mut run = RunView::new(method, run, 0);
                         run.failed = Some(error);
-                        if run.method.kind == MethodKind::SapNet {
+                        if run.method.kind.spreads {
                             self.runs.insert(0, run);
                         } else {
                             self.runs.push(run);
@@ -485,7 +484,7 @@ impl Dashboard {
                 .probabilities
                 .iter()
                 .position(|&p| p > LOCK_IN)
-                .filter(|_| snapshot.method.kind.picks_by_probability());
+                .filter(|_| snapshot.method.kind.picks_by_probability);
             // The trainer dates the first lock-in at its step (the headless results' figure);
             // a frame sees it only when it is drawn. A later one, after the first let go, is
             // dated from the first snapshot that shows it.

@@ -2,8 +2,9 @@
 //! library's ten architectures, with made-up but plausible numbers, so that what is drawn
 //! does not depend on timing.
 
-use sapnet::config::{Config, Method};
+use sapnet::config::Config;
 use sapnet::dqn::UpdateReport;
+use sapnet::reuse::Method;
 use sapnet::sapnet::{PolicyDescription, SapNet};
 use sapnet::trainer::{
     ActivationSnapshot, ChosenPolicy, Deposit, EpisodeRecord, Event, MethodId, RunRecord,

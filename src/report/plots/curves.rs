@@ -298,13 +298,13 @@ mod tests {
             curves: vec![
                 Curve {
                     label: "sapnet".into(),
-                    kind: crate::config::MethodKind::SapNet,
+                    kind: crate::reuse::sapnet::KIND,
                     returns: vec![],
                     tests: vec![vec![0.0, 10.0], vec![500.0, 20.0]],
                 },
                 Curve {
                     label: "dqn[100]".into(),
-                    kind: crate::config::MethodKind::Dqn,
+                    kind: crate::reuse::scratch::KIND,
                     returns: vec![],
                     tests: vec![vec![9.0, 10.0]],
                 },

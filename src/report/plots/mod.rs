@@ -19,7 +19,7 @@ use std::sync::Once;
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 
-use crate::config::MethodKind;
+use crate::reuse::MethodKind;
 
 /// DejaVu Sans (licence in `assets/fonts/`): plotters' `ab_glyph` backend needs a font and
 /// a headless machine may have none.
@@ -166,13 +166,13 @@ mod tests {
             curves: vec![
                 Curve {
                     label: "sapnet".into(),
-                    kind: MethodKind::SapNet,
+                    kind: crate::reuse::sapnet::KIND,
                     returns: vec![vec![10.0, 20.0, 30.0], vec![12.0, 18.0]],
                     tests: vec![vec![100.0, 90.0], vec![80.0, 95.0]],
                 },
                 Curve {
                     label: "dqn[100]".into(),
-                    kind: MethodKind::Dqn,
+                    kind: crate::reuse::scratch::KIND,
                     returns: vec![vec![9.0, 11.0, 10.0]],
                     tests: vec![vec![9.0, 10.0]],
                 },

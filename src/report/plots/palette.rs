@@ -6,7 +6,7 @@
 
 use plotters::prelude::*;
 
-use crate::config::MethodKind;
+use crate::reuse::MethodKind;
 
 /// How a method's line is stroked.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -46,16 +46,10 @@ impl Pen {
     }
 }
 
-/// The hue (degrees) and saturation of a family; DQN's family is grey.
+/// The hue (degrees) and saturation of a family, as its method's file gives them (DQN's
+/// is grey); methods of one hue are one family here (both random selectors).
 fn family(kind: MethodKind) -> (f64, f64) {
-    match kind {
-        MethodKind::SapNet => (0.0, 0.72),
-        MethodKind::Random | MethodKind::RandomPerEpisode => (212.0, 0.65),
-        MethodKind::Ucb1 => (125.0, 0.55),
-        MethodKind::Prql => (280.0, 0.50),
-        MethodKind::BestSource => (30.0, 0.80),
-        MethodKind::Dqn => (0.0, 0.0),
-    }
+    (f64::from(kind.hue), f64::from(kind.saturation) / 100.0)
 }
 
 /// The members of a family in turn: three solid lines 0.2 apart in lightness, then two
@@ -198,21 +192,23 @@ mod tests {
     /// source, DQN) and two more DQNs: every pen differs, every family shares one hue.
     #[test]
     fn thirteen_methods_get_distinct_pens_with_families_by_hue() {
-        use MethodKind::*;
+        use crate::reuse::Method;
+        let sapnet = Method::SapNet.kind();
+        let dqn = Method::Dqn { hidden: vec![100] }.kind();
         let kinds = [
-            SapNet,
-            SapNet,
-            SapNet,
-            SapNet,
-            SapNet,
-            Random,
-            RandomPerEpisode,
-            Ucb1,
-            Prql,
-            BestSource,
-            Dqn,
-            Dqn,
-            Dqn,
+            sapnet,
+            sapnet,
+            sapnet,
+            sapnet,
+            sapnet,
+            Method::Random.kind(),
+            Method::RandomPerEpisode.kind(),
+            Method::Ucb1.kind(),
+            Method::Prql(Default::default()).kind(),
+            Method::BestSource.kind(),
+            dqn,
+            dqn,
+            dqn,
         ];
         let pens = method_pens(&kinds);
         for i in 0..pens.len() {
@@ -242,7 +238,7 @@ mod tests {
 
     #[test]
     fn a_sixth_member_swaps_the_dash_of_the_first() {
-        let pens = method_pens(&[MethodKind::SapNet; 6]);
+        let pens = method_pens(&[crate::reuse::Method::SapNet.kind(); 6]);
         assert_eq!(pens[5].colour, pens[0].colour);
         assert_eq!((pens[0].dash, pens[5].dash), (Dash::Solid, Dash::Dashed));
     }
