@@ -61,9 +61,7 @@ fn sources(n: u64) -> Arc<Vec<SourcePolicy>> {
 /// drain them (headless between progress updates, the TUI once per frame): never parked
 /// on the channel, so that no send has to wake a thread. Returns the time `train` took:
 /// the front end's shutdown (waiting out the sleep it is in) is not training time.
-fn drained(
-    train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Command>),
-) -> Duration {
+fn drained(train: impl FnOnce(&mpsc::Sender<Event>, &trainer::CommandReceiver)) -> Duration {
     let (events, received) = mpsc::channel::<Event>();
     let drain = thread::spawn(move || {
         let mut count = 0;
@@ -77,7 +75,7 @@ fn drained(
             }
         }
     });
-    let (_commands, commands) = mpsc::channel();
+    let (_commands, commands) = trainer::command_channel();
     let started = Instant::now();
     train(&events, &commands);
     let took = started.elapsed();
@@ -89,9 +87,7 @@ fn drained(
 /// As [`drained`], but the thread is the dashboard's: every frame (33 ms) it folds the
 /// events into a [`Dashboard`] and draws it at 200×60, so that training competes with
 /// the UI's work as it does with the TUI open.
-fn watched(
-    train: impl FnOnce(&mpsc::Sender<Event>, &mpsc::Receiver<trainer::Command>),
-) -> Duration {
+fn watched(train: impl FnOnce(&mpsc::Sender<Event>, &trainer::CommandReceiver)) -> Duration {
     let (events, received) = mpsc::channel::<Event>();
     let ui = thread::spawn(move || {
         let mut dashboard = Dashboard::new("CartPole-v1");
@@ -118,7 +114,7 @@ fn watched(
             }
         }
     });
-    let (_commands, commands) = mpsc::channel();
+    let (_commands, commands) = trainer::command_channel();
     let started = Instant::now();
     train(&events, &commands);
     let took = started.elapsed();

@@ -26,7 +26,7 @@ fn a_100_unit_dqn_learns_cartpole() {
         config.seed,
     );
     let (events, received) = mpsc::channel();
-    let (_commands, commands) = mpsc::channel();
+    let (_commands, commands) = sapnet::trainer::command_channel();
     let outcome = trainer::train(&spec, &events, &commands).unwrap();
     drop(events);
 

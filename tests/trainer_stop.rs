@@ -24,7 +24,7 @@ fn spec() -> RunSpec {
 #[test]
 fn a_stop_before_the_first_step_trains_nothing() {
     let (events, received) = mpsc::channel();
-    let (commands_tx, commands) = mpsc::channel();
+    let (commands_tx, commands) = trainer::command_channel();
     commands_tx.send(Command::Stop).unwrap();
     let outcome = trainer::train(&spec(), &events, &commands).unwrap();
     assert!(outcome.record.stopped);
@@ -38,7 +38,7 @@ fn a_stop_before_the_first_step_trains_nothing() {
 #[test]
 fn a_stop_mid_run_keeps_the_episodes_so_far() {
     let (events, received) = mpsc::channel();
-    let (commands_tx, commands) = mpsc::channel();
+    let (commands_tx, commands) = trainer::command_channel();
     let worker = thread::spawn(move || trainer::train(&spec(), &events, &commands));
     let mut episodes_seen = 0;
     for event in &received {

@@ -59,7 +59,7 @@ fn spec(episodes: u32, stream: StreamOptions) -> RunSpec {
 
 fn collect(spec: &RunSpec) -> (Vec<Event>, trainer::RunOutcome) {
     let (events, received) = mpsc::channel();
-    let (_commands, commands_rx) = mpsc::channel();
+    let (_commands, commands_rx) = trainer::command_channel();
     let outcome = trainer::train(spec, &events, &commands_rx).unwrap();
     drop(events);
     (received.into_iter().collect(), outcome)

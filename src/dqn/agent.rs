@@ -1,5 +1,8 @@
 //! The DQN learner (ChainerRL's `DQN` agent, with the hyper-parameters of `DqnConfig`).
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
 use rand::Rng;
 
 use super::backprop::Workspace;
@@ -57,6 +60,8 @@ pub struct DqnAgent {
     last_loss: Option<f64>,
     /// Whether each report carries the TD error of the latest transition ([`TdError`]).
     measure_td: bool,
+    /// Raised when the run is asked to stop: a round of many updates ends at the next.
+    interrupt: Option<Arc<AtomicBool>>,
     /// Reused between updates.
     batch: Batch,
     targets: Vec<f32>,
@@ -76,6 +81,7 @@ impl DqnAgent {
             statistic_loss: 0.0,
             last_loss: None,
             measure_td: false,
+            interrupt: None,
             batch: Batch::new(),
             targets: Vec::new(),
         })
@@ -93,6 +99,12 @@ impl DqnAgent {
     /// target net once, the online net before and after), so it is off unless asked for.
     pub fn measure_td_error(&mut self, on: bool) {
         self.measure_td = on;
+    }
+
+    /// A round of updates (up to `gradient_steps`) ends early, its learning kept, once
+    /// `flag` is raised: how the run that owns this learner tells it to stop.
+    pub fn interrupt_rounds_with(&mut self, flag: Arc<AtomicBool>) {
+        self.interrupt = Some(flag);
     }
 
     /// `max_a Q_online(obs, a)`: the online net's value estimate of `obs`.
@@ -138,9 +150,14 @@ impl DqnAgent {
         };
         let mut loss = 0.0;
         for k in 0..self.config.gradient_steps {
-            // A round of many updates (gradient_steps up to 10,000) hears a signal between
-            // two of them: what it learned so far is kept, the run stops at its step's end.
-            if k > 0 && crate::signals::received().is_some() {
+            // A round of many updates (gradient_steps up to 10,000) hears a stop between two
+            // of them: what it learned so far is kept, the run stops at its step's end.
+            if k > 0
+                && self
+                    .interrupt
+                    .as_ref()
+                    .is_some_and(|f| f.load(Ordering::Relaxed))
+            {
                 break;
             }
             let mut batch = std::mem::take(&mut self.batch);

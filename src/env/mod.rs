@@ -22,10 +22,10 @@ mod params;
 
 pub use acrobot::Acrobot;
 pub use cartpole::CartPole;
+pub use gymnasium::{GymnasiumParams, PythonSettings, WorkerTimeouts};
 pub use mountain_car::MountainCar;
 pub use params::{
-    AcrobotParams, ActionSet, CartPoleParams, EnvConfig, GymnasiumParams, Integrator,
-    MountainCarParams, PythonSettings, WorkerTimeouts,
+    AcrobotParams, ActionSet, CartPoleParams, EnvConfig, Integrator, MountainCarParams,
 };
 
 /// What one call of [`Environment::step`] returns (Gymnasium's 5-tuple without `info`).

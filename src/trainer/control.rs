@@ -1,13 +1,14 @@
 //! How a run obeys the front end's [`Command`]s between steps.
 
-use std::sync::mpsc::{Receiver, TryRecvError};
+use std::sync::mpsc::TryRecvError;
 use std::time::Duration;
 
 use super::events::Command;
+use super::CommandReceiver;
 
 /// The command channel of one run and what it has asked for so far.
 pub(crate) struct Control<'a> {
-    commands: &'a Receiver<Command>,
+    commands: &'a CommandReceiver,
     paused: bool,
     /// Steps granted by `Command::Step` while paused.
     granted: u32,
@@ -23,7 +24,7 @@ pub(crate) enum Next {
 }
 
 impl<'a> Control<'a> {
-    pub fn new(commands: &'a Receiver<Command>, trace: bool) -> Self {
+    pub fn new(commands: &'a CommandReceiver, trace: bool) -> Self {
         Self {
             commands,
             paused: false,
@@ -37,7 +38,7 @@ impl<'a> Control<'a> {
     /// channel counts as `Stop`), and sleeps the throttle delay.
     pub fn before_step(&mut self) -> Next {
         loop {
-            match self.commands.try_recv() {
+            match self.commands.receiver.try_recv() {
                 Ok(command) => {
                     if self.apply(command) == Next::Stop {
                         return Next::Stop;
@@ -48,7 +49,7 @@ impl<'a> Control<'a> {
             }
         }
         while self.paused && self.granted == 0 {
-            match self.commands.recv() {
+            match self.commands.receiver.recv() {
                 Ok(command) => {
                     if self.apply(command) == Next::Stop {
                         return Next::Stop;
@@ -98,13 +99,12 @@ impl<'a> Control<'a> {
 
 #[cfg(test)]
 mod tests {
-    use std::sync::mpsc;
 
     use super::*;
 
     #[test]
     fn runs_until_stopped() {
-        let (tx, rx) = mpsc::channel();
+        let (tx, rx) = super::super::command_channel();
         let mut control = Control::new(&rx, false);
         assert_eq!(control.before_step(), Next::Step);
         tx.send(Command::Stop).unwrap();
@@ -113,14 +113,14 @@ mod tests {
 
     #[test]
     fn a_closed_channel_stops() {
-        let (tx, rx) = mpsc::channel::<Command>();
+        let (tx, rx) = super::super::command_channel();
         drop(tx);
         assert_eq!(Control::new(&rx, false).before_step(), Next::Stop);
     }
 
     #[test]
     fn paused_runs_take_only_granted_steps() {
-        let (tx, rx) = mpsc::channel();
+        let (tx, rx) = super::super::command_channel();
         let mut control = Control::new(&rx, false);
         for command in [Command::Pause, Command::Step, Command::Step] {
             tx.send(command).unwrap();
@@ -136,7 +136,7 @@ mod tests {
 
     #[test]
     fn stop_ends_a_pause() {
-        let (tx, rx) = mpsc::channel();
+        let (tx, rx) = super::super::command_channel();
         let mut control = Control::new(&rx, false);
         tx.send(Command::Pause).unwrap();
         tx.send(Command::Stop).unwrap();
@@ -145,7 +145,7 @@ mod tests {
 
     #[test]
     fn trace_and_throttle_are_remembered() {
-        let (tx, rx) = mpsc::channel();
+        let (tx, rx) = super::super::command_channel();
         let mut control = Control::new(&rx, false);
         tx.send(Command::Trace(true)).unwrap();
         tx.send(Command::Throttle(Duration::from_millis(2)))

@@ -9,7 +9,9 @@ mod control;
 mod events;
 mod run;
 
-use std::sync::mpsc::{self, Sender};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::Arc;
 use std::thread::{self, JoinHandle};
 
 pub use events::{
@@ -66,13 +68,59 @@ pub struct RunOutcome {
 /// A run on its own thread: send it commands, join it for the outcome.
 #[derive(Debug)]
 pub struct RunHandle {
-    pub commands: Sender<Command>,
+    pub commands: Commands,
     pub thread: JoinHandle<Result<RunOutcome, TrainerError>>,
+}
+
+/// The front end's end of a run's command channel. A [`Command::Stop`] also raises the
+/// run's stop flag, which its learners read between the updates of a long round (they
+/// cannot read the channel: the run's loop does, between steps).
+#[derive(Debug, Clone)]
+pub struct Commands {
+    sender: Sender<Command>,
+    stop: Arc<AtomicBool>,
+}
+
+impl Commands {
+    pub fn send(&self, command: Command) -> Result<(), mpsc::SendError<Command>> {
+        if command == Command::Stop {
+            self.stop.store(true, Ordering::SeqCst);
+        }
+        self.sender.send(command)
+    }
+}
+
+/// The run's end of its command channel: the commands, and the stop flag its learners
+/// are given.
+#[derive(Debug)]
+pub struct CommandReceiver {
+    receiver: Receiver<Command>,
+    stop: Arc<AtomicBool>,
+}
+
+impl CommandReceiver {
+    /// Raised by a `Stop` sent through [`Commands`].
+    pub fn stop_flag(&self) -> Arc<AtomicBool> {
+        Arc::clone(&self.stop)
+    }
+}
+
+/// A run's command channel.
+pub fn command_channel() -> (Commands, CommandReceiver) {
+    let (sender, receiver) = mpsc::channel();
+    let stop = Arc::new(AtomicBool::new(false));
+    (
+        Commands {
+            sender,
+            stop: Arc::clone(&stop),
+        },
+        CommandReceiver { receiver, stop },
+    )
 }
 
 /// Starts `spec` on a thread of its own that sends its events to `events`.
 pub fn spawn(spec: RunSpec, events: Sender<Event>) -> std::io::Result<RunHandle> {
-    let (commands, receiver) = mpsc::channel();
+    let (commands, receiver) = command_channel();
     let thread = thread::Builder::new()
         .name(format!("trainer {} run {}", spec.method, spec.run))
         .spawn(move || {

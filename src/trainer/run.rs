@@ -21,7 +21,7 @@
 //! with a learner of its own ([`Learning::Learner`]: DQN from scratch, PRQ-learning) has
 //! none, and its learner waits for `replay_start_size` transitions as any DQN does.
 
-use std::sync::mpsc::{Receiver, Sender};
+use std::sync::mpsc::Sender;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -30,10 +30,10 @@ use rand::SeedableRng;
 
 use super::control::{Control, Next};
 use super::events::{
-    ActivationSnapshot, ChosenPolicy, Command, EpisodeRecord, Event, LockIn, MethodId, RunRecord,
+    ActivationSnapshot, ChosenPolicy, EpisodeRecord, Event, LockIn, MethodId, RunRecord,
     SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
 };
-use super::{Divergence, RunOutcome, TrainerError};
+use super::{CommandReceiver, Divergence, RunOutcome, TrainerError};
 use crate::dqn::DqnConfig;
 use crate::dqn::{Architecture, DqnAgent, DqnError, QNet, ReplayBuffer, Transition, UpdateReport};
 use crate::env::{self, EnvConfig, Environment};
@@ -269,7 +269,7 @@ pub fn selector(spec: &RunSpec) -> Result<Box<dyn reuse::Selector>, TrainerError
 pub fn train(
     spec: &RunSpec,
     events: &Sender<Event>,
-    commands: &Receiver<Command>,
+    commands: &CommandReceiver,
 ) -> Result<RunOutcome, TrainerError> {
     let started = Instant::now();
     let streams = Streams::new(spec.seed);
@@ -289,8 +289,9 @@ pub fn train(
             .collect::<Result<Vec<_>, _>>()?,
         Learning::Learner => Vec::new(),
     };
-    if needs.td_error {
-        agents.iter_mut().for_each(|a| a.measure_td_error(true));
+    for agent in &mut agents {
+        agent.measure_td_error(needs.td_error);
+        agent.interrupt_rounds_with(commands.stop_flag());
     }
     let learner = match spec.reuse.learner_hidden() {
         Some(hidden) => {
@@ -301,7 +302,9 @@ pub fn train(
                 spec.dqn.init,
                 &mut StdRng::seed_from_u64(streams.weights),
             )?;
-            Some(DqnAgent::new(net, &spec.dqn)?)
+            let mut learner = DqnAgent::new(net, &spec.dqn)?;
+            learner.interrupt_rounds_with(commands.stop_flag());
+            Some(learner)
         }
         None => None,
     };

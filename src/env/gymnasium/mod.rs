@@ -15,7 +15,10 @@
 //! may set, and `--python` overrides; a stored config never chooses it), else the active
 //! virtualenv (`$VIRTUAL_ENV/bin/python`), else `python3` on the `PATH`.
 
+mod params;
 mod worker;
+
+pub use params::{known, GymnasiumParams, Known, PythonSettings, WorkerTimeouts};
 
 use std::cell::Cell;
 use std::collections::HashMap;
@@ -27,7 +30,7 @@ use serde::Deserialize;
 
 pub use worker::{interrupt_waits, SCRIPT_NAME};
 
-use super::{EnvError, Environment, GymnasiumParams, Step};
+use super::{EnvError, Environment, Step};
 use worker::Worker;
 
 /// Requests, as the worker reads them: an opcode, a u32 and a u64.
