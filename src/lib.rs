@@ -12,6 +12,8 @@
 //!   [`experiment`]: planning and scheduling a protocol's runs.
 //! - [`stats`]: interval estimates over runs' scores; [`report`]: the methods side by side
 //!   and the plots; [`results`]: a results directory on disk. Below both front ends.
+//! - [`tensorboard`]: TensorBoard's event files, written (scalars, hyper-parameters) and
+//!   read.
 //! - [`headless`]: the scripted front end over the trainer's events.
 //! - [`teach`]: stepping activation and spreading by hand on a small graph.
 //! - [`tui`]: the terminal dashboard over the trainer's events, and interactive teach mode.
@@ -42,5 +44,6 @@ pub mod sources;
 pub mod stats;
 pub mod sweep;
 pub mod teach;
+pub mod tensorboard;
 pub mod trainer;
 pub mod tui;
