@@ -1,7 +1,7 @@
 //! Reading an event file back, event by event, every record's two CRCs checked.
 
 use std::fs::File;
-use std::io::{self, BufReader};
+use std::io::{self, BufReader, Seek};
 use std::path::{Path, PathBuf};
 
 use super::event::{self, Event};
@@ -48,12 +48,19 @@ impl EventFile {
     /// Opens `path` (see [`safe_io::open`]: a regular file of at most
     /// [`MAX_EVENT_FILE_BYTES`]; a link followed only if `links` says so).
     pub fn open(path: &Path, links: Links) -> Result<Self, EventFileError> {
-        let io_error = |error| EventFileError::Io {
-            path: path.to_path_buf(),
-            error,
-        };
-        let file = safe_io::open(path, links, MAX_EVENT_FILE_BYTES).map_err(io_error)?;
-        let len = file.metadata().map_err(io_error)?.len();
+        let file = safe_io::open(path, links, MAX_EVENT_FILE_BYTES)
+            .map_err(|error| io_error(path, error))?;
+        Self::from_file(file, path)
+    }
+
+    /// Reads `file`, opened from `path` as [`open`](Self::open) does (a caller that has
+    /// already looked at its first bytes), from its start.
+    pub fn from_file(mut file: File, path: &Path) -> Result<Self, EventFileError> {
+        let len = file
+            .rewind()
+            .and_then(|()| file.metadata())
+            .map_err(|error| io_error(path, error))?
+            .len();
         Ok(Self {
             path: path.to_path_buf(),
             records: Records::new(BufReader::new(file), len),
@@ -69,10 +76,7 @@ impl EventFile {
     fn next_event(&mut self) -> Result<Option<Event>, EventFileError> {
         let offset = self.records.offset();
         let record = self.records.next_record().map_err(|e| match e {
-            RecordError::Io(error) => EventFileError::Io {
-                path: self.path.clone(),
-                error,
-            },
+            RecordError::Io(error) => io_error(&self.path, error),
             RecordError::Corrupt(what) => EventFileError::Corrupt {
                 path: self.path.clone(),
                 offset,
@@ -102,6 +106,13 @@ impl Iterator for EventFile {
         let next = self.next_event();
         self.failed = next.is_err();
         next.transpose()
+    }
+}
+
+fn io_error(path: &Path, error: io::Error) -> EventFileError {
+    EventFileError::Io {
+        path: path.to_path_buf(),
+        error,
     }
 }
 
