@@ -85,7 +85,7 @@ fn element_count(shape: &[u8]) -> Result<u64, DecodeError> {
 fn fixed_width<const N: usize>(
     packed: &[u8],
 ) -> Result<impl Iterator<Item = [u8; N]> + '_, DecodeError> {
-    if packed.len() % N != 0 {
+    if !packed.len().is_multiple_of(N) {
         return Err(DecodeError::Truncated);
     }
     Ok(packed
