@@ -12,6 +12,9 @@
 //!   [`experiment`]: planning and scheduling a protocol's runs.
 //! - [`stats`]: interval estimates over runs' scores; [`report`]: the methods side by side
 //!   and the plots; [`results`]: a results directory on disk. Below both front ends.
+//! - [`tensorboard`]: TensorBoard's event files, written (scalars, hyper-parameters) and
+//!   read; [`outside_runs`]: runs made by other tools (Stable-Baselines3's monitor files,
+//!   CSV exports, event files) read as episodes and scored as sapnet scores its own.
 //! - [`headless`]: the scripted front end over the trainer's events.
 //! - [`teach`]: stepping activation and spreading by hand on a small graph.
 //! - [`tui`]: the terminal dashboard over the trainer's events, and interactive teach mode.
@@ -29,6 +32,7 @@ pub mod folder_lock;
 pub mod headless;
 pub mod import;
 pub mod limits;
+pub mod outside_runs;
 pub mod policy_store;
 pub mod progress;
 pub mod random_episodes;
@@ -44,5 +48,6 @@ pub mod sources;
 pub mod stats;
 pub mod sweep;
 pub mod teach;
+pub mod tensorboard;
 pub mod trainer;
 pub mod tui;

@@ -1,0 +1,94 @@
+//! Why a run made by another tool could not be read: each names the file and, where it
+//! applies, the place in it.
+
+use std::fmt;
+use std::io;
+use std::path::PathBuf;
+
+use crate::tensorboard::EventFileError;
+
+/// A place in a file: a CSV cell or an event.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Location {
+    /// A CSV cell: its 1-based line in the file, its 1-based column and the column's name.
+    Cell {
+        line: u64,
+        column: usize,
+        name: String,
+    },
+    /// A scalar of the event whose record starts at byte `offset`.
+    Event { offset: u64, tag: String },
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Location::Cell { line, column, name } => {
+                write!(f, "line {line}, column {column} ({name})")
+            }
+            Location::Event { offset, tag } => write!(f, "the event at byte {offset} ({tag})"),
+        }
+    }
+}
+
+/// Why a run could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum OutsideRunError {
+    // `error`s are not `source`s: the message says them, and an error chain would print
+    // them twice.
+    #[error("{}: {error}", path.display())]
+    Io { path: PathBuf, error: io::Error },
+    #[error("{}: not a run sapnet can read ({why}): a run is a Stable-Baselines3 monitor.csv, \
+             a CSV with a header, or a TensorBoard event file or folder of them", path.display())]
+    UnknownFormat { path: PathBuf, why: &'static str },
+    #[error("{}: no episode: {what} holds no value", path.display())]
+    NoEpisode { path: PathBuf, what: String },
+    #[error("{}: {at}: {text:?} is not {expected}", path.display())]
+    NotANumber {
+        path: PathBuf,
+        at: Location,
+        text: String,
+        expected: &'static str,
+    },
+    #[error("{}: {at}: the return {value} is not finite", path.display())]
+    NonFiniteReturn {
+        path: PathBuf,
+        at: Location,
+        value: f64,
+    },
+    #[error("{}: no column {} (the columns are {})", path.display(), either(tried), listed(found))]
+    MissingColumn {
+        path: PathBuf,
+        tried: Vec<String>,
+        found: Vec<String>,
+    },
+    #[error("{}: no scalar tagged {} (the tags are {})", path.display(), either(tried), listed(found))]
+    MissingTag {
+        path: PathBuf,
+        tried: Vec<String>,
+        found: Vec<String>,
+    },
+    #[error("{}: {error}", path.display())]
+    Csv { path: PathBuf, error: csv::Error },
+    #[error(transparent)]
+    EventFile(#[from] EventFileError),
+}
+
+/// `"a", "b" or "c"`.
+fn either(names: &[String]) -> String {
+    let quoted: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
+    match quoted.split_last() {
+        None => String::new(),
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+    }
+}
+
+/// `"a", "b", "c"`, or `none`.
+fn listed(names: &[String]) -> String {
+    if names.is_empty() {
+        return "none".to_string();
+    }
+    let quoted: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
+    quoted.join(", ")
+}
