@@ -12,7 +12,6 @@ use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
 use sapnet::config::Config;
-use sapnet::experiment::method_ids;
 use sapnet::report::{Report, RunSummary, TaskRuns};
 use sapnet::trainer::{MethodId, RunRecord};
 
@@ -31,7 +30,7 @@ fn protocol(runs: u32) -> Protocol {
     let mut rng = StdRng::seed_from_u64(1);
     let mut summaries = Vec::new();
     let mut rewards = BTreeMap::new();
-    for method in method_ids(&config) {
+    for method in MethodId::all(&config.protocol.methods) {
         for run in 0..runs {
             let returns: Vec<f64> = (0..1000).map(|_| rng.random_range(0.0..500.0)).collect();
             let record = RunRecord {

@@ -428,7 +428,7 @@ fn reference_bands(dir: &Path, task: &str) -> Result<Vec<tui::reference::Band>> 
 /// next), step by step, beside the same run of the first DQN baseline, episode by episode;
 /// the library is loaded (or trained, with a progress bar) before the screen switches.
 fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
-    let ids = experiment::method_ids(config);
+    let ids = crate::trainer::MethodId::all(&config.protocol.methods);
     let followed = match &cli.run.follow {
         Some(label) => {
             let Some(id) = ids.iter().find(|m| m.label() == label.as_str()) else {
@@ -734,7 +734,7 @@ mod tests {
             .flat_map(|run| {
                 [
                     spec(run, "sapnet", crate::reuse::sapnet::KIND),
-                    spec(run, "dqn[4]", crate::reuse::scratch::KIND),
+                    spec(run, "dqn[4]", crate::reuse::from_scratch::KIND),
                 ]
             })
             .collect()

@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 
 use serde::{Deserialize, Serialize};
 
-use super::gymnasium::{known, GymnasiumParams, PythonSettings};
+use super::gymnasium::{known_task, GymnasiumParams, PythonSettings};
 
 /// Which environment a config runs, with its physics.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -106,7 +106,7 @@ impl EnvConfig {
                     [low, high] => Some((low, high)),
                     _ => None,
                 })
-                .or_else(|| known(&p.id).map(|k| k.return_range))
+                .or_else(|| known_task(&p.id).map(|k| k.return_range))
                 .unwrap_or((0.0, 1.0)),
         }
     }
@@ -140,7 +140,7 @@ impl EnvConfig {
             EnvConfig::MountainCar(_) => vec![-150.0, -110.0],
             EnvConfig::Acrobot(_) => vec![-150.0, -100.0],
             EnvConfig::Gymnasium(p) => {
-                known(&p.id).map_or_else(Vec::new, |k| k.thresholds.to_vec())
+                known_task(&p.id).map_or_else(Vec::new, |k| k.thresholds.to_vec())
             }
         }
     }
@@ -205,7 +205,7 @@ impl EnvConfig {
             EnvConfig::Acrobot(p) => Some(p.max_episode_steps),
             EnvConfig::Gymnasium(p) => p
                 .max_episode_steps
-                .or_else(|| known(&p.id).map(|k| k.max_episode_steps)),
+                .or_else(|| known_task(&p.id).map(|k| k.max_episode_steps)),
         }
     }
 }

@@ -6,7 +6,6 @@ use std::sync::Arc;
 
 use anyhow::Result;
 
-use super::memory;
 use crate::config::Config;
 use crate::reuse::ReuseError;
 use crate::sapnet::SapNetError;
@@ -23,30 +22,19 @@ pub struct Plan {
     pub sources: Option<Arc<Vec<SourcePolicy>>>,
 }
 
-/// The ids of the config's methods, in the protocol's order.
-pub fn method_ids(config: &Config) -> Vec<MethodId> {
-    config
-        .protocol
-        .methods
-        .iter()
-        .enumerate()
-        .map(|(i, method)| MethodId::new(i, method))
-        .collect()
-}
-
 /// Loads the library if a method reuses one (training it first, with progress on stderr,
 /// if `<library>/<source task>/` holds none or an unfinished one and `library` allows it;
 /// `stop` ends that training), then plans every run.
 ///
 /// Runs are refused, before the library is trained or anything allocated, if `jobs` of the
-/// largest could not fit in the machine's memory together ([`memory::check`]).
+/// largest could not fit in the machine's memory together ([`crate::trainer::memory::check`]).
 pub fn plan(
     config: &Config,
     library: &LibraryRoot,
     jobs: usize,
     stop: &Receiver<Command>,
 ) -> Result<Plan> {
-    memory::check(&run_specs(config, None), jobs)?;
+    crate::trainer::memory::check(&run_specs(config, None), jobs)?;
     let reuses = config.protocol.methods.iter().any(|m| m.kind().reuses);
     let sources = if reuses {
         Some(Arc::new(sources::ensure_library(config, library, stop)?))
@@ -54,7 +42,7 @@ pub fn plan(
         None
     };
     let specs = run_specs(config, sources.as_ref());
-    memory::check(&specs, jobs)?;
+    crate::trainer::memory::check(&specs, jobs)?;
     // A selector that cannot be built fails every run of its method: say so before any
     // run trains.
     for spec in specs.iter().filter(|s| s.run == 0 && s.method.kind.reuses) {
@@ -95,7 +83,7 @@ impl std::fmt::Display for ConfigField {
 /// One spec per (method, run), each with its own seed derived from the run seed, the
 /// method's label and the run's index ([`seeds::run_seed`]).
 pub fn run_specs(config: &Config, sources: Option<&Arc<Vec<SourcePolicy>>>) -> Vec<RunSpec> {
-    let ids = method_ids(config);
+    let ids = MethodId::all(&config.protocol.methods);
     let none = Arc::new(Vec::new());
     let mut specs = Vec::new();
     for run in 0..config.protocol.runs {

@@ -279,7 +279,7 @@ fn protocol(
         copies,
     );
     let started = Instant::now();
-    let outcome = experiment::schedule(plan.specs, options.jobs, commands, &mut files);
+    let outcome = crate::trainer::schedule(plan.specs, options.jobs, commands, &mut files);
     files.finish_progress(matches!(outcome, Ok(false)));
     let ending = match outcome {
         Ok(false) => Ending {

@@ -7,12 +7,13 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 
 use crate::config::Config;
-use crate::experiment::{policy_info, LibraryCopies, Observer};
+use crate::experiment::{policy_info, LibraryCopies};
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::progress::Progress;
 use crate::report::RunSummary;
 use crate::results::records::{run_name, RunWriter};
 use crate::results::{self, Summary};
+use crate::trainer::Observer;
 use crate::trainer::{Divergence, Event, MethodId, RunOutcome, RunSpec, TrainerError};
 
 /// What the event stream writes: each run's record, progress, and `summary.json` after

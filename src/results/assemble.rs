@@ -14,8 +14,8 @@ use anyhow::{Context, Result};
 use serde::Deserialize;
 
 use super::files;
+use super::plot_data;
 use super::records::{self, RunFolder};
-use super::replot;
 use super::summary::{self, Status, Summary};
 use crate::config::Config;
 use crate::report::{plots, LibraryEntry, Report, TaskRuns};
@@ -87,7 +87,7 @@ pub fn assemble(
     if !summary.runs.is_empty() {
         report.write(out)?;
         crate::failpoint::point("report-written");
-        let data = replot::read(out)?;
+        let data = plot_data::read(out)?;
         plots::write_all(out, &data)
             .with_context(|| format!("drawing the plots in {}", out.display()))?;
         crate::failpoint::point("plots-drawn");

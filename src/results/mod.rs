@@ -1,10 +1,11 @@
 //! A results directory on disk, below both front ends: `summary.json` ([`summary`]), each
 //! run's own record in `runs/` ([`records`]), the CSV files ([`files`]) put together from
 //! the records ([`assemble`]), and reading it all back — for `--resume`, `sapnet plot`
-//! ([`replot`]), `sweep merge` and the dashboard's `--compare`.
+//! ([`replot`]), `sweep merge` and the dashboard's `--compare` ([`plot_data`]).
 
 pub mod assemble;
 pub mod files;
+pub mod plot_data;
 pub mod pool;
 pub mod records;
 pub mod replot;
@@ -20,7 +21,8 @@ use crate::report::{LibraryEntry, RunSummary};
 use crate::trainer::MethodId;
 
 pub use assemble::{assemble, Ending};
-pub use replot::{read as read_plot_data, replot};
+pub use plot_data::read as read_plot_data;
+pub use replot::replot;
 pub use summary::{read_header, write_json, RunKey, Status, Summary, SummaryHeader};
 
 /// Refuses a folder whose summary lists runs but which holds none of their records

@@ -13,7 +13,6 @@ use anyhow::{bail, Context, Result};
 use super::files;
 use super::summary::{self, RunKey};
 use crate::config::Config;
-use crate::experiment;
 use crate::report::RunSummary;
 use crate::trainer::{self, EpisodeRecord, MethodId, RunRecord, TraceRecord};
 
@@ -226,7 +225,7 @@ pub fn read(out: &Path, config: &Config) -> Result<Vec<RunFolder>> {
         return Ok(Vec::new());
     };
     let entries = std::fs::read_dir(&dir).with_context(|| format!("reading {}", dir.display()))?;
-    let ids: BTreeMap<String, MethodId> = experiment::method_ids(config)
+    let ids: BTreeMap<String, MethodId> = crate::trainer::MethodId::all(&config.protocol.methods)
         .into_iter()
         .map(|id| (id.label().to_string(), id))
         .collect();
@@ -300,7 +299,7 @@ pub fn unfinished(config: &Config, finished: &[RunFolder]) -> Vec<RunKey> {
             &r.method == method && r.run == run && !r.stopped
         })
     };
-    let ids = experiment::method_ids(config);
+    let ids = crate::trainer::MethodId::all(&config.protocol.methods);
     let mut keys = Vec::new();
     for id in &ids {
         for run in 0..config.protocol.runs {

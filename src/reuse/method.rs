@@ -9,10 +9,10 @@ use std::fmt;
 use serde::{Deserialize, Serialize, Serializer};
 
 use super::best_source::Oracle;
+use super::from_scratch::FromScratch;
 use super::prql::PrqlKnobs;
 use super::random::{PerEpisode, PerStep};
 use super::sapnet::SapNetKnobs;
-use super::scratch::FromScratch;
 use super::ucb1::Bandit;
 use super::{Library, ReuseError, Selector};
 use crate::sapnet::SapNetParams;

@@ -17,17 +17,17 @@
 //! acts).
 //!
 //! One file per method: [`sapnet`], [`random`], [`ucb1`], [`prql`], [`best_source`],
-//! [`scratch`], each defining its [`ReuseMethod`]. Adding one is a new file here, a variant
+//! [`from_scratch`], each defining its [`ReuseMethod`]. Adding one is a new file here, a variant
 //! of [`Method`] and its arm in [`Method::definition`]; the compiler points at the rest.
 
 pub mod best_source;
 pub mod exclusion;
+pub mod from_scratch;
 mod method;
+pub mod parameter_schedule;
 pub mod prql;
 pub mod random;
 pub mod sapnet;
-pub mod schedule;
-pub mod scratch;
 pub mod ucb1;
 
 use std::fmt;

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::exclusion::{Exclusion, Exclusions};
 use super::method::{check_label, MethodKind, ReuseMethod, Tested};
-use super::schedule::Schedule;
+use super::parameter_schedule::Schedule;
 use super::{
     Activation, Actor, Deposit, EpisodeEnd, Feedback, Learning, Library, Needs, ReuseError,
     Selector, SelectorView,

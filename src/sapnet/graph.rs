@@ -4,8 +4,8 @@
 //! the neighbours of j, and how far away": eq. 3's zeros are simply absent. A weight is a
 //! *distance*: the smaller, the further activation spreads.
 
-use super::config::{BaseGraph, SapNetParams};
 use super::error::SapNetError;
+use super::params::{BaseGraph, SapNetParams};
 use super::policy::PolicyDescription;
 use super::prototype::prototype_matrix;
 

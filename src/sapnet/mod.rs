@@ -9,10 +9,10 @@
 //!
 //! [`SapNet`] bundles them as Algorithm 3 uses them.
 
-mod config;
 mod error;
 pub mod graph;
 pub mod judgment;
+mod params;
 mod policy;
 pub mod prototype;
 pub mod selection;
@@ -22,10 +22,10 @@ use rand::Rng;
 
 use selection::SelectionTerms;
 
-pub use config::{BaseGraph, Paths, Prototype, SapNetParams, WeightedPrototype};
 pub use error::SapNetError;
 pub use graph::Graph;
 pub use judgment::judge;
+pub use params::{BaseGraph, Paths, Prototype, SapNetParams, WeightedPrototype};
 pub use policy::PolicyDescription;
 pub use spreading::{
     Call, CallCount, NoTrace, SpreadState, Spreader, Spreading, TraceSink, TraceStep,

@@ -3,7 +3,7 @@
 //! A prototype looks at a policy from one viewpoint and names its category; two policies
 //! are related under the prototype when the names agree.
 
-use super::config::{Prototype, WeightedPrototype};
+use super::params::{Prototype, WeightedPrototype};
 use super::policy::PolicyDescription;
 
 /// The category a prototype puts a policy in. Only equality matters.

@@ -23,8 +23,8 @@
 
 use serde::Serialize;
 
-use super::config::Paths;
 use super::graph::Graph;
+use super::params::Paths;
 
 /// How far activation may spread (eq. 10 and the walks of Algorithm 2).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -9,8 +9,8 @@ use anyhow::{bail, Context, Result};
 use super::manifest::{self, LibraryTraining, Manifest, ManifestEntry};
 use super::{library_dir, plan, policy_files, tasks, SourcePlan};
 use crate::config::Config;
-use crate::experiment::{schedule, Observer};
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
+use crate::trainer::{schedule, Observer};
 use crate::trainer::{Command, Event, RunOutcome, RunSpec, TrainerError};
 
 /// Trains the library `config` describes into `<library>/<source task>/`, one policy at a
@@ -32,7 +32,7 @@ pub fn train_library(
         .enumerate()
         .map(|(i, source)| source_spec(config, i, source))
         .collect();
-    crate::experiment::memory::check(&specs, 1)?;
+    crate::trainer::memory::check(&specs, 1)?;
     crate::safe_io::real_dir(&dir)
         .with_context(|| format!("the library folder {}", dir.display()))?;
     // One trainer per library: a second `sapnet sources` (or a run training a missing

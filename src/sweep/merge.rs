@@ -22,7 +22,6 @@ use anyhow::{Context, Result};
 
 use super::{cell_name, cell_results, Manifest};
 use crate::config::Config;
-use crate::experiment::method_ids;
 use crate::report::{self, comparison, improvement, Curve, PlotData, Report, RunSummary, TaskRuns};
 use crate::results::{self, Results};
 use crate::reuse::Method;
@@ -304,7 +303,7 @@ fn pool(group: &[&Results]) -> Results {
     }
     let mut config: Config = group[0].config.clone();
     config.protocol.methods = methods;
-    let ids = method_ids(&config);
+    let ids = MethodId::all(&config.protocol.methods);
     let id_of = |label: &str| ids.iter().find(|id| id.label() == label).cloned();
     let mut runs = Vec::new();
     let mut rewards: BTreeMap<(MethodId, u32), Vec<f64>> = BTreeMap::new();
@@ -352,7 +351,7 @@ fn pool(group: &[&Results]) -> Results {
 
 /// Learning curves and tests of the pooled runs, titled with `subject` (the axis value).
 fn plot_data(pooled: &Results, subject: Option<String>) -> PlotData {
-    let curves = method_ids(&pooled.config)
+    let curves = MethodId::all(&pooled.config.protocol.methods)
         .into_iter()
         .filter_map(|id| {
             let mine: Vec<&RunSummary> = pooled

@@ -44,6 +44,15 @@ impl MethodId {
     pub fn label(&self) -> &str {
         &self.label
     }
+
+    /// The ids of a protocol's `methods`, in their order.
+    pub fn all(methods: &[Method]) -> Vec<MethodId> {
+        methods
+            .iter()
+            .enumerate()
+            .map(|(i, method)| MethodId::new(i, method))
+            .collect()
+    }
 }
 
 impl fmt::Display for MethodId {

@@ -7,7 +7,9 @@
 
 mod control;
 mod events;
+pub mod memory;
 mod run;
+pub mod scheduler;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};
@@ -19,6 +21,7 @@ pub use events::{
     RunRecord, SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
 };
 pub use run::{selector, test_greedy, train, RunSpec, SourcePolicy, LOCK_IN};
+pub use scheduler::{schedule, Observer};
 
 use crate::dqn::{DqnError, QNet};
 use crate::reuse::ReuseError;

@@ -18,7 +18,7 @@
 mod params;
 mod worker;
 
-pub use params::{known, GymnasiumParams, Known, PythonSettings, WorkerTimeouts};
+pub use params::{known_task, GymnasiumParams, KnownTask, PythonSettings, WorkerTimeouts};
 
 use std::cell::Cell;
 use std::collections::HashMap;

@@ -130,7 +130,7 @@ impl GymnasiumParams {
             ),
             None => rules.holds(
                 "return_range",
-                known(&self.id).is_some(),
+                known_task(&self.id).is_some(),
                 &format!(
                     "Some([lowest, highest]): the returns of {} an episode can have (it scales \
                      returns for UCB1, PRQ-learning and pooled reports; sapnet knows it only \
@@ -143,7 +143,7 @@ impl GymnasiumParams {
 }
 
 /// What sapnet knows of some Gymnasium tasks, so that a config need not say it.
-pub struct Known {
+pub struct KnownTask {
     pub return_range: (f64, f64),
     pub thresholds: &'static [f64],
     pub max_episode_steps: u32,
@@ -152,29 +152,29 @@ pub struct Known {
 /// The classic-control tasks as Gymnasium registers them, and LunarLander-v3, whose
 /// returns have no bounds: its range is a scale, from about a random policy's return
 /// (−200) to above "solved" (200) at 300.
-pub fn known(id: &str) -> Option<Known> {
+pub fn known_task(id: &str) -> Option<KnownTask> {
     Some(match id {
-        "CartPole-v1" => Known {
+        "CartPole-v1" => KnownTask {
             return_range: (0.0, 500.0),
             thresholds: &[195.0, 475.0],
             max_episode_steps: 500,
         },
-        "CartPole-v0" => Known {
+        "CartPole-v0" => KnownTask {
             return_range: (0.0, 200.0),
             thresholds: &[195.0, 475.0],
             max_episode_steps: 200,
         },
-        "MountainCar-v0" => Known {
+        "MountainCar-v0" => KnownTask {
             return_range: (-200.0, 0.0),
             thresholds: &[-150.0, -110.0],
             max_episode_steps: 200,
         },
-        "Acrobot-v1" => Known {
+        "Acrobot-v1" => KnownTask {
             return_range: (-500.0, 0.0),
             thresholds: &[-150.0, -100.0],
             max_episode_steps: 500,
         },
-        "LunarLander-v3" => Known {
+        "LunarLander-v3" => KnownTask {
             return_range: (-200.0, 300.0),
             thresholds: &[100.0, 200.0],
             max_episode_steps: 1000,

@@ -172,7 +172,7 @@ mod tests {
                 },
                 Curve {
                     label: "dqn[100]".into(),
-                    kind: crate::reuse::scratch::KIND,
+                    kind: crate::reuse::from_scratch::KIND,
                     returns: vec![vec![9.0, 11.0, 10.0]],
                     tests: vec![vec![9.0, 10.0]],
                 },
