@@ -11,8 +11,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
 use sapnet::teach::config::TeachConfig;
+use sapnet::teach::Teach;
 use sapnet::tui::dashboard::Dashboard;
-use sapnet::tui::teach::Teach;
 use sapnet::tui::theme::Theme;
 use sapnet::tui::{teach_view, view};
 

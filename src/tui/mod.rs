@@ -5,26 +5,22 @@
 //! parking on it, so a send never has to wake this thread) and draws at most
 //! [`FRAME`]ly.
 //!
-//! - [`dashboard`]: what the UI keeps of the stream, and what keys do.
-//! - [`teach`]: one activation's spreading, a call at a time, with undo.
-//! - [`knobs`]: teach mode's live edits (T_ω, 𝒜, τ, paths, an edge's weight).
+//! - [`dashboard`]: what the UI keeps of the stream, and what keys do (teach mode's keys
+//!   too: its state, [`Teach`], lives in [`crate::teach`], which draws nothing).
 //! - [`reference`]: a finished protocol's bands beside the live run (`--compare`).
 //! - [`row_window`]: which rows a table too long for its panel shows.
 //! - [`view`], [`step_line`], [`teach_view`], [`graph_view`]: drawing, as pure functions
 //!   of that state; they also tell what a click landed on ([`view::clicked`]), in the
 //!   rectangles they draw in.
-//! - [`graph_layout`], [`labels`]: the graph's geometry and short names, which the state
-//!   (moving the cursor) and the views share. The state modules import no view.
+//! - [`graph_layout`]: the graph's geometry, which the state (moving the cursor) and the
+//!   views share. The state modules import no view.
 
 pub mod dashboard;
 pub mod graph_layout;
 pub mod graph_view;
-pub mod knobs;
-pub mod labels;
 pub mod reference;
 pub mod row_window;
 pub mod step_line;
-pub mod teach;
 pub mod teach_view;
 pub mod theme;
 pub mod view;
@@ -35,9 +31,10 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use crossterm::event::{self as term, KeyEventKind, MouseButton, MouseEventKind};
 
+use crate::teach::session::CALLS_PER_FRAME;
+use crate::teach::Teach;
 use crate::trainer::{self, Command, RunHandle, RunSpec};
 use dashboard::{apply_teach_key, Action, Dashboard};
-use teach::Teach;
 use theme::Theme;
 
 /// The time between frames: about 30 per second.
@@ -232,7 +229,7 @@ pub fn run_teach(mut teach: Teach) -> Result<()> {
             return Ok(());
         }
         // A long `r` runs in slices between frames: keys are read between them.
-        teach.advance(teach::CALLS_PER_FRAME);
+        teach.advance(CALLS_PER_FRAME);
         terminal
             .draw(|frame| teach_view::draw(frame, &teach, help, theme))
             .context("drawing teach mode")?;
@@ -291,12 +288,9 @@ mod tests {
     fn the_state_modules_import_no_view() {
         let state = [
             ("dashboard.rs", include_str!("dashboard.rs")),
-            ("teach.rs", include_str!("teach.rs")),
-            ("knobs.rs", include_str!("knobs.rs")),
             ("reference.rs", include_str!("reference.rs")),
             ("row_window.rs", include_str!("row_window.rs")),
             ("graph_layout.rs", include_str!("graph_layout.rs")),
-            ("labels.rs", include_str!("labels.rs")),
         ];
         for (file, text) in state {
             for view in ["view", "teach_view", "graph_view", "step_line"] {

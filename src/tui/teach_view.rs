@@ -9,13 +9,13 @@ use ratatui::Frame;
 
 use super::graph_layout;
 use super::graph_view::{self, node_style, Scene};
-use super::knobs::{EditReport, Knob};
-use super::labels;
 use super::row_window::RowWindow;
-use super::teach::Teach;
 use super::theme::Theme;
 use super::view::{draw_help, probability_bar, too_small, MIN_HEIGHT, MIN_WIDTH};
 use crate::sapnet::TraceStep;
+use crate::teach::knobs::{EditReport, Knob};
+use crate::teach::labels;
+use crate::teach::Teach;
 
 /// Draws stand-alone teach mode (`sapnet teach`).
 pub fn draw(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {

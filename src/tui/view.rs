@@ -13,11 +13,11 @@ use ratatui::Frame;
 use super::dashboard::{Clicked, Dashboard, Focus, Mode, RunView, SapNetView, HISTORY, SPEEDS};
 use super::graph_layout;
 use super::graph_view::{self, node_style, Scene};
-use super::labels;
 use super::reference::Band;
 use super::row_window::RowWindow;
 use super::step_line::step_line;
 use super::theme::Theme;
+use crate::teach::labels;
 
 /// The smallest terminal the layouts fit.
 pub const MIN_WIDTH: u16 = 80;
