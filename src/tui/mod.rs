@@ -11,7 +11,8 @@
 //! - [`row_window`]: which rows a table too long for its panel shows.
 //! - [`view`], [`step_line`], [`teach_view`], [`graph_view`]: drawing, as pure functions
 //!   of that state; they also tell what a click landed on ([`view::clicked`]), in the
-//!   rectangles they draw in.
+//!   rectangles they draw in; [`screen`] holds what both screens share (the smallest
+//!   terminal, the keys' overlay), so neither screen's view imports the other's helpers.
 //! - [`graph_layout`]: the graph's geometry, which the state (moving the cursor) and the
 //!   views share. The state modules import no view.
 
@@ -20,6 +21,7 @@ pub mod graph_layout;
 pub mod graph_view;
 pub mod reference;
 pub mod row_window;
+pub mod screen;
 pub mod step_line;
 pub mod teach_view;
 pub mod theme;

@@ -5,9 +5,7 @@ use ratatui::layout::{Constraint, Layout, Position, Rect};
 use ratatui::style::Modifier;
 use ratatui::symbols::Marker;
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{
-    Axis, Block, Cell, Chart, Clear, Dataset, GraphType, Paragraph, Row, Table, Wrap,
-};
+use ratatui::widgets::{Axis, Block, Cell, Chart, Dataset, GraphType, Paragraph, Row, Table, Wrap};
 use ratatui::Frame;
 
 use super::dashboard::{Clicked, Dashboard, Focus, Mode, RunView, SapNetView, HISTORY, SPEEDS};
@@ -15,13 +13,10 @@ use super::graph_layout;
 use super::graph_view::{self, node_style, Scene};
 use super::reference::Band;
 use super::row_window::RowWindow;
+use super::screen::{draw_help, probability_bar, too_small};
 use super::step_line::step_line;
 use super::theme::Theme;
 use crate::teach::labels;
-
-/// The smallest terminal the layouts fit.
-pub const MIN_WIDTH: u16 = 80;
-pub const MIN_HEIGHT: u16 = 24;
 
 /// Draws the whole dashboard (or teach mode on the live graph, or the help overlay).
 pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
@@ -47,26 +42,6 @@ pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
             draw_help(frame, area, HELP, theme);
         }
     }
-}
-
-pub(super) fn too_small(frame: &mut Frame, area: Rect) -> bool {
-    if area.width >= MIN_WIDTH && area.height >= MIN_HEIGHT {
-        return false;
-    }
-    let text = format!(
-        "This terminal is {}×{}; sapnet needs at least {MIN_WIDTH}×{MIN_HEIGHT}. Enlarge it, or press q to quit.",
-        area.width, area.height
-    );
-    let [middle] = Layout::vertical([Constraint::Length(3)])
-        .flex(ratatui::layout::Flex::Center)
-        .areas(area);
-    frame.render_widget(
-        Paragraph::new(text)
-            .wrap(Wrap { trim: true })
-            .alignment(ratatui::layout::Alignment::Center),
-        middle,
-    );
-    true
 }
 
 /// Where the dashboard's panels are on a screen of `area`: drawing and mouse clicks use
@@ -506,16 +481,6 @@ fn format_activation(a: f64) -> String {
     }
 }
 
-/// `P` as a bar of `width` cells and its value, e.g. `██████░░░░ 0.61`.
-pub(super) fn probability_bar(p: f64, width: usize) -> String {
-    let filled = ((p.clamp(0.0, 1.0) * width as f64).round() as usize).min(width);
-    format!(
-        "{}{} {p:.2}",
-        "█".repeat(filled),
-        "░".repeat(width - filled)
-    )
-}
-
 /// The chart's legend is its title: one coloured name per curve, with the symbol its
 /// curve is drawn with, so it names the curves in colour and without, at any width, and
 /// covers no data (ratatui's legend box sat on the newest episodes at 120+ columns and was
@@ -865,73 +830,9 @@ const HELP: &[(&str, &str)] = &[
     ("+/−", "its positive / negative transitions so far (eq. 7)"),
 ];
 
-/// The width of the help's key column, with the two spaces after it.
-const HELP_KEYS: usize = 20;
-
-pub(super) fn draw_help(frame: &mut Frame, area: Rect, keys: &[(&str, &str)], theme: Theme) {
-    let width = 76.min(area.width);
-    // What a key does wraps under itself, beside the keys' column.
-    let room = usize::from(width.saturating_sub(2)).saturating_sub(HELP_KEYS);
-    let mut lines: Vec<Line> = Vec::new();
-    for (key, what) in keys {
-        for (k, part) in wrap_words(what, room).into_iter().enumerate() {
-            let key = if k == 0 { *key } else { "" };
-            lines.push(Line::from(vec![
-                Span::styled(format!("{key:>w$}  ", w = HELP_KEYS - 2), theme.title()),
-                Span::raw(part),
-            ]));
-        }
-    }
-    let height = (lines.len() as u16 + 4).min(area.height);
-    let [row] = Layout::vertical([Constraint::Length(height)])
-        .flex(ratatui::layout::Flex::Center)
-        .areas(area);
-    let [popup] = Layout::horizontal([Constraint::Length(width)])
-        .flex(ratatui::layout::Flex::Center)
-        .areas(row);
-    frame.render_widget(Clear, popup);
-    frame.render_widget(
-        Paragraph::new(lines).block(
-            Block::bordered()
-                .title(Span::styled(" keys ", theme.title()))
-                .border_style(theme.title()),
-        ),
-        popup,
-    );
-}
-
-/// `text` in lines of at most `width` columns, broken between words (a word longer than
-/// the width has a line of its own).
-fn wrap_words(text: &str, width: usize) -> Vec<String> {
-    let mut lines = vec![String::new()];
-    for word in text.split(' ') {
-        let line = lines.last_mut().expect("one line at least");
-        let wanted = Line::from(line.as_str()).width() + 1 + Line::from(word).width();
-        if line.is_empty() {
-            line.push_str(word);
-        } else if wanted <= width {
-            line.push(' ');
-            line.push_str(word);
-        } else {
-            lines.push(word.to_string());
-        }
-    }
-    lines
-}
-
 #[cfg(test)]
 mod tests {
-    use super::{count, sparkline, wrap_words};
-
-    #[test]
-    fn help_lines_wrap_between_words() {
-        assert_eq!(
-            wrap_words("the weight M of an edge", 14),
-            ["the weight M", "of an edge"]
-        );
-        assert_eq!(wrap_words("quit", 14), ["quit"]);
-        assert_eq!(wrap_words("", 14), [""]);
-    }
+    use super::{count, sparkline};
 
     #[test]
     fn sparklines_share_one_scale() {
