@@ -13,7 +13,7 @@ use sapnet::teach::Teach;
 use sapnet::trainer::Event;
 use sapnet::tui::dashboard::Dashboard;
 use sapnet::tui::theme::Theme;
-use sapnet::tui::{teach_view, view};
+use sapnet::tui::{dashboard_view as view, teach_view};
 
 const SIZES: [(u16, u16); 2] = [(120, 40), (80, 24)];
 

@@ -11,7 +11,7 @@ use sapnet::teach::config::TeachConfig;
 use sapnet::teach::Teach;
 use sapnet::trainer::Command;
 use sapnet::tui::dashboard::{Action, Dashboard, Focus, Mode, CURVE_POINTS, SPEEDS};
-use sapnet::tui::{graph_layout, teach_view, view};
+use sapnet::tui::{dashboard_view as view, graph_layout, teach_view};
 
 fn key(c: char) -> KeyEvent {
     KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)

@@ -1,6 +1,6 @@
 //! The dashboard's state: what the UI keeps of the trainer's event stream, and what the
-//! keys do to it. No drawing here (see `view`), so scripted events and keys can be checked
-//! without a terminal.
+//! keys do to it. No drawing here (see `dashboard_view`), so scripted events and keys can
+//! be checked without a terminal.
 //!
 //! Memory stays bounded over any run: steps are folded into counters as they arrive, and
 //! the curves keep one point per episode, thinned by half whenever they pass

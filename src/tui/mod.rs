@@ -9,23 +9,24 @@
 //!   too: its state, [`Teach`], lives in [`crate::teach`], which draws nothing).
 //! - [`reference`]: a finished protocol's bands beside the live run (`--compare`).
 //! - [`row_window`]: which rows a table too long for its panel shows.
-//! - [`view`], [`step_line`], [`teach_view`], [`graph_view`]: drawing, as pure functions
-//!   of that state; they also tell what a click landed on ([`view::clicked`]), in the
-//!   rectangles they draw in; [`screen`] holds what both screens share (the smallest
-//!   terminal, the keys' overlay), so neither screen's view imports the other's helpers.
+//! - [`dashboard_view`], [`teach_view`]: drawing each screen, a file per panel, as pure
+//!   functions of that state; they also tell what a click landed on
+//!   ([`dashboard_view::clicked`]), in the rectangles they draw in. Both draw the graph
+//!   with [`graph_view`] and share [`screen`] (the smallest terminal, the keys' overlay);
+//!   the dashboard's view draws teach mode on the live graph with `teach_view`, never the
+//!   reverse.
 //! - [`graph_layout`]: the graph's geometry, which the state (moving the cursor) and the
 //!   views share. The state modules import no view.
 
 pub mod dashboard;
+pub mod dashboard_view;
 pub mod graph_layout;
 pub mod graph_view;
 pub mod reference;
 pub mod row_window;
 pub mod screen;
-pub mod step_line;
 pub mod teach_view;
 pub mod theme;
-pub mod view;
 
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
@@ -100,7 +101,7 @@ pub struct DashboardRuns {
 /// A left click on a screen of `area` showing `dashboard`: the view that drew it tells
 /// what the click landed on, the dashboard acts on it.
 pub fn click(dashboard: &mut Dashboard, area: ratatui::layout::Rect, column: u16, row: u16) {
-    if let Some(clicked) = view::clicked(dashboard, area, column, row) {
+    if let Some(clicked) = dashboard_view::clicked(dashboard, area, column, row) {
         dashboard.on_click(clicked);
     }
 }
@@ -139,7 +140,7 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
             }
             dashboard.tick(Instant::now());
             terminal
-                .draw(|frame| view::draw_dashboard(frame, &dashboard, theme))
+                .draw(|frame| dashboard_view::draw_dashboard(frame, &dashboard, theme))
                 .context("drawing the dashboard")?;
             if !term::poll(FRAME).context("reading the keyboard")? {
                 continue;
@@ -295,7 +296,7 @@ mod tests {
             ("graph_layout.rs", include_str!("graph_layout.rs")),
         ];
         for (file, text) in state {
-            for view in ["view", "teach_view", "graph_view", "step_line"] {
+            for view in ["dashboard_view", "teach_view", "graph_view", "screen"] {
                 for path in [format!("super::{view}"), format!("tui::{view}")] {
                     assert!(
                         !text.contains(&format!("{path}::")) && !text.contains(&format!("{path};")),
