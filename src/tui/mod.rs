@@ -306,4 +306,46 @@ mod tests {
             }
         }
     }
+
+    /// The screens' views meet in one direction only: the dashboard's draws teach mode on
+    /// the live graph with teach mode's. Teach mode's panels, and what both views draw with,
+    /// name neither screen above them (`view.rs` and `teach_view.rs` once imported each
+    /// other).
+    #[test]
+    fn the_views_import_each_other_one_way() {
+        let below_the_dashboard = [
+            ("screen.rs", include_str!("screen.rs")),
+            ("graph_view.rs", include_str!("graph_view.rs")),
+            ("theme.rs", include_str!("theme.rs")),
+            ("teach_view/mod.rs", include_str!("teach_view/mod.rs")),
+            ("teach_view/call.rs", include_str!("teach_view/call.rs")),
+            ("teach_view/edits.rs", include_str!("teach_view/edits.rs")),
+            (
+                "teach_view/figures.rs",
+                include_str!("teach_view/figures.rs"),
+            ),
+            (
+                "teach_view/graph_panel.rs",
+                include_str!("teach_view/graph_panel.rs"),
+            ),
+            ("teach_view/help.rs", include_str!("teach_view/help.rs")),
+            ("teach_view/stack.rs", include_str!("teach_view/stack.rs")),
+            (
+                "teach_view/status_bar.rs",
+                include_str!("teach_view/status_bar.rs"),
+            ),
+            ("teach_view/trace.rs", include_str!("teach_view/trace.rs")),
+            ("teach_view/values.rs", include_str!("teach_view/values.rs")),
+        ];
+        for (file, text) in below_the_dashboard {
+            let mut above = vec!["dashboard_view"];
+            if !file.starts_with("teach_view/") {
+                above.push("teach_view");
+            }
+            for view in above {
+                assert!(!text.contains(&format!("{view}::")), "{file} uses {view}");
+                assert!(!text.contains(&format!("::{view};")), "{file} uses {view}");
+            }
+        }
+    }
 }
