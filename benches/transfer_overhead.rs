@@ -24,8 +24,8 @@ use sapnet::reuse::Method;
 use sapnet::sapnet::PolicyDescription;
 use sapnet::trainer::{self, Event, MethodId, RunSpec, SourcePolicy, StreamOptions};
 use sapnet::tui::dashboard::Dashboard;
+use sapnet::tui::dashboard_view as view;
 use sapnet::tui::theme::Theme;
-use sapnet::tui::view;
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;

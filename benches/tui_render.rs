@@ -11,10 +11,10 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
 use sapnet::teach::config::TeachConfig;
+use sapnet::teach::Teach;
 use sapnet::tui::dashboard::Dashboard;
-use sapnet::tui::teach::Teach;
 use sapnet::tui::theme::Theme;
-use sapnet::tui::{teach_view, view};
+use sapnet::tui::{dashboard_view, teach_view};
 
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
@@ -33,7 +33,7 @@ fn render(c: &mut Criterion) {
     group.bench_function("dashboard 200x60, 5000 episodes", |b| {
         b.iter(|| {
             terminal
-                .draw(|f| view::draw_dashboard(f, &dashboard, theme))
+                .draw(|f| dashboard_view::draw_dashboard(f, &dashboard, theme))
                 .expect("draw");
         })
     });

@@ -13,8 +13,9 @@ use crate::experiment;
 use crate::headless::{self, OutputOptions, RunOptions};
 use crate::ron_file::{parse_ron, ConfigError};
 use crate::teach::config::TeachConfig;
+use crate::teach::Teach;
 use crate::trainer::{RunSpec, StreamOptions};
-use crate::tui::{self, teach::Teach};
+use crate::tui;
 use crate::{assets, env, random_episodes, trainer};
 use crate::{report, results};
 

@@ -9,11 +9,11 @@ use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
 use sapnet::teach::config::TeachConfig;
+use sapnet::teach::Teach;
 use sapnet::trainer::Event;
 use sapnet::tui::dashboard::Dashboard;
-use sapnet::tui::teach::Teach;
 use sapnet::tui::theme::Theme;
-use sapnet::tui::{teach_view, view};
+use sapnet::tui::{dashboard_view as view, teach_view};
 
 const SIZES: [(u16, u16); 2] = [(120, 40), (80, 24)];
 

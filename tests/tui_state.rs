@@ -8,10 +8,10 @@ use common::tui_script;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::layout::Rect;
 use sapnet::teach::config::TeachConfig;
+use sapnet::teach::Teach;
 use sapnet::trainer::Command;
 use sapnet::tui::dashboard::{Action, Dashboard, Focus, Mode, CURVE_POINTS, SPEEDS};
-use sapnet::tui::teach::Teach;
-use sapnet::tui::{graph_layout, teach_view, view};
+use sapnet::tui::{dashboard_view as view, graph_layout, teach_view};
 
 fn key(c: char) -> KeyEvent {
     KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)

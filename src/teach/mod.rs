@@ -2,9 +2,44 @@
 //! time, with every quantity of eq. 8–11 shown.
 //!
 //! - [`config`]: the teach file (RON), a graph given by its edges or by policy categories.
+//! - [`session`]: a lesson being taught: the picked policy, one activation's spreading
+//!   stepped a call at a time, with undo (teach mode's state; the terminal UI draws it).
+//! - [`knobs`]: the session's live edits (T_ω, 𝒜, τ, paths, an edge's weight) and what
+//!   each changed.
+//! - [`labels`]: short names for policies and tasks, for a graph node or a narrow column.
 //! - [`headless`]: `sapnet teach --headless`, the trace as a table or as JSON.
+//!
+//! Nothing here draws: the terminal UI (`tui`) imports this module, never the reverse.
 
 pub mod config;
 pub mod headless;
+pub mod knobs;
+pub mod labels;
+pub mod session;
 
 pub use config::{Lesson, TeachConfig};
+pub use session::Teach;
+
+#[cfg(test)]
+mod tests {
+    /// The model sits below the front ends: a lesson can be stepped, edited and checked
+    /// without a terminal, and the terminal UI imports it, never the reverse.
+    #[test]
+    fn teaching_imports_no_front_end() {
+        let files = [
+            ("mod.rs", include_str!("mod.rs")),
+            ("config.rs", include_str!("config.rs")),
+            ("headless.rs", include_str!("headless.rs")),
+            ("knobs.rs", include_str!("knobs.rs")),
+            ("labels.rs", include_str!("labels.rs")),
+            ("session.rs", include_str!("session.rs")),
+        ];
+        // The paths are put together, so that this test does not find them in itself.
+        let front_ends = [["crate", "tui::"], ["ratatui", ""], ["crossterm", ""]];
+        for (file, text) in files {
+            for path in front_ends.map(|parts| parts.join("::")) {
+                assert!(!text.contains(&path), "{file} names {path}");
+            }
+        }
+    }
+}

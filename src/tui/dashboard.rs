@@ -1,6 +1,6 @@
 //! The dashboard's state: what the UI keeps of the trainer's event stream, and what the
-//! keys do to it. No drawing here (see `view`), so scripted events and keys can be checked
-//! without a terminal.
+//! keys do to it. No drawing here (see `dashboard_view`), so scripted events and keys can
+//! be checked without a terminal.
 //!
 //! Memory stays bounded over any run: steps are folded into counters as they arrive, and
 //! the curves keep one point per episode, thinned by half whenever they pass
@@ -12,14 +12,16 @@ use std::time::{Duration, Instant};
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
 use crate::sapnet::{PolicyDescription, Prototype, SapNet};
+use crate::teach::knobs::Knob;
+use crate::teach::labels::short_task;
+use crate::teach::session::CALLS_PER_FRAME;
+use crate::teach::Teach;
 use crate::trainer::{
     ActivationSnapshot, Command, Event, MethodId, RunRecord, StepRecord, LOCK_IN,
 };
 
 use super::graph_layout;
-use super::knobs::Knob;
 use super::reference::Band;
-use super::teach::Teach;
 
 /// Points kept per curve; beyond it every other point is dropped and the stride doubles.
 pub const CURVE_POINTS: usize = 4096;
@@ -189,7 +191,7 @@ impl SapNetView {
             .is_some_and(|p| p.prototype == Prototype::SourceTask);
         let mut names: Vec<String> = Vec::new();
         for policy in &self.policies {
-            let task = super::labels::short_task(&policy.description.source_task);
+            let task = short_task(&policy.description.source_task);
             if !names.iter().any(|n| n == task) {
                 names.push(task.to_string());
             }
@@ -501,7 +503,7 @@ impl Dashboard {
     /// Records the step count at `now` for the steps/s figure (over the last 2 s).
     pub fn tick(&mut self, now: Instant) {
         if let Some(teach) = &mut self.teach {
-            teach.advance(super::teach::CALLS_PER_FRAME);
+            teach.advance(CALLS_PER_FRAME);
         }
         // A count that went back belongs to a new run (`m`): measure it afresh.
         if self

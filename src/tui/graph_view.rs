@@ -11,9 +11,9 @@ use ratatui::widgets::Block;
 use ratatui::Frame;
 
 use super::graph_layout::{positions, X_BOUNDS, Y_BOUNDS};
-use super::labels::labels;
 use super::theme::{heat_symbol, Theme};
 use crate::sapnet::SapNet;
+use crate::teach::labels::labels;
 
 /// What to draw of a graph.
 #[derive(Debug, Clone, Copy)]

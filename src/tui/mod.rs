@@ -5,29 +5,28 @@
 //! parking on it, so a send never has to wake this thread) and draws at most
 //! [`FRAME`]ly.
 //!
-//! - [`dashboard`]: what the UI keeps of the stream, and what keys do.
-//! - [`teach`]: one activation's spreading, a call at a time, with undo.
-//! - [`knobs`]: teach mode's live edits (T_ω, 𝒜, τ, paths, an edge's weight).
+//! - [`dashboard`]: what the UI keeps of the stream, and what keys do (teach mode's keys
+//!   too: its state, [`Teach`], lives in [`crate::teach`], which draws nothing).
 //! - [`reference`]: a finished protocol's bands beside the live run (`--compare`).
 //! - [`row_window`]: which rows a table too long for its panel shows.
-//! - [`view`], [`step_line`], [`teach_view`], [`graph_view`]: drawing, as pure functions
-//!   of that state; they also tell what a click landed on ([`view::clicked`]), in the
-//!   rectangles they draw in.
-//! - [`graph_layout`], [`labels`]: the graph's geometry and short names, which the state
-//!   (moving the cursor) and the views share. The state modules import no view.
+//! - [`dashboard_view`], [`teach_view`]: drawing each screen, a file per panel, as pure
+//!   functions of that state; they also tell what a click landed on
+//!   ([`dashboard_view::clicked`]), in the rectangles they draw in. Both draw the graph
+//!   with [`graph_view`] and share [`screen`] (the smallest terminal, the keys' overlay);
+//!   the dashboard's view draws teach mode on the live graph with `teach_view`, never the
+//!   reverse.
+//! - [`graph_layout`]: the graph's geometry, which the state (moving the cursor) and the
+//!   views share. The state modules import no view.
 
 pub mod dashboard;
+pub mod dashboard_view;
 pub mod graph_layout;
 pub mod graph_view;
-pub mod knobs;
-pub mod labels;
 pub mod reference;
 pub mod row_window;
-pub mod step_line;
-pub mod teach;
+pub mod screen;
 pub mod teach_view;
 pub mod theme;
-pub mod view;
 
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
@@ -35,9 +34,10 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use crossterm::event::{self as term, KeyEventKind, MouseButton, MouseEventKind};
 
+use crate::teach::session::CALLS_PER_FRAME;
+use crate::teach::Teach;
 use crate::trainer::{self, Command, RunHandle, RunSpec};
 use dashboard::{apply_teach_key, Action, Dashboard};
-use teach::Teach;
 use theme::Theme;
 
 /// The time between frames: about 30 per second.
@@ -101,7 +101,7 @@ pub struct DashboardRuns {
 /// A left click on a screen of `area` showing `dashboard`: the view that drew it tells
 /// what the click landed on, the dashboard acts on it.
 pub fn click(dashboard: &mut Dashboard, area: ratatui::layout::Rect, column: u16, row: u16) {
-    if let Some(clicked) = view::clicked(dashboard, area, column, row) {
+    if let Some(clicked) = dashboard_view::clicked(dashboard, area, column, row) {
         dashboard.on_click(clicked);
     }
 }
@@ -140,7 +140,7 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
             }
             dashboard.tick(Instant::now());
             terminal
-                .draw(|frame| view::draw_dashboard(frame, &dashboard, theme))
+                .draw(|frame| dashboard_view::draw_dashboard(frame, &dashboard, theme))
                 .context("drawing the dashboard")?;
             if !term::poll(FRAME).context("reading the keyboard")? {
                 continue;
@@ -232,7 +232,7 @@ pub fn run_teach(mut teach: Teach) -> Result<()> {
             return Ok(());
         }
         // A long `r` runs in slices between frames: keys are read between them.
-        teach.advance(teach::CALLS_PER_FRAME);
+        teach.advance(CALLS_PER_FRAME);
         terminal
             .draw(|frame| teach_view::draw(frame, &teach, help, theme))
             .context("drawing teach mode")?;
@@ -291,21 +291,60 @@ mod tests {
     fn the_state_modules_import_no_view() {
         let state = [
             ("dashboard.rs", include_str!("dashboard.rs")),
-            ("teach.rs", include_str!("teach.rs")),
-            ("knobs.rs", include_str!("knobs.rs")),
             ("reference.rs", include_str!("reference.rs")),
             ("row_window.rs", include_str!("row_window.rs")),
             ("graph_layout.rs", include_str!("graph_layout.rs")),
-            ("labels.rs", include_str!("labels.rs")),
         ];
         for (file, text) in state {
-            for view in ["view", "teach_view", "graph_view", "step_line"] {
+            for view in ["dashboard_view", "teach_view", "graph_view", "screen"] {
                 for path in [format!("super::{view}"), format!("tui::{view}")] {
                     assert!(
                         !text.contains(&format!("{path}::")) && !text.contains(&format!("{path};")),
                         "{file} uses {path}"
                     );
                 }
+            }
+        }
+    }
+
+    /// The screens' views meet in one direction only: the dashboard's draws teach mode on
+    /// the live graph with teach mode's. Teach mode's panels, and what both views draw with,
+    /// name neither screen above them (`view.rs` and `teach_view.rs` once imported each
+    /// other).
+    #[test]
+    fn the_views_import_each_other_one_way() {
+        let below_the_dashboard = [
+            ("screen.rs", include_str!("screen.rs")),
+            ("graph_view.rs", include_str!("graph_view.rs")),
+            ("theme.rs", include_str!("theme.rs")),
+            ("teach_view/mod.rs", include_str!("teach_view/mod.rs")),
+            ("teach_view/call.rs", include_str!("teach_view/call.rs")),
+            ("teach_view/edits.rs", include_str!("teach_view/edits.rs")),
+            (
+                "teach_view/figures.rs",
+                include_str!("teach_view/figures.rs"),
+            ),
+            (
+                "teach_view/graph_panel.rs",
+                include_str!("teach_view/graph_panel.rs"),
+            ),
+            ("teach_view/help.rs", include_str!("teach_view/help.rs")),
+            ("teach_view/stack.rs", include_str!("teach_view/stack.rs")),
+            (
+                "teach_view/status_bar.rs",
+                include_str!("teach_view/status_bar.rs"),
+            ),
+            ("teach_view/trace.rs", include_str!("teach_view/trace.rs")),
+            ("teach_view/values.rs", include_str!("teach_view/values.rs")),
+        ];
+        for (file, text) in below_the_dashboard {
+            let mut above = vec!["dashboard_view"];
+            if !file.starts_with("teach_view/") {
+                above.push("teach_view");
+            }
+            for view in above {
+                assert!(!text.contains(&format!("{view}::")), "{file} uses {view}");
+                assert!(!text.contains(&format!("::{view};")), "{file} uses {view}");
             }
         }
     }

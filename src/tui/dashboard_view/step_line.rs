@@ -9,13 +9,13 @@
 
 use ratatui::text::{Line, Span};
 
-use super::dashboard::Dashboard;
-use super::theme::Theme;
 use crate::trainer::StepRecord;
+use crate::tui::dashboard::Dashboard;
+use crate::tui::theme::Theme;
 
 /// The step line of `dashboard`'s followed run in `width` columns (a waiting note before
 /// its first step). Parts that do not fit are left out whole; the most telling come first.
-pub fn step_line(dashboard: &Dashboard, width: u16, theme: Theme) -> Line<'static> {
+pub(super) fn step_line(dashboard: &Dashboard, width: u16, theme: Theme) -> Line<'static> {
     let Some(step) = &dashboard.last_step else {
         return Line::styled(" waiting for the first step…", theme.dim());
     };

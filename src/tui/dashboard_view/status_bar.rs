@@ -1,0 +1,137 @@
+//! The dashboard's bottom line: the mode, how fast training is let run and where the run
+//! is, and the keys of the mode.
+
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::style::Modifier;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::Paragraph;
+use ratatui::Frame;
+
+use super::figures::thousands;
+use crate::tui::dashboard::{Dashboard, Mode, SPEEDS};
+use crate::tui::theme::Theme;
+
+/// The bottom line: mode and figures on the left, the keys of the mode on the right
+/// (the figures give way first on a narrow terminal).
+pub(super) fn draw(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Theme) {
+    let (mode, hints) = match dashboard.mode {
+        Mode::Running => ("RUNNING", "space pause · t teach · ? keys · q quit"),
+        Mode::Paused => ("PAUSED", "space resume · n step · t teach · ? keys"),
+        Mode::Teach => (
+            "TEACH",
+            "a · s · r · u · c · 1–5 +/− edit · t back · ? keys",
+        ),
+    };
+    let run = dashboard.main_run();
+    let finished = run.is_some_and(|r| r.ended.is_some());
+    // The followed run failing is the one thing worth the whole line: its training went no
+    // further. A baseline's failure is a note beside the figures; the rest goes on.
+    let failure = run.and_then(|r| Some((&r.method, r.failed.as_ref()?)));
+    let other_failures: Vec<&str> = dashboard
+        .runs
+        .iter()
+        .skip(1)
+        .filter(|r| r.failed.is_some())
+        .map(|r| r.method.label())
+        .collect();
+    let hints = if failure.is_some() {
+        "q quit"
+    } else if let Some(notice) = dashboard.notice {
+        notice
+    } else if area.width < 100 {
+        "? keys · q quit"
+    } else if finished && dashboard.mode != Mode::Teach {
+        // Nothing left to pause or step; the graph can still be taught on.
+        "t teach · ? keys · q quit"
+    } else {
+        hints
+    };
+    let episode = run.map_or("-".to_string(), |r| {
+        // Run 0 goes without saying; another (`--follow-run`) is named, from 0 as in the
+        // results' files.
+        let which = match r.run {
+            0 => String::new(),
+            run => format!(" run {run}"),
+        };
+        // The episode being played, as the step line counts it: the next one once its
+        // first step came (the run counts the episodes that ended).
+        let playing = dashboard.last_step.as_ref().map_or(0, |s| s.episode);
+        format!(
+            "{}{which} ep {}/{}",
+            r.method,
+            r.episode.max(playing),
+            r.planned_episodes
+        )
+    });
+    // Paused, training makes no steps: the last rate measured would be stale.
+    let speed = match (dashboard.mode, dashboard.steps_per_second) {
+        (Mode::Teach, _) => Some("paused".to_string()),
+        _ if finished || dashboard.mode == Mode::Paused => None,
+        (_, Some(s)) => Some(format!("{s:.0} steps/s")),
+        (_, None) => Some("- steps/s".to_string()),
+    };
+    let throttle = match SPEEDS[dashboard.speed] {
+        d if d.is_zero() => "full speed".to_string(),
+        d => format!("{} ms/step", d.as_millis()),
+    };
+    let epsilon = run.map_or(0.0, |r| r.epsilon);
+    let figures = match failure {
+        Some((method, error)) => Line::from(vec![
+            Span::styled(" FAILED ", theme.stopped().add_modifier(Modifier::REVERSED)),
+            Span::raw(if error.contains(method.label()) {
+                format!(" {error}")
+            } else {
+                format!(" {method}: {error}")
+            }),
+        ]),
+        None => {
+            let mut spans = vec![Span::styled(
+                format!(" {} ", if finished { "DONE" } else { mode }),
+                theme.title().add_modifier(Modifier::REVERSED),
+            )];
+            // First, where a narrow terminal cannot cut it off; the error itself is
+            // printed when the dashboard closes.
+            for method in other_failures {
+                spans.push(Span::styled(format!(" {method} FAILED ·"), theme.stopped()));
+            }
+            // The state first: how fast training is let run, where the run is. What does
+            // not fit before the keys is dropped from the end, never cut mid-word; two
+            // spaces at least keep the last figure from reading into the keys.
+            let room = usize::from(area.width)
+                .saturating_sub(hints.chars().count() + 2)
+                .saturating_sub(spans.iter().map(|s| s.content.chars().count()).sum());
+            let figures = [
+                Some(throttle),
+                Some(episode),
+                Some(format!("step {}", thousands(dashboard.step))),
+                speed,
+                Some(format!("ε {epsilon:.2}")),
+                Some(dashboard.task.clone()),
+            ];
+            let mut text = String::new();
+            for figure in figures.into_iter().flatten() {
+                let next = if text.is_empty() {
+                    format!(" {figure}")
+                } else {
+                    format!(" · {figure}")
+                };
+                if text.chars().count() + next.chars().count() > room {
+                    break;
+                }
+                text.push_str(&next);
+            }
+            spans.push(Span::raw(text));
+            Line::from(spans)
+        }
+    };
+    let [left, right] = Layout::horizontal([
+        Constraint::Min(0),
+        Constraint::Length(hints.chars().count() as u16 + 1),
+    ])
+    .areas(area);
+    frame.render_widget(Paragraph::new(figures), left);
+    frame.render_widget(
+        Paragraph::new(Span::styled(hints, theme.dim())).right_aligned(),
+        right,
+    );
+}

@@ -1,0 +1,87 @@
+//! The edit panel: the knobs `1`…`5` (T_ω, 𝒜, τ, paths, an edge's weight M), the chosen
+//! one marked, and what the last turn changed, or why it was refused.
+
+use ratatui::style::Modifier;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Paragraph, Wrap};
+
+use super::figures::signed;
+use crate::teach::knobs::{EditReport, Knob};
+use crate::teach::Teach;
+use crate::tui::theme::Theme;
+
+/// The knobs (`1`…`5`, the chosen one marked), and the last edit's effect or the notice.
+pub(super) fn paragraph(teach: &Teach, theme: Theme) -> Paragraph<'static> {
+    let names = teach.names();
+    let edge = teach.selected_edge();
+    let mut knobs = Vec::new();
+    for knob in Knob::ALL {
+        let symbol = match (knob, edge) {
+            (Knob::EdgeWeight, Some((i, j))) => format!("M({},{})", names[i], names[j]),
+            _ => knob.symbol().to_string(),
+        };
+        let text = format!("{} {symbol} {}", knob.key(), knob.value(teach.net(), edge));
+        if !knobs.is_empty() {
+            knobs.push(Span::raw(" · "));
+        }
+        knobs.push(if knob == teach.knob() {
+            Span::styled(text, theme.title().add_modifier(Modifier::REVERSED))
+        } else {
+            Span::raw(text)
+        });
+    }
+    let mut lines = vec![Line::from(knobs)];
+    if let Some(notice) = teach.notice() {
+        lines.push(Line::styled(notice.to_string(), theme.stopped()));
+    } else if let Some(report) = teach.last_edit() {
+        lines.push(Line::from(edit_summary(report, names)));
+    }
+    Paragraph::new(lines)
+        .wrap(Wrap { trim: false })
+        .block(Block::bordered().title(Span::styled(
+            " edit (1–5 choose, +/− turn, e edge) ",
+            theme.title(),
+        )))
+}
+
+/// `T_ω 1 → 0.9: π1's walk 21 → 9 calls, restarted · at its end A moved most at π0
+/// (−0.83), P(π1) 0.45 → 0.52`.
+fn edit_summary(report: &EditReport, names: &[String]) -> String {
+    let what = match report.edge {
+        Some((i, j)) => format!("M({},{})", names[i], names[j]),
+        None => report.knob.symbol().to_string(),
+    };
+    let mut text = format!("{what} {} → {}", report.from, report.to);
+    let Some(policy) = report.policy else {
+        let (i, dp) = largest(&report.probability_change());
+        if dp != 0.0 {
+            text.push_str(&format!(": P({}) moved {}", names[i], signed(dp, 3)));
+        }
+        return text;
+    };
+    text.push_str(&format!(
+        ": {}'s walk {} → {} calls, restarted",
+        names[policy], report.calls.0, report.calls.1
+    ));
+    let (i, da) = largest(&report.activation_change());
+    if da != 0.0 {
+        text.push_str(&format!(" · at its end A[{}] {}", names[i], signed(da, 4)));
+    }
+    let (j, dp) = largest(&report.probability_change());
+    if dp != 0.0 {
+        text.push_str(&format!(", P({}) {}", names[j], signed(dp, 3)));
+    }
+    text
+}
+
+/// The index and value of the change largest in size.
+fn largest(changes: &[f64]) -> (usize, f64) {
+    changes
+        .iter()
+        .copied()
+        .enumerate()
+        .fold(
+            (0, 0.0),
+            |best, (i, x)| if x.abs() > best.1.abs() { (i, x) } else { best },
+        )
+}
