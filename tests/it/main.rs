@@ -23,6 +23,7 @@ mod headless_cli;
 mod hostile_folders;
 mod import_cli;
 mod judgment_signals;
+mod layers;
 mod other_agents;
 mod pinned_numbers;
 mod pool_cli;
