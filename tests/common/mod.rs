@@ -1,11 +1,8 @@
-// Each test binary (and the render bench) uses a part of the script.
-#[allow(dead_code)]
+//! Helpers shared by the tests of `tests/it/` (and, for `tui_script.rs`, by the render
+//! bench, which includes that file by path: so this folder stays beside `it/`).
+
 pub mod library;
-#[allow(dead_code)]
 pub mod python;
-#[allow(dead_code)]
 pub mod signal;
-#[allow(dead_code)]
 pub mod tmux;
-#[allow(dead_code)]
 pub mod tui_script;

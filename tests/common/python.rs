@@ -23,10 +23,9 @@ pub fn with_gymnasium() -> Option<PathBuf> {
 }
 
 /// The Python with Gymnasium, or the test returns, saying it is skipped.
-#[macro_export]
 macro_rules! python_or_skip {
     () => {
-        match common::python::with_gymnasium() {
+        match $crate::common::python::with_gymnasium() {
             Some(p) => p,
             None => {
                 eprintln!("no Python with Gymnasium (SAPNET_TEST_PYTHON): skipped");
@@ -35,3 +34,6 @@ macro_rules! python_or_skip {
         }
     };
 }
+
+// Imported by path (`use crate::common::python::python_or_skip;`) as any item is.
+pub(crate) use python_or_skip;

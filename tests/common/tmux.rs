@@ -14,7 +14,7 @@ pub struct Session(String);
 
 impl Session {
     pub fn start(width: u16, height: u16, command: &str) -> Self {
-        // One session per test, tests of this file running side by side.
+        // One session per test, the tests running side by side in one process.
         static SESSIONS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
         let k = SESSIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let name = format!("sapnet-e2e-{}-{k}", std::process::id());
@@ -56,7 +56,6 @@ impl Session {
 
     /// The pane's rows as the terminal shows them, its scrollback first, a wrapped line as
     /// two rows.
-    #[allow(dead_code)] // not every test binary that includes this module reads rows
     pub fn rows(&self) -> Vec<String> {
         let out = Command::new("tmux")
             .args(["capture-pane", "-p", "-S", "-", "-t", &self.0])
