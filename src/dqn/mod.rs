@@ -15,6 +15,7 @@ mod exploration;
 pub mod kernels;
 mod loss;
 mod optim;
+mod q_values;
 mod qnet;
 mod replay;
 mod scratch;

@@ -19,6 +19,7 @@ pub mod gymnasium;
 pub mod mapping;
 mod mountain_car;
 mod params;
+mod rules;
 
 pub use acrobot::Acrobot;
 pub use cartpole::CartPole;

@@ -7,6 +7,7 @@ use std::f64::consts::PI;
 use serde::{Deserialize, Serialize};
 
 use super::gymnasium::{known_task, GymnasiumParams, PythonSettings};
+use super::rules::Rules;
 
 /// Which environment a config runs, with its physics.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -304,60 +305,6 @@ fn value_text(value: &serde_json::Value) -> String {
         },
         serde_json::Value::String(s) => s.clone(),
         other => other.to_string(),
-    }
-}
-
-/// The first broken rule of one task's physics, located.
-pub(super) struct Rules<'a> {
-    field: &'a str,
-    task: &'a str,
-    broken: Option<String>,
-}
-
-impl<'a> Rules<'a> {
-    fn new(field: &'a str, task: &'a str) -> Self {
-        Self {
-            field,
-            task,
-            broken: None,
-        }
-    }
-
-    pub(super) fn holds(&mut self, name: &str, ok: bool, expected: &str) {
-        if !ok && self.broken.is_none() {
-            self.broken = Some(format!(
-                "field `{}.{name}` ({}): expected {expected}",
-                self.field, self.task
-            ));
-        }
-    }
-
-    fn finite(&mut self, name: &str, value: f64) {
-        self.holds(
-            name,
-            value.is_finite(),
-            &format!("a finite number, got {value:?}"),
-        );
-    }
-
-    fn positive(&mut self, name: &str, value: f64) {
-        self.holds(
-            name,
-            value > 0.0 && value.is_finite(),
-            &format!("a finite number > 0, got {value:?}"),
-        );
-    }
-
-    pub(super) fn time_limit(&mut self, steps: u32) {
-        self.holds(
-            "max_episode_steps",
-            steps >= 1,
-            "a time limit of at least 1 step, got 0",
-        );
-    }
-
-    fn result(self) -> Result<(), String> {
-        self.broken.map_or(Ok(()), Err)
     }
 }
 

@@ -2,7 +2,7 @@
 
 use rand::rngs::StdRng;
 
-use super::method::{MethodKind, ReuseMethod, Tested};
+use super::definition::{MethodKind, ReuseMethod, Tested};
 use super::{Actor, Learning, Library, ReuseError, Selector, SelectorView};
 use crate::sapnet::SapNetParams;
 

@@ -21,6 +21,7 @@
 //! of [`Method`] and its arm in [`Method::definition`]; the compiler points at the rest.
 
 pub mod best_source;
+mod definition;
 pub mod exclusion;
 pub mod from_scratch;
 mod method;
@@ -34,7 +35,8 @@ use std::fmt;
 
 use rand::rngs::StdRng;
 
-pub use method::{check_label, Method, MethodKind, ReuseMethod, Tested};
+pub use definition::{check_label, MethodKind, ReuseMethod, Tested};
+pub use method::Method;
 
 use crate::sapnet::{PolicyDescription, SapNetError, SapNetParams, TraceStep};
 

@@ -20,7 +20,7 @@ use rand::rngs::StdRng;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
-use super::method::{check_label, MethodKind, ReuseMethod, Tested};
+use super::definition::{check_label, MethodKind, ReuseMethod, Tested};
 use super::{Actor, EpisodeEnd, Learning, Library, ReuseError, Selector, SelectorView};
 use crate::ron_file::Got;
 use crate::sapnet::SapNetParams;

@@ -7,8 +7,8 @@
 use rand::rngs::StdRng;
 use serde::{Deserialize, Serialize};
 
+use super::definition::{check_label, MethodKind, ReuseMethod, Tested};
 use super::exclusion::{Exclusion, Exclusions};
-use super::method::{check_label, MethodKind, ReuseMethod, Tested};
 use super::parameter_schedule::Schedule;
 use super::{
     Activation, Actor, Deposit, EpisodeEnd, Feedback, Learning, Library, Needs, ReuseError,

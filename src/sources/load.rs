@@ -2,17 +2,16 @@
 //! trained first where that is allowed; and each source tested on the target.
 
 use std::path::{Path, PathBuf};
-use std::sync::mpsc::Receiver;
 
 use anyhow::{bail, Context, Result};
 
 use super::manifest::{self, LibraryTraining};
-use super::{library_dir, plan, policy_files, train_library, InterTaskMapping, SourceTask, Spaces};
+use super::{library_dir, plan, policy_files, InterTaskMapping, SourceTask, Spaces};
 use crate::config::Config;
 use crate::policy_store;
 use crate::sapnet::PolicyDescription;
 use crate::seeds;
-use crate::trainer::{Command, SourcePolicy};
+use crate::trainer::SourcePolicy;
 
 /// A source tested on the target task.
 #[derive(Debug, Clone, PartialEq)]
@@ -293,38 +292,4 @@ pub fn needs_training(config: &Config, library: &Path) -> Result<bool> {
         Some(found) => !found.complete,
         None => policy_files(&dir)?.is_empty(),
     })
-}
-
-/// The library of `config`, trained first (or its training finished) if `root` allows it
-/// and `<library>/<task>/` holds none or an unfinished one, with progress on stderr
-/// (`stop` ends it), then loaded.
-pub fn ensure_library(
-    config: &Config,
-    root: &LibraryRoot,
-    stop: &Receiver<Command>,
-) -> Result<Vec<SourcePolicy>> {
-    let dir = library_dir(&root.path, config);
-    if needs_training(config, &root.path)? {
-        let state = if dir.exists() {
-            "an unfinished source library"
-        } else {
-            "no source library"
-        };
-        if !root.train_if_missing {
-            bail!(
-                "{state} in {}: train it with `sapnet sources --config <FILE> --library {}`, \
-                 or pass --train-library to train it before this run",
-                dir.display(),
-                root.path.display()
-            );
-        }
-        eprintln!(
-            "{state} in {}: training {} source policies first ({} episodes each)",
-            dir.display(),
-            config.sources.count,
-            config.sources.training_episodes
-        );
-        train_library(config, &root.path, false, stop)?;
-    }
-    load_library(config, &root.path)
 }

@@ -28,9 +28,9 @@ mod train;
 
 pub use crate::env::mapping::{check_fit, native_spaces, InterTaskMapping, Spaces};
 pub use import::{import, Imported};
-pub use load::{ensure_library, evaluate, load_library, needs_training, Evaluation, LibraryRoot};
+pub use load::{evaluate, load_library, needs_training, Evaluation, LibraryRoot};
 pub use manifest::{LibraryTraining, Manifest, ManifestEntry};
-pub use train::train_library;
+pub use train::{ensure_library, train_library};
 
 /// Stream key of the source library's plan ([`seeds::library_v1`]), which no experiment uses.
 pub(crate) const SOURCES_STREAM: u64 = u64::MAX;

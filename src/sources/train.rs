@@ -7,11 +7,47 @@ use std::sync::mpsc::Receiver;
 use anyhow::{bail, Context, Result};
 
 use super::manifest::{self, LibraryTraining, Manifest, ManifestEntry};
-use super::{library_dir, plan, policy_files, tasks, SourcePlan};
+use super::{
+    library_dir, load_library, needs_training, plan, policy_files, tasks, LibraryRoot, SourcePlan,
+};
 use crate::config::Config;
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::trainer::{schedule, Observer};
-use crate::trainer::{Command, Event, RunOutcome, RunSpec, TrainerError};
+use crate::trainer::{Command, Event, RunOutcome, RunSpec, SourcePolicy, TrainerError};
+
+/// The library of `config`, trained first (or its training finished) if `root` allows it
+/// and `<library>/<task>/` holds none or an unfinished one, with progress on stderr
+/// (`stop` ends it), then loaded.
+pub fn ensure_library(
+    config: &Config,
+    root: &LibraryRoot,
+    stop: &Receiver<Command>,
+) -> Result<Vec<SourcePolicy>> {
+    let dir = library_dir(&root.path, config);
+    if needs_training(config, &root.path)? {
+        let state = if dir.exists() {
+            "an unfinished source library"
+        } else {
+            "no source library"
+        };
+        if !root.train_if_missing {
+            bail!(
+                "{state} in {}: train it with `sapnet sources --config <FILE> --library {}`, \
+                 or pass --train-library to train it before this run",
+                dir.display(),
+                root.path.display()
+            );
+        }
+        eprintln!(
+            "{state} in {}: training {} source policies first ({} episodes each)",
+            dir.display(),
+            config.sources.count,
+            config.sources.training_episodes
+        );
+        train_library(config, &root.path, false, stop)?;
+    }
+    load_library(config, &root.path)
+}
 
 /// Trains the library `config` describes into `<library>/<source task>/`, one policy at a
 /// time, each on disk (and in the manifest) as soon as it is trained: a stop or a kill

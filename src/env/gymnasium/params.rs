@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::super::params::Rules;
+use crate::env::rules::Rules;
 
 /// A Gymnasium task: `Gymnasium(id: "LunarLander-v3", kwargs: {"gravity": -8.0})`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
