@@ -11,13 +11,12 @@ use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, SourcesCommand, SweepComman
 use crate::config::Config;
 use crate::experiment;
 use crate::headless::{self, OutputOptions, RunOptions};
+use crate::results;
 use crate::ron_file::{parse_ron, ConfigError};
 use crate::teach::config::TeachConfig;
 use crate::teach::Teach;
-use crate::trainer::{RunSpec, StreamOptions};
 use crate::tui;
 use crate::{assets, env, random_episodes, trainer};
-use crate::{report, results};
 
 pub fn run(cli: Cli) -> Result<()> {
     if let Some(command) = &cli.command {
@@ -50,7 +49,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 "{} made again: comparison.csv, improvement.csv, scores.csv, intervals.png, profiles.png, improvement.png, learning_curve.png, tests.png, activations.png, selections.png",
                 args.dir.display()
             );
-            print_comparison(&summary)
+            headless::print_comparison(&summary)
         }
         None => run_experiment(&cli),
     }
@@ -277,7 +276,7 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     let options = run_options(cli);
     let summary = headless::run(&config, &output, &options, &on_interrupt()?)
         .map_err(|error| in_config_file(error, cli))?;
-    report(&summary, &output.dir)
+    headless::print_summary(&summary, &output.dir)
 }
 
 /// Names the config's file in an error one of its fields caused (a field only the library
@@ -310,7 +309,7 @@ fn resume_experiment(cli: &Cli) -> Result<()> {
         &run_options(cli),
         &on_interrupt()?,
     )?;
-    report(&summary, dir)
+    headless::print_summary(&summary, dir)
 }
 
 fn run_options(cli: &Cli) -> RunOptions {
@@ -324,143 +323,23 @@ fn run_options(cli: &Cli) -> RunOptions {
     }
 }
 
-/// What a headless protocol did: where its files are, each run on stderr, the comparison
-/// on stdout.
-fn report(summary: &results::Summary, dir: &Path) -> Result<()> {
-    let config = &summary.config;
-    let dir = dir.display();
-    if summary.stopped() {
-        eprintln!("stopped by the user: what was done so far is in {dir} (episodes.csv, tests.csv, summary.json, plots); `sapnet --headless --resume --out {dir}` finishes it");
-    } else {
-        eprintln!("results in {dir}: episodes.csv, tests.csv, activations.csv, comparison.csv, improvement.csv, scores.csv, summary.json, runs/, policies/, intervals.png, profiles.png, improvement.png, learning_curve.png, tests.png, activations.png, selections.png (the plots also as .svg)");
-    }
-    for run in &summary.runs {
-        let tests: Vec<String> = run
-            .record
-            .test_returns
-            .iter()
-            .map(|r| format!("{r:.0}"))
-            .collect();
-        eprintln!(
-            "{} run {}: {} episodes, best MA{} {}, greedy tests [{}]",
-            run.record.method,
-            run.record.run,
-            run.record.episodes,
-            config.protocol.moving_average,
-            run.best_moving_average
-                .map_or("-".into(), |a| format!("{a:.1}")),
-            tests.join(", ")
-        );
-        if let Some(chosen) = &run.record.chosen {
-            eprintln!(
-                "  chosen policy {} {:?} ({} {:.2})",
-                chosen.name, chosen.hidden, chosen.score_name, chosen.score
-            );
-        }
-        if let Some(copy) = &run.library_copy {
-            eprintln!("  added to the policy library as {}", copy.display());
-        }
-    }
-    print_comparison(summary)
-}
-
-/// The comparison table of a protocol, on stdout.
-fn print_comparison(summary: &results::Summary) -> Result<()> {
-    let mut table = if summary.comparison.is_empty() {
-        String::new()
-    } else {
-        report::comparison::table(&summary.comparison, report::Units::Returns)
-    };
-    let stopped: Vec<String> = summary
-        .runs
-        .iter()
-        .filter(|r| r.record.stopped)
-        .map(|r| {
-            format!(
-                "{} run {} at episode {}/{}",
-                r.record.method.label(),
-                r.record.run,
-                r.record.episodes,
-                summary.config.protocol.episodes
-            )
-        })
-        .collect();
-    if !stopped.is_empty() {
-        table.push_str(&format!(
-            "not in the table, stopped before their end: {}\n",
-            stopped.join(", ")
-        ));
-    }
-    if table.is_empty() {
-        return Ok(());
-    }
-    let mut out = std::io::stdout().lock();
-    write!(out, "{table}")
-        .and_then(|()| out.flush())
-        .context("writing to stdout")
-}
-
-/// The bands of a finished protocol's methods (`--compare DIR`), from its episodes.csv;
-/// refused when that protocol trained on another task than `task`, the dashboard's (its
-/// returns would be drawn on the wrong scale).
-fn reference_bands(dir: &Path, task: &str) -> Result<Vec<tui::reference::Band>> {
-    let data = results::read_plot_data(dir).with_context(|| {
-        format!(
-            "--compare {}: expected the output folder of a `sapnet --headless` run",
-            dir.display()
-        )
-    })?;
-    anyhow::ensure!(
-        data.task == task,
-        "--compare {}: its results are on {}, the dashboard trains on {task}: compare with a \
-         protocol on the same task",
-        dir.display(),
-        data.task
-    );
-    Ok(data
-        .curves
-        .iter()
-        .map(|c| tui::reference::Band::from_runs(&c.label, &c.returns, data.window))
-        .collect())
-}
-
 /// The dashboard follows one run (`--follow-run`, else run 0) of one reusing method
 /// (`--follow`, else the first SAP-Net method, else the first that reuses; `m` moves to the
 /// next), step by step, beside the same run of the first DQN baseline, episode by episode;
 /// the library is loaded (or trained, with a progress bar) before the screen switches.
 fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
     let ids = crate::trainer::MethodId::all(&config.protocol.methods);
-    let followed = match &cli.run.follow {
-        Some(label) => {
-            let Some(id) = ids.iter().find(|m| m.label() == label.as_str()) else {
-                let labels: Vec<&str> = ids.iter().map(|m| m.label()).collect();
-                anyhow::bail!(
-                    "--follow {label}: the config has no such method; its methods are {}",
-                    labels.join(", ")
-                );
-            };
-            anyhow::ensure!(
-                id.kind.reuses,
-                "--follow {label}: the dashboard follows a method that reuses the library; \
-                 the DQN baseline runs beside it anyway"
-            );
-            Some(id.clone())
-        }
-        None => ids
-            .iter()
-            .find(|m| m.kind.spreads)
-            .or_else(|| ids.iter().find(|m| m.kind.reuses))
-            .cloned(),
-    };
+    let followed = tui::follow::followed_method(&ids, cli.run.follow.as_deref())?;
     // Read before training starts, so that a wrong folder is said at once.
     let reference = match &cli.run.compare {
-        Some(dir) => reference_bands(dir, &config.env.gym_id())?,
+        Some(dir) => tui::reference::bands_of_folder(dir, &config.env.gym_id())?,
         None => Vec::new(),
     };
     // The followed run and the DQN baseline train side by side.
     let plan = experiment::plan(config, &cli.run.library_root(), 2, &on_interrupt()?)
         .map_err(|error| in_config_file(error, cli))?;
-    let (followable, baseline) = dashboard_specs(&plan.specs, cli.run.follow_run.unwrap_or(0))?;
+    let (followable, baseline) =
+        tui::follow::dashboard_specs(&plan.specs, cli.run.follow_run.unwrap_or(0))?;
     let first = followable
         .iter()
         .position(|s| Some(&s.method) == followed.as_ref())
@@ -480,32 +359,6 @@ fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
          protocol's results"
     );
     Ok(())
-}
-
-/// Run `run` (`--follow-run`, from 0 as in the results' files) of every reusing method,
-/// streaming every step, and of the first DQN baseline: what the dashboard can train.
-fn dashboard_specs(specs: &[RunSpec], run: u32) -> Result<(Vec<RunSpec>, Option<RunSpec>)> {
-    let runs = specs.iter().map(|s| s.run + 1).max().unwrap_or(0);
-    anyhow::ensure!(
-        run < runs,
-        "--follow-run {run}: expected a run from 0 to {} (the config's {runs} runs per method, \
-         numbered from 0 as in the results' files)",
-        runs.saturating_sub(1)
-    );
-    let followable = specs
-        .iter()
-        .filter(|s| s.run == run && s.method.kind.reuses)
-        .map(|s| {
-            let mut spec = s.clone();
-            spec.stream = StreamOptions::live();
-            spec
-        })
-        .collect();
-    let baseline = specs
-        .iter()
-        .find(|s| s.run == run && !s.method.kind.reuses)
-        .cloned();
-    Ok((followable, baseline))
 }
 
 fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
@@ -712,34 +565,6 @@ fn default_out_dir(config: Option<&Path>) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dqn::DqnConfig;
-    use crate::env::EnvConfig;
-
-    /// Two runs of a reusing method and of a DQN baseline, as a plan lists them.
-    fn specs() -> Vec<RunSpec> {
-        let spec = |run, label: &str, kind| {
-            let mut s = RunSpec::scratch(
-                run,
-                label,
-                EnvConfig::CartPole(Default::default()),
-                DqnConfig::default(),
-                vec![4],
-                10,
-                1,
-                u64::from(run) + 7,
-            );
-            s.method.kind = kind;
-            s
-        };
-        (0..2)
-            .flat_map(|run| {
-                [
-                    spec(run, "sapnet", crate::reuse::sapnet::KIND),
-                    spec(run, "dqn[4]", crate::reuse::from_scratch::KIND),
-                ]
-            })
-            .collect()
-    }
 
     #[test]
     fn a_lesson_given_as_a_training_config_is_named_as_such() {
@@ -751,25 +576,5 @@ mod tests {
             err.contains("fig2.ron: this is a lesson, for `sapnet teach --config`"),
             "{err}"
         );
-    }
-
-    #[test]
-    fn the_dashboard_trains_the_run_asked_for() {
-        let (followable, baseline) = dashboard_specs(&specs(), 1).unwrap();
-        assert_eq!(followable.len(), 1);
-        assert_eq!((followable[0].run, followable[0].seed), (1, 8));
-        assert_eq!(followable[0].stream, StreamOptions::live());
-        assert_eq!(baseline.map(|b| (b.run, b.seed)), Some((1, 8)));
-        let (first, _) = dashboard_specs(&specs(), 0).unwrap();
-        assert_eq!(first[0].run, 0);
-    }
-
-    #[test]
-    fn a_run_the_config_does_not_have_is_refused_with_the_range() {
-        for run in [2, 3] {
-            let err = dashboard_specs(&specs(), run).unwrap_err().to_string();
-            assert!(err.contains(&format!("--follow-run {run}")), "{err}");
-            assert!(err.contains("from 0 to 1"), "{err}");
-        }
     }
 }

@@ -33,6 +33,9 @@
 
 mod observer;
 mod output;
+mod summary;
+
+pub use summary::{print_comparison, print_summary};
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::Receiver;

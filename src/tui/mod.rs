@@ -20,6 +20,7 @@
 
 pub mod dashboard;
 pub mod dashboard_view;
+pub mod follow;
 pub mod graph_layout;
 pub mod graph_view;
 pub mod reference;
@@ -290,7 +291,17 @@ mod tests {
     #[test]
     fn the_state_modules_import_no_view() {
         let state = [
-            ("dashboard.rs", include_str!("dashboard.rs")),
+            ("dashboard/mod.rs", include_str!("dashboard/mod.rs")),
+            ("dashboard/keys.rs", include_str!("dashboard/keys.rs")),
+            (
+                "dashboard/live_curve.rs",
+                include_str!("dashboard/live_curve.rs"),
+            ),
+            (
+                "dashboard/run_views.rs",
+                include_str!("dashboard/run_views.rs"),
+            ),
+            ("follow.rs", include_str!("follow.rs")),
             ("reference.rs", include_str!("reference.rs")),
             ("row_window.rs", include_str!("row_window.rs")),
             ("graph_layout.rs", include_str!("graph_layout.rs")),

@@ -2,6 +2,11 @@
 //! average of its runs' returns, their mean and the 95% bootstrap interval of that mean,
 //! drawn under the live curves of the same method.
 
+use std::path::Path;
+
+use anyhow::{Context, Result};
+
+use crate::results;
 use crate::seeds::{self, Part};
 use crate::stats::{aggregate, bootstrap, Scores};
 
@@ -69,6 +74,30 @@ impl Band {
         }
         band
     }
+}
+
+/// The bands of a finished protocol's methods (`--compare DIR`), from its episodes.csv;
+/// refused when that protocol trained on another task than `task`, the dashboard's (its
+/// returns would be drawn on the wrong scale).
+pub fn bands_of_folder(dir: &Path, task: &str) -> Result<Vec<Band>> {
+    let data = results::read_plot_data(dir).with_context(|| {
+        format!(
+            "--compare {}: expected the output folder of a `sapnet --headless` run",
+            dir.display()
+        )
+    })?;
+    anyhow::ensure!(
+        data.task == task,
+        "--compare {}: its results are on {}, the dashboard trains on {task}: compare with a \
+         protocol on the same task",
+        dir.display(),
+        data.task
+    );
+    Ok(data
+        .curves
+        .iter()
+        .map(|c| Band::from_runs(&c.label, &c.returns, data.window))
+        .collect())
 }
 
 #[cfg(test)]

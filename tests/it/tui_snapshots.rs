@@ -107,7 +107,7 @@ fn an_excluded_category_is_shown_on_the_graph_and_in_teach() {
     };
     snapshot.excluded = excluded.clone();
     d.on_event(Event::Activations(snapshot));
-    assert_eq!(d.sapnet.as_ref().unwrap().excluded, excluded);
+    assert_eq!(d.library.as_ref().unwrap().excluded, excluded);
     for size in SIZES {
         let terminal = draw_dashboard(&d, size);
         let screen = format!("{}", terminal.backend());

@@ -31,7 +31,7 @@ fn events_fill_the_table_the_curves_and_the_status() {
     let d = scripted(30);
     let methods: Vec<&str> = d.runs.iter().map(|r| r.method.label()).collect();
     assert_eq!(methods, ["sapnet", "dqn[100]"]);
-    let view = d.sapnet.as_ref().unwrap();
+    let view = d.library.as_ref().unwrap();
     assert_eq!(view.acting, Some(6));
     assert_eq!(view.net.chosen(), 6);
     assert!((view.probabilities.iter().sum::<f64>() - 1.0).abs() < 1e-9);
@@ -116,7 +116,7 @@ fn arrows_and_hjkl_move_the_cursor_around_and_tab_the_focus() {
 fn in_the_graph_arrows_move_to_the_nearest_node_that_way() {
     let mut d = scripted(1);
     d.on_key(KeyEvent::new(KeyCode::Tab, KeyModifiers::NONE));
-    let view = d.sapnet.as_ref().unwrap();
+    let view = d.library.as_ref().unwrap();
     let positions = graph_layout::positions(view.policies.len(), Some(&view.categories()));
     let start = d.cursor;
     d.on_key(key('j'));
@@ -145,7 +145,7 @@ fn z_enlarges_the_focused_panel_and_a_click_picks_a_row_or_a_node() {
     sapnet::tui::click(&mut d, screen, layout.table.x + 3, layout.table.y + 4);
     assert_eq!((d.cursor, d.focus), (2, Focus::Table));
     // A click on a node of the graph picks it and focuses the graph.
-    let view_state = d.sapnet.as_ref().unwrap();
+    let view_state = d.library.as_ref().unwrap();
     let positions =
         graph_layout::positions(view_state.policies.len(), Some(&view_state.categories()));
     let target = 7;
@@ -173,7 +173,7 @@ fn z_enlarges_the_focused_panel_and_a_click_picks_a_row_or_a_node() {
 #[test]
 fn teach_mode_pauses_steps_a_copy_and_leaves_training_untouched() {
     let mut d = scripted(10);
-    let live = d.sapnet.as_ref().unwrap().net.activations().to_vec();
+    let live = d.library.as_ref().unwrap().net.activations().to_vec();
     d.on_key(key('j'));
     assert_eq!(d.on_key(key('t')), Action::SendAll(Command::Pause));
     assert_eq!(d.mode, Mode::Teach);
@@ -189,7 +189,7 @@ fn teach_mode_pauses_steps_a_copy_and_leaves_training_untouched() {
     assert_eq!(d.mode, Mode::Paused);
     assert!(d.teach.is_none());
     assert_eq!(
-        d.sapnet.as_ref().unwrap().net.activations(),
+        d.library.as_ref().unwrap().net.activations(),
         live.as_slice()
     );
 }
@@ -274,7 +274,7 @@ fn m_follows_the_next_method_and_late_events_of_the_old_one_are_left_out() {
     assert_eq!(d.on_key(key('m')), Action::FollowNext);
     // The UI stops SAP-Net's run and starts UCB1's: the old run leaves the screen.
     d.follow("ucb1");
-    assert!(d.sapnet.is_none());
+    assert!(d.library.is_none());
     let methods: Vec<&str> = d.runs.iter().map(|r| r.method.label()).collect();
     assert_eq!(methods, ["dqn[100]"]);
     // SAP-Net's late events change nothing.
@@ -282,7 +282,7 @@ fn m_follows_the_next_method_and_late_events_of_the_old_one_are_left_out() {
         d.on_event(event);
     }
     d.on_event(tui_script::sapnet_start());
-    assert!(d.sapnet.is_none());
+    assert!(d.library.is_none());
     assert_eq!(d.runs.len(), 1);
     // UCB1's start takes the followed place, under its own scores.
     let mut start = tui_script::sapnet_start();
@@ -291,7 +291,7 @@ fn m_follows_the_next_method_and_late_events_of_the_old_one_are_left_out() {
         sapnet.as_mut().unwrap().score_name = "mean";
     }
     d.on_event(start);
-    let view = d.sapnet.as_ref().unwrap();
+    let view = d.library.as_ref().unwrap();
     assert_eq!((view.method.as_str(), view.score_name), ("ucb1", "mean"));
     assert_eq!(d.runs[0].method.label(), "ucb1");
     // A paused dashboard starts the new run paused, at its speed.
@@ -325,7 +325,7 @@ fn lock_in_is_dated_from_the_first_snapshot_above_the_threshold() {
         probabilities[top] = p;
         tui_script::probabilities_at(tui_script::method("sapnet"), step, probabilities)
     };
-    let locked = |d: &Dashboard| d.sapnet.as_ref().unwrap().locked;
+    let locked = |d: &Dashboard| d.library.as_ref().unwrap().locked;
     d.on_event(snapshot(5, 6, 0.9));
     assert_eq!(locked(&d), None);
     d.on_event(snapshot(10, 6, 0.995));
@@ -354,7 +354,7 @@ fn a_method_that_picks_by_rule_never_shows_a_lock_in() {
     let mut probabilities = vec![0.0; n];
     probabilities[2] = 1.0;
     d.on_event(tui_script::probabilities_at(ucb1, 102_244, probabilities));
-    assert_eq!(d.sapnet.as_ref().unwrap().locked, None);
+    assert_eq!(d.library.as_ref().unwrap().locked, None);
 }
 
 /// Issue 27: plain `sapnet` showed "P(source-6) > 0.99 since step" 645, 640 or 624 from
@@ -405,7 +405,7 @@ fn the_dashboard_shows_the_lock_in_step_the_headless_run_records() {
         .lock_in_step
         .expect("SAP-Net locks in within 40 episodes");
     assert_eq!(shown.lock_in_step, Some(step));
-    let (_, since) = live.sapnet.as_ref().unwrap().locked.expect("shown locked");
+    let (_, since) = live.library.as_ref().unwrap().locked.expect("shown locked");
     assert_eq!(since, step);
     assert_eq!(
         shown.chosen.map(|c| c.name),

@@ -5,13 +5,13 @@ use ratatui::layout::Rect;
 use ratatui::widgets::Block;
 use ratatui::Frame;
 
-use crate::tui::dashboard::{Dashboard, SapNetView};
+use crate::tui::dashboard::{Dashboard, LibraryView};
 use crate::tui::graph_view::{self, Scene};
 use crate::tui::theme::Theme;
 
 /// "SAP-Net graph", or for another method the scores it keeps; the categories left out of
 /// the candidates counted.
-pub(super) fn title(view: &SapNetView) -> String {
+pub(super) fn title(view: &LibraryView) -> String {
     let mut title = if view.score_name == "A" {
         "SAP-Net graph".to_string()
     } else {
@@ -29,7 +29,7 @@ pub(super) fn draw(
     frame: &mut Frame,
     area: Rect,
     block: Block,
-    view: &SapNetView,
+    view: &LibraryView,
     dashboard: &Dashboard,
     theme: Theme,
 ) {

@@ -64,7 +64,7 @@ pub fn clicked(dashboard: &Dashboard, area: Rect, column: u16, row: u16) -> Opti
         let teach = dashboard.teach.as_ref()?;
         return teach_view::clicked(teach, area, column, row).map(Clicked::Teach);
     }
-    let view = dashboard.sapnet.as_ref()?;
+    let view = dashboard.library.as_ref()?;
     let layout = training_layout(area, dashboard.zoomed());
     let inside = |r: Rect| r.contains(Position::new(column, row));
     if inside(layout.table) {
@@ -132,7 +132,7 @@ fn draw_training(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
         Paragraph::new(step_line(dashboard, step.width, theme)),
         step,
     );
-    match &dashboard.sapnet {
+    match &dashboard.library {
         Some(view) => {
             if !graph.is_empty() {
                 let focused = dashboard.focus == Focus::Graph;

@@ -9,7 +9,7 @@ use ratatui::Frame;
 
 use super::figures::{count, format_activation, sparkline, thousands};
 use crate::teach::labels;
-use crate::tui::dashboard::{Dashboard, Mode, SapNetView, HISTORY};
+use crate::tui::dashboard::{Dashboard, LibraryView, Mode, HISTORY};
 use crate::tui::graph_view::{self, node_style};
 use crate::tui::row_window::RowWindow;
 use crate::tui::screen::probability_bar;
@@ -47,7 +47,11 @@ pub(super) fn title(dashboard: &Dashboard, width: u16) -> String {
             let mean = record.test_returns.iter().sum::<f64>() / record.test_returns.len() as f64;
             format!("policies · chosen {} · test mean {mean:.1}", chosen.name)
         }
-        None => match dashboard.sapnet.as_ref().and_then(|v| Some((v, v.locked?))) {
+        None => match dashboard
+            .library
+            .as_ref()
+            .and_then(|v| Some((v, v.locked?)))
+        {
             // The softmax has collapsed: say so, and since when if it fits.
             Some((view, (i, since))) => {
                 let name = &view.policies[i].name;
@@ -73,7 +77,7 @@ pub(super) fn title(dashboard: &Dashboard, width: u16) -> String {
 /// than the one seen, so the bottom border names it when it is hidden instead.
 pub(super) fn policy_rows(area: Rect, dashboard: &Dashboard) -> RowWindow {
     let (total, acting) = dashboard
-        .sapnet
+        .library
         .as_ref()
         .map_or((0, None), |v| (v.policies.len(), v.acting));
     // Below the top border and the header, above the bottom border.
@@ -93,7 +97,7 @@ pub(super) fn draw(
     frame: &mut Frame,
     area: Rect,
     block: Block,
-    view: &SapNetView,
+    view: &LibraryView,
     dashboard: &Dashboard,
     theme: Theme,
 ) {

@@ -21,7 +21,7 @@ pub(super) fn step_line(dashboard: &Dashboard, width: u16, theme: Theme) -> Line
     };
     let name = |i: usize| {
         dashboard
-            .sapnet
+            .library
             .as_ref()
             .and_then(|v| v.policies.get(i))
             .map_or_else(|| format!("source {i}"), |p| p.name.clone())
