@@ -10,7 +10,7 @@ mod tui_script;
 use criterion::{criterion_group, criterion_main, Criterion};
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
-use sapnet::teach::config::TeachConfig;
+use sapnet::teach::lesson::TeachConfig;
 use sapnet::teach::Teach;
 use sapnet::tui::dashboard::Dashboard;
 use sapnet::tui::theme::Theme;

@@ -13,10 +13,10 @@ use crate::experiment;
 use crate::headless::{self, OutputOptions, RunOptions};
 use crate::results;
 use crate::ron_file::{parse_ron, ConfigError};
-use crate::teach::config::TeachConfig;
+use crate::teach::lesson::TeachConfig;
 use crate::teach::Teach;
 use crate::tui;
-use crate::{assets, env, random_episodes, trainer};
+use crate::{assets, env, env_command, trainer};
 
 pub fn run(cli: Cli) -> Result<()> {
     if let Some(command) = &cli.command {
@@ -192,9 +192,9 @@ fn origin(cli: &Cli, label: &str) -> String {
 fn run_env(cli: &Cli, args: &EnvArgs) -> Result<()> {
     let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
     let mut env = env::make(&config.env)?;
-    let episodes = random_episodes::run(env.as_mut(), args.episodes, config.seed)?;
+    let episodes = env_command::run(env.as_mut(), args.episodes, config.seed)?;
     let mut out = std::io::stdout().lock();
-    random_episodes::print(&mut out, env.id(), &episodes)
+    env_command::print(&mut out, env.id(), &episodes)
         .and_then(|()| out.flush())
         .context("writing to stdout")
 }

@@ -6,7 +6,7 @@
 //!   activation and spreading. Pure maths.
 //! - [`env`](mod@env): native CartPole, MountainCar and Acrobot, with Gymnasium's dynamics
 //!   to the bit.
-//! - [`dqn`]: the DQN on candle; [`policy_store`]: policies on disk; [`import`](mod@import):
+//! - [`dqn`]: the DQN on candle; [`policy_store`]: policies on disk; [`checkpoints`]:
 //!   Q-networks trained elsewhere (Stable-Baselines3, PyTorch, safetensors) read as ours.
 //! - [`trainer`]: training runs on their own thread, reporting through events;
 //!   [`experiment`]: planning and scheduling a protocol's runs.
@@ -22,20 +22,20 @@
 
 pub mod app;
 pub mod assets;
+pub mod checkpoints;
 pub mod cli;
 pub mod config;
 pub mod dqn;
 pub mod env;
+pub mod env_command;
 pub mod experiment;
 pub mod failpoint;
 pub mod folder_lock;
 pub mod headless;
-pub mod import;
 pub mod limits;
 pub mod outside_runs;
 pub mod policy_store;
 pub mod progress;
-pub mod random_episodes;
 pub mod report;
 pub mod results;
 pub mod reuse;

@@ -1,4 +1,4 @@
-//! `sapnet sources import`: a policy trained elsewhere ([`crate::import`]) added to a
+//! `sapnet sources import`: a policy trained elsewhere ([`crate::checkpoints`]) added to a
 //! finished library, written as every library policy is and listed in the manifest's
 //! `imported`, so that every run, comparison, screen and sweep reuses it as a source.
 
@@ -9,9 +9,9 @@ use anyhow::{bail, Context, Result};
 
 use super::manifest::{self, ManifestEntry};
 use super::{library_dir, policy_files, source_task};
+use crate::checkpoints::{self, Origin, Spaces};
 use crate::config::Config;
 use crate::dqn::Architecture;
-use crate::import::{self, Origin, Spaces};
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::seeds;
 
@@ -64,7 +64,7 @@ pub fn import(
         observation_size,
         action_count,
     };
-    let foreign = import::read(file, spaces, prefix)
+    let foreign = checkpoints::read(file, spaces, prefix)
         .map_err(|reason| anyhow::anyhow!("cannot import {}: {reason}", file.display()))?;
 
     if manifest::read(&dir)?.is_none() {

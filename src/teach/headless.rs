@@ -6,13 +6,13 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 
-use super::config::{Lesson, TeachConfig};
+use super::lesson::{Lesson, TeachConfig};
 use crate::cli::TeachArgs;
 use crate::sapnet::TraceStep;
 
 /// What `--json` prints: one object, nothing else.
 #[derive(Debug, Serialize)]
-struct Report<'a> {
+struct JsonTrace<'a> {
     activations: &'a [f64],
     probabilities: &'a [f64],
     trace: Vec<TraceStep>,
@@ -42,7 +42,7 @@ pub fn run(config: Option<&Path>, args: &TeachArgs, out: &mut impl Write) -> Res
     let probabilities = net.probabilities();
 
     if args.json {
-        let report = Report {
+        let report = JsonTrace {
             activations: net.activations(),
             probabilities: &probabilities,
             trace: per_activation.into_iter().flat_map(|(_, t)| t).collect(),

@@ -204,7 +204,7 @@ pub fn walk_end(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::teach::config::TeachConfig;
+    use crate::teach::lesson::TeachConfig;
 
     fn fig2() -> SapNet {
         TeachConfig::load(None).expect("embedded Fig. 2").net

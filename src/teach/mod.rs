@@ -11,13 +11,13 @@
 //!
 //! Nothing here draws: the terminal UI (`tui`) imports this module, never the reverse.
 
-pub mod config;
 pub mod headless;
 pub mod knobs;
 pub mod labels;
+pub mod lesson;
 pub mod session;
 
-pub use config::{Lesson, TeachConfig};
+pub use lesson::{Lesson, TeachConfig};
 pub use session::Teach;
 
 #[cfg(test)]
@@ -28,7 +28,7 @@ mod tests {
     fn teaching_imports_no_front_end() {
         let files = [
             ("mod.rs", include_str!("mod.rs")),
-            ("config.rs", include_str!("config.rs")),
+            ("lesson.rs", include_str!("lesson.rs")),
             ("headless.rs", include_str!("headless.rs")),
             ("knobs.rs", include_str!("knobs.rs")),
             ("labels.rs", include_str!("labels.rs")),

@@ -468,7 +468,7 @@ impl Teach {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::teach::config::TeachConfig;
+    use crate::teach::lesson::TeachConfig;
 
     fn fig2() -> Teach {
         let lesson = TeachConfig::load(None).expect("embedded Fig. 2");

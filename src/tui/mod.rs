@@ -78,7 +78,7 @@ fn open_terminal() -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
 }
 
 /// A run the dashboard drives: its commands, and the thread to join at the end.
-struct Driven {
+struct LiveRun {
     handle: RunHandle,
     /// Whether pause, step and speed go to this run (the followed reusing run, or the only
     /// one).
@@ -112,13 +112,13 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
     let mut dashboard = Dashboard::new(task);
     dashboard.reference = plan.reference.clone();
     let (events_tx, events) = mpsc::channel();
-    let mut runs: Vec<Driven> = Vec::new();
+    let mut runs: Vec<LiveRun> = Vec::new();
     let mut followed = plan.followed;
     if let Some(spec) = plan.followable.get(followed) {
         dashboard.follow(spec.method.label());
         let handle =
             trainer::spawn(spec.clone(), events_tx.clone()).context("starting a trainer thread")?;
-        runs.push(Driven {
+        runs.push(LiveRun {
             handle,
             leads: true,
         });
@@ -127,7 +127,7 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
         let handle =
             trainer::spawn(spec, events_tx.clone()).context("starting a trainer thread")?;
         let leads = runs.is_empty();
-        runs.push(Driven { handle, leads });
+        runs.push(LiveRun { handle, leads });
     }
     let (mut terminal, guard) = open_terminal()?;
     let result = (|| -> Result<()> {
@@ -187,7 +187,7 @@ pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
                     for command in dashboard.settings() {
                         let _ = handle.commands.send(command);
                     }
-                    runs.push(Driven {
+                    runs.push(LiveRun {
                         handle,
                         leads: true,
                     });

@@ -33,7 +33,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("the dispatch", &["app"]),
     (
         "front ends",
-        &["tui", "headless", "sweep", "teach", "random_episodes"],
+        &["tui", "headless", "sweep", "teach", "env_command"],
     ),
     ("the command line's arguments", &["cli"]),
     ("results folders", &["results"]),
@@ -49,7 +49,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("policy reuse", &["reuse"]),
     (
         "policies on disk and from elsewhere",
-        &["policy_store", "import"],
+        &["policy_store", "checkpoints"],
     ),
     ("the DQN", &["dqn"]),
     ("RON files", &["ron_file"]),

@@ -6,7 +6,7 @@ use crate::common::tui_script;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
-use sapnet::teach::config::TeachConfig;
+use sapnet::teach::lesson::TeachConfig;
 use sapnet::teach::Teach;
 use sapnet::trainer::Event;
 use sapnet::tui::dashboard::Dashboard;

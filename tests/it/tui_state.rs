@@ -5,7 +5,7 @@ use std::time::Duration;
 use crate::common::tui_script;
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::layout::Rect;
-use sapnet::teach::config::TeachConfig;
+use sapnet::teach::lesson::TeachConfig;
 use sapnet::teach::Teach;
 use sapnet::trainer::Command;
 use sapnet::tui::dashboard::{Action, Dashboard, Focus, Mode, CURVE_POINTS, SPEEDS};
