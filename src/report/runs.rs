@@ -100,23 +100,10 @@ mod tests {
 
     #[test]
     fn the_best_window_is_dated_by_its_last_episode() {
-        let record = RunRecord {
-            run: 0,
-            method: MethodId::new(0, &crate::reuse::Method::Dqn { hidden: vec![4] }),
-            seed: 0,
-            episodes: 5,
-            steps: 0,
-            updates: 0,
-            chosen: None,
-            source_steps: Vec::new(),
-            lock_in_step: None,
-            positive: Vec::new(),
-            negative: Vec::new(),
-            exclusions: 0,
-            test_returns: vec![10.0, 20.0],
-            stopped: false,
-            wall_s: 0.0,
-        };
+        let method = MethodId::new(0, &crate::reuse::Method::Dqn { hidden: vec![4] });
+        let mut record = RunRecord::new(0, method, 0);
+        record.episodes = 5;
+        record.test_returns = vec![10.0, 20.0];
         let s = RunSummary::new(record, &[1.0, 5.0, 3.0, 9.0, 1.0], 2);
         // windows: 3, 4, 6, 5 → best 6 over episodes 3–4.
         assert_eq!(s.best_moving_average, Some(6.0));

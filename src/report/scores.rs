@@ -72,23 +72,9 @@ mod tests {
     use crate::trainer::{MethodId, RunRecord};
 
     fn summary(tests: Vec<f64>) -> RunSummary {
-        let record = RunRecord {
-            run: 3,
-            method: MethodId::new(0, &Method::Ucb1),
-            seed: 0,
-            episodes: 6,
-            steps: 0,
-            updates: 0,
-            chosen: None,
-            source_steps: vec![],
-            lock_in_step: None,
-            positive: Vec::new(),
-            negative: Vec::new(),
-            exclusions: 0,
-            test_returns: tests,
-            stopped: false,
-            wall_s: 0.0,
-        };
+        let mut record = RunRecord::new(3, MethodId::new(0, &Method::Ucb1), 0);
+        record.episodes = 6;
+        record.test_returns = tests;
         RunSummary::new(record, &[], 2)
     }
 

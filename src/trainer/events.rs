@@ -147,26 +147,65 @@ pub struct RunRecord<M = MethodId> {
     pub wall_s: f64,
 }
 
+impl<M> RunRecord<M> {
+    /// The record of a run that has done nothing yet: the one place a record is made, so
+    /// that a field added to it gets its starting value here and nowhere else.
+    pub fn new(run: u32, method: M, seed: u64) -> Self {
+        RunRecord {
+            run,
+            method,
+            seed,
+            episodes: 0,
+            steps: 0,
+            updates: 0,
+            chosen: None,
+            source_steps: Vec::new(),
+            lock_in_step: None,
+            positive: Vec::new(),
+            negative: Vec::new(),
+            exclusions: 0,
+            test_returns: Vec::new(),
+            stopped: false,
+            wall_s: 0.0,
+        }
+    }
+}
+
 impl RunRecord<String> {
     /// The record read back from disk, its method known again by its id in the protocol.
-    pub fn with_method(self, method: MethodId) -> RunRecord {
-        RunRecord {
-            run: self.run,
-            method,
-            seed: self.seed,
-            episodes: self.episodes,
-            steps: self.steps,
-            updates: self.updates,
-            chosen: self.chosen,
-            source_steps: self.source_steps,
-            lock_in_step: self.lock_in_step,
-            positive: self.positive,
-            negative: self.negative,
-            exclusions: self.exclusions,
-            test_returns: self.test_returns,
-            stopped: self.stopped,
-            wall_s: self.wall_s,
-        }
+    pub fn with_method(self, method: MethodId) -> RunRecord<MethodId> {
+        // Every field named: one added to the record and not carried over does not compile.
+        let Self {
+            run,
+            method: _,
+            seed,
+            episodes,
+            steps,
+            updates,
+            chosen,
+            source_steps,
+            lock_in_step,
+            positive,
+            negative,
+            exclusions,
+            test_returns,
+            stopped,
+            wall_s,
+        } = self;
+        let mut record = RunRecord::new(run, method, seed);
+        record.episodes = episodes;
+        record.steps = steps;
+        record.updates = updates;
+        record.chosen = chosen;
+        record.source_steps = source_steps;
+        record.lock_in_step = lock_in_step;
+        record.positive = positive;
+        record.negative = negative;
+        record.exclusions = exclusions;
+        record.test_returns = test_returns;
+        record.stopped = stopped;
+        record.wall_s = wall_s;
+        record
     }
 }
 

@@ -7,9 +7,12 @@
 
 mod control;
 mod events;
+mod learners;
 pub mod memory;
 mod run;
+mod run_state;
 pub mod scheduler;
+mod spec;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};
@@ -20,8 +23,10 @@ pub use events::{
     ActivationSnapshot, ChosenPolicy, Command, Deposit, EpisodeRecord, Event, LockIn, MethodId,
     RunRecord, SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
 };
-pub use run::{selector, test_greedy, train, RunSpec, SourcePolicy, LOCK_IN};
+pub use run::train;
+pub use run_state::{test_greedy, LOCK_IN};
 pub use scheduler::{schedule, Observer};
+pub use spec::{selector, RunSpec, SourcePolicy};
 
 use crate::dqn::{DqnError, QNet};
 use crate::reuse::ReuseError;

@@ -159,29 +159,20 @@ fn episode_end(label: &str, episode: u32, reward: f64) -> Event {
 
 /// The end of SAP-Net's run after `episodes` episodes: source-6 chosen and tested.
 pub fn sapnet_end(episodes: u32) -> Event {
-    Event::RunEnded(RunRecord {
-        run: 0,
-        method: method("sapnet"),
-        seed: 1,
-        episodes,
-        steps: 6450,
-        updates: 5950,
-        chosen: Some(ChosenPolicy {
-            index: 6,
-            name: "source-6".into(),
-            hidden: HIDDEN[6].to_vec(),
-            score: 3117.0,
-            score_name: "A".into(),
-        }),
-        source_steps: Vec::new(),
-        lock_in_step: None,
-        positive: Vec::new(),
-        negative: Vec::new(),
-        exclusions: 0,
-        test_returns: vec![500.0, 500.0, 487.0, 500.0, 500.0],
-        stopped: false,
-        wall_s: 12.5,
-    })
+    let mut record = RunRecord::new(0, method("sapnet"), 1);
+    record.episodes = episodes;
+    record.steps = 6450;
+    record.updates = 5950;
+    record.chosen = Some(ChosenPolicy {
+        index: 6,
+        name: "source-6".into(),
+        hidden: HIDDEN[6].to_vec(),
+        score: 3117.0,
+        score_name: "A".into(),
+    });
+    record.test_returns = vec![500.0, 500.0, 487.0, 500.0, 500.0];
+    record.wall_s = 12.5;
+    Event::RunEnded(record)
 }
 
 /// A selector's snapshot of `method` at `step` with these probabilities, and nothing else

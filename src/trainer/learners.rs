@@ -1,0 +1,129 @@
+//! Who acts and learns in a run: a copy of each source as a learner of its own (when
+//! sources learn) and the method's own learner (when it has one).
+
+use rand::rngs::StdRng;
+use rand::SeedableRng;
+
+use super::spec::{RunSpec, SourcePolicy};
+use super::CommandReceiver;
+use crate::dqn::{Architecture, DqnAgent, DqnError, QNet};
+use crate::env::Environment;
+use crate::reuse::{Actor, Learning};
+
+pub(super) struct Learners<'a> {
+    sources: &'a [SourcePolicy],
+    agents: Vec<DqnAgent>,
+    learner: Option<DqnAgent>,
+}
+
+impl<'a> Learners<'a> {
+    /// The learners `spec`'s method trains on `env`: the sources' copies measure the TD
+    /// error when `td_error` asks for it; the learner's weights are drawn from the seed
+    /// `weights`. All stop a long round of updates when `commands` is told to stop.
+    pub fn new(
+        spec: &'a RunSpec,
+        learning: Learning,
+        td_error: bool,
+        env: &dyn Environment,
+        weights: u64,
+        commands: &CommandReceiver,
+    ) -> Result<Self, DqnError> {
+        let mut agents = match learning {
+            Learning::ActingSource => spec
+                .sources
+                .iter()
+                .map(|s| DqnAgent::new(s.net.deep_copy()?, &spec.dqn))
+                .collect::<Result<Vec<_>, _>>()?,
+            Learning::Learner => Vec::new(),
+        };
+        for agent in &mut agents {
+            agent.measure_td_error(td_error);
+            agent.interrupt_rounds_with(commands.stop_flag());
+        }
+        let learner = match spec.reuse.learner_hidden() {
+            Some(hidden) => {
+                let architecture =
+                    Architecture::new(env.observation_size(), &hidden, env.action_count());
+                let net = QNet::with_init(
+                    architecture,
+                    spec.dqn.init,
+                    &mut StdRng::seed_from_u64(weights),
+                )?;
+                let mut learner = DqnAgent::new(net, &spec.dqn)?;
+                learner.interrupt_rounds_with(commands.stop_flag());
+                Some(learner)
+            }
+            None => None,
+        };
+        Ok(Self {
+            sources: &spec.sources,
+            agents,
+            learner,
+        })
+    }
+
+    pub fn act(&self, actor: Actor, obs: &[f32], rng: &mut StdRng) -> Result<usize, DqnError> {
+        match actor {
+            Actor::Source(i) => self.agents[i].act(obs, rng),
+            Actor::SourceGreedy(i) => self.sources[i].net.greedy_action(obs),
+            Actor::Learner => self.learner().act(obs, rng),
+        }
+    }
+
+    /// `max_a Q(obs, a)` of the network that acts as `actor`.
+    pub fn value(&self, actor: Actor, obs: &[f32]) -> Result<f64, DqnError> {
+        match actor {
+            Actor::Source(i) => self.agents[i].value(obs),
+            Actor::SourceGreedy(i) => self.sources[i].net.max_q(obs).map(f64::from),
+            Actor::Learner => self.learner().value(obs),
+        }
+    }
+
+    /// `max_a Q_j(obs, a)` of every source: its learning copy, if sources learn.
+    pub fn source_values(&self, obs: &[f32]) -> Result<Vec<f64>, DqnError> {
+        if self.agents.is_empty() {
+            let values = self.sources.iter().map(|s| s.net.max_q(obs).map(f64::from));
+            values.collect()
+        } else {
+            self.agents.iter().map(|a| a.value(obs)).collect()
+        }
+    }
+
+    /// The learning copy of source `source`, or the method's own learner for `None`.
+    pub fn agent(&self, source: Option<usize>) -> &DqnAgent {
+        match source {
+            Some(i) => &self.agents[i],
+            None => self.learner(),
+        }
+    }
+
+    pub fn agent_mut(&mut self, source: Option<usize>) -> &mut DqnAgent {
+        match source {
+            Some(i) => &mut self.agents[i],
+            None => self.learner.as_mut().expect("the method has a learner"),
+        }
+    }
+
+    /// The online network of [`agent`](Self::agent)`(source)`, taken out of the run.
+    pub fn take_net(&mut self, source: Option<usize>) -> QNet {
+        match source {
+            Some(i) => self.agents.swap_remove(i).into_online(),
+            None => self
+                .learner
+                .take()
+                .expect("a method that ends with no source has a learner")
+                .into_online(),
+        }
+    }
+
+    fn learner(&self) -> &DqnAgent {
+        self.learner
+            .as_ref()
+            .expect("a method whose selector picks its learner has one")
+    }
+
+    pub fn updates(&self) -> u64 {
+        let own = self.learner.as_ref().map_or(0, DqnAgent::updates);
+        self.agents.iter().map(DqnAgent::updates).sum::<u64>() + own
+    }
+}
