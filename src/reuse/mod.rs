@@ -210,8 +210,9 @@ pub trait Selector: Send + fmt::Debug {
     /// the run's result is its learner: the method's [`Tested`] rule.
     fn chosen(&self) -> Option<usize>;
 
-    /// The SAP-Net behind the selector, if it is one: its graph, for drawing and teaching.
-    fn sapnet(&self) -> Option<&crate::sapnet::SapNet> {
+    /// The graph the selector spreads activation over, if it spreads (SAP-Net): for drawing
+    /// and teaching.
+    fn graph(&self) -> Option<&crate::sapnet::SapNet> {
         None
     }
 

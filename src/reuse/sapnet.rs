@@ -479,7 +479,7 @@ impl Selector for SapNetSelector {
         Some(self.net.chosen())
     }
 
-    fn sapnet(&self) -> Option<&SapNet> {
+    fn graph(&self) -> Option<&SapNet> {
         Some(&self.net)
     }
 

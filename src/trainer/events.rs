@@ -224,7 +224,7 @@ pub struct SourceSummary {
 /// For a selector that is not SAP-Net the graph is the library's under the config's
 /// `sapnet` section, drawn with the selector's own scores.
 #[derive(Debug, Clone, PartialEq)]
-pub struct SapNetStart {
+pub struct LibraryStart {
     pub policies: Vec<SourceSummary>,
     pub net: SapNet,
     /// What the selector's scores are: `A` for SAP-Net's activations, else its own.
@@ -309,7 +309,7 @@ pub enum Event {
         method: MethodId,
         planned_episodes: u32,
         /// Present for runs that reuse the library.
-        sapnet: Option<Box<SapNetStart>>,
+        library: Option<Box<LibraryStart>>,
     },
     Step(StepRecord),
     Activations(ActivationSnapshot),

@@ -7,8 +7,8 @@
 
 mod control;
 mod events;
-mod learners;
 pub mod memory;
+mod networks;
 mod run;
 mod run_state;
 pub mod scheduler;
@@ -20,8 +20,8 @@ use std::sync::Arc;
 use std::thread::{self, JoinHandle};
 
 pub use events::{
-    ActivationSnapshot, ChosenPolicy, Command, Deposit, EpisodeRecord, Event, LockIn, MethodId,
-    RunRecord, SapNetStart, SourceSummary, StepRecord, StreamOptions, TraceRecord,
+    ActivationSnapshot, ChosenPolicy, Command, Deposit, EpisodeRecord, Event, LibraryStart, LockIn,
+    MethodId, RunRecord, SourceSummary, StepRecord, StreamOptions, TraceRecord,
 };
 pub use run::train;
 pub use run_state::{test_greedy, LOCK_IN};

@@ -9,10 +9,10 @@ use rand::SeedableRng;
 
 use super::control::{Control, Next};
 use super::events::{
-    ActivationSnapshot, ChosenPolicy, EpisodeRecord, Event, LockIn, RunRecord, SapNetStart,
+    ActivationSnapshot, ChosenPolicy, EpisodeRecord, Event, LibraryStart, LockIn, RunRecord,
     SourceSummary, StepRecord, TraceRecord,
 };
-use super::learners::Learners;
+use super::networks::RunNetworks;
 use super::spec::{selector, RunSpec};
 use super::{CommandReceiver, Divergence, RunOutcome, TrainerError};
 use crate::dqn::{DqnError, QNet, ReplayBuffer, Transition, UpdateReport};
@@ -25,7 +25,7 @@ use crate::seeds;
 pub const LOCK_IN: f64 = 0.99;
 
 /// The seeds of a run's independent random streams.
-struct Streams {
+struct RunSeeds {
     weights: u64,
     /// ε-greedy and minibatch sampling.
     agent: u64,
@@ -35,7 +35,7 @@ struct Streams {
     selection: u64,
 }
 
-impl Streams {
+impl RunSeeds {
     fn new(seed: u64) -> Self {
         use seeds::Part::Name;
         Self {
@@ -129,14 +129,14 @@ pub(super) struct Run<'a> {
     events: &'a Sender<Event>,
     control: Control<'a>,
     started: Instant,
-    streams: Streams,
+    seeds: RunSeeds,
     env: Box<dyn Environment>,
     selector: Box<dyn Selector>,
     learning: Learning,
     /// What the selector asks the run to measure, asked once: a method that needs nothing
     /// measures nothing.
     needs: Needs,
-    learners: Learners<'a>,
+    networks: RunNetworks<'a>,
     replay: ReplayBuffer,
     rng: StdRng,
     selection_rng: StdRng,
@@ -167,29 +167,29 @@ impl<'a> Run<'a> {
         commands: &'a CommandReceiver,
     ) -> Result<Self, TrainerError> {
         let started = Instant::now();
-        let streams = Streams::new(spec.seed);
+        let seeds = RunSeeds::new(spec.seed);
         let mut env = env::make(&spec.env)?;
         let selector = selector(spec)?;
         let learning = selector.learning();
         let needs = selector.needs();
         let n = spec.sources.len();
-        let learners = Learners::new(
+        let networks = RunNetworks::new(
             spec,
             learning,
             needs.td_error,
             env.as_ref(),
-            streams.weights,
+            seeds.weights,
             commands,
         )?;
         let replay = ReplayBuffer::new(spec.dqn.replay_capacity, env.observation_size());
-        let rng = StdRng::seed_from_u64(streams.agent);
-        let selection_rng = StdRng::seed_from_u64(streams.selection);
+        let rng = StdRng::seed_from_u64(seeds.agent);
+        let selection_rng = StdRng::seed_from_u64(seeds.selection);
         let control = Control::new(commands, spec.stream.trace);
         let _ = events.send(Event::RunStarted {
             run: spec.run,
             method: spec.method.clone(),
             planned_episodes: spec.episodes,
-            sapnet: library_start(spec, selector.as_ref()),
+            library: library_start(spec, selector.as_ref()),
         });
         let replay_start = spec.dqn.replay_start_size as u64;
         let warm_up = match learning {
@@ -197,20 +197,20 @@ impl<'a> Run<'a> {
             Learning::Learner => 0,
         };
         let last_snapshot = Instant::now();
-        let obs = env.reset(Some(streams.env))?.to_vec();
+        let obs = env.reset(Some(seeds.env))?.to_vec();
         Ok(Self {
             spec,
             events,
             control,
             started,
-            streams,
+            seeds,
             next_obs: vec![0.0; obs.len()],
             obs,
             env,
             selector,
             learning,
             needs,
-            learners,
+            networks,
             replay,
             rng,
             selection_rng,
@@ -249,11 +249,11 @@ impl<'a> Run<'a> {
         } else {
             self.selector.act(&mut self.selection_rng)
         };
-        let action = self.learners.act(actor, &self.obs, &mut self.rng)?;
+        let action = self.networks.act(actor, &self.obs, &mut self.rng)?;
         // V_i(s_t) of the acting source as it acts, before its update.
         let value = match actor.source() {
             Some(i) if self.needs.values && !in_warm_up => {
-                Some((i, self.learners.value(actor, &self.obs)?))
+                Some((i, self.networks.value(actor, &self.obs)?))
             }
             _ => None,
         };
@@ -296,7 +296,7 @@ impl<'a> Run<'a> {
         if done {
             let bootstrapped = truncated && !terminated && !self.spec.dqn.truncation_as_terminal;
             if self.needs.values && bootstrapped {
-                let values = self.learners.source_values(&self.next_obs)?;
+                let values = self.networks.source_values(&self.next_obs)?;
                 self.selector.on_truncated(&values);
             }
             self.obs.copy_from_slice(self.env.reset(None)?);
@@ -320,7 +320,7 @@ impl<'a> Run<'a> {
             Learning::Learner => None,
         };
         let report = match self
-            .learners
+            .networks
             .agent_mut(learner)
             .observe(&self.replay, &mut self.rng)
         {
@@ -372,7 +372,7 @@ impl<'a> Run<'a> {
             source: error,
             episodes: self.record.episodes,
             steps: self.steps,
-            last_good: self.learners.take_net(learner),
+            last_good: self.networks.take_net(learner),
         }))
     }
 
@@ -388,7 +388,7 @@ impl<'a> Run<'a> {
         if self.snapshots {
             self.send_snapshot(episode);
         }
-        let shown = self.learners.agent(match self.learning {
+        let shown = self.networks.agent(match self.learning {
             Learning::ActingSource => Some(self.last_source),
             Learning::Learner => None,
         });
@@ -416,7 +416,7 @@ impl<'a> Run<'a> {
         let spec = self.spec;
         let mut record = self.record;
         record.steps = self.steps;
-        record.updates = self.learners.updates();
+        record.updates = self.networks.updates();
         record.source_steps = self.tally.run;
         let view = self.selector.view();
         (record.positive, record.negative) = (view.positive.clone(), view.negative.clone());
@@ -429,14 +429,14 @@ impl<'a> Run<'a> {
             score: view.scores[chosen],
             score_name: view.score_name.into(),
         });
-        let net = self.learners.take_net(chosen);
+        let net = self.networks.take_net(chosen);
         if !record.stopped {
             let mut test_env = env::make(&spec.env)?;
             record.test_returns = test_greedy(
                 &net,
                 test_env.as_mut(),
                 spec.test_episodes,
-                self.streams.test_env,
+                self.seeds.test_env,
             )?;
         }
         record.wall_s = self.started.elapsed().as_secs_f64();
@@ -498,15 +498,15 @@ impl<'a> Run<'a> {
 /// The library as front ends draw it: SAP-Net's own net, or for another selector the
 /// library's graph under the config's SAP-Net section (none without a library, or if that
 /// graph cannot be built).
-fn library_start(spec: &RunSpec, selector: &dyn Selector) -> Option<Box<SapNetStart>> {
+fn library_start(spec: &RunSpec, selector: &dyn Selector) -> Option<Box<LibraryStart>> {
     if spec.sources.is_empty() {
         return None;
     }
-    let net = match selector.sapnet() {
+    let net = match selector.graph() {
         Some(net) => net.clone(),
         None => SapNet::from_policies(&spec.descriptions(), spec.sapnet.clone()).ok()?,
     };
-    Some(Box::new(SapNetStart {
+    Some(Box::new(LibraryStart {
         policies: spec
             .sources
             .iter()
@@ -576,7 +576,7 @@ mod tests {
 
     /// Every stream of every run of a protocol, and of a sweep over its `seed`, is its own:
     /// no run's seed or stream equals another's (the derivation before 2026-12 gave
-    /// `seed 1, method 0` the streams of `seed 0, method 1`).
+    /// `seed 1, method 0` the seeds of `seed 0, method 1`).
     #[test]
     fn every_stream_of_a_sweep_over_seeds_is_distinct() {
         let mut config = crate::config::Config::from_ron(
@@ -590,7 +590,7 @@ mod tests {
         for seed in 0..10 {
             config.seed = seed;
             for spec in crate::experiment::run_specs(&config, None) {
-                let s = Streams::new(spec.seed);
+                let s = RunSeeds::new(spec.seed);
                 for stream in [
                     spec.seed,
                     s.weights,

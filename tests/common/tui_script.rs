@@ -7,8 +7,8 @@ use sapnet::dqn::UpdateReport;
 use sapnet::reuse::Method;
 use sapnet::sapnet::{PolicyDescription, SapNet};
 use sapnet::trainer::{
-    ActivationSnapshot, ChosenPolicy, Deposit, EpisodeRecord, Event, MethodId, RunRecord,
-    SapNetStart, SourceSummary, StepRecord,
+    ActivationSnapshot, ChosenPolicy, Deposit, EpisodeRecord, Event, LibraryStart, MethodId,
+    RunRecord, SourceSummary, StepRecord,
 };
 
 /// The id of the scripted methods: `sapnet` first, then `dqn[100]`, as the embedded
@@ -45,7 +45,7 @@ pub fn sapnet_start() -> Event {
         run: 0,
         method: method("sapnet"),
         planned_episodes: 5000,
-        sapnet: Some(Box::new(SapNetStart {
+        library: Some(Box::new(LibraryStart {
             policies: descriptions
                 .into_iter()
                 .enumerate()
@@ -66,7 +66,7 @@ pub fn baseline_start() -> Event {
         run: 0,
         method: method("dqn[100]"),
         planned_episodes: 5000,
-        sapnet: None,
+        library: None,
     }
 }
 

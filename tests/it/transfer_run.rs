@@ -77,7 +77,7 @@ fn the_warm_up_acts_in_turn_then_sap_net_selects_learns_and_activates() {
     let (events, outcome) = collect(&spec);
 
     let Event::RunStarted {
-        sapnet: Some(start),
+        library: Some(start),
         ..
     } = &events[0]
     else {

@@ -248,7 +248,12 @@ fn a_small_terminal_is_told_the_size_needed() {
 fn another_selector_is_drawn_under_its_own_scores() {
     // UCB1 followed instead of SAP-Net: the graph and table name its scores.
     let mut start = tui_script::sapnet_start();
-    if let sapnet::trainer::Event::RunStarted { method, sapnet, .. } = &mut start {
+    if let sapnet::trainer::Event::RunStarted {
+        method,
+        library: sapnet,
+        ..
+    } = &mut start
+    {
         *method = sapnet::trainer::MethodId::new(7, &sapnet::reuse::Method::Ucb1);
         sapnet.as_mut().unwrap().score_name = "mean";
     }
@@ -299,7 +304,10 @@ fn a_library_over_several_tasks_is_grouped_and_labelled_by_task() {
     );
     let net = sapnet::sapnet::SapNet::from_policies(&descriptions, params).unwrap();
     let mut start = tui_script::sapnet_start();
-    if let sapnet::trainer::Event::RunStarted { sapnet, .. } = &mut start {
+    if let sapnet::trainer::Event::RunStarted {
+        library: sapnet, ..
+    } = &mut start
+    {
         let start = sapnet.as_mut().unwrap();
         for (policy, description) in start.policies.iter_mut().zip(descriptions) {
             policy.description = description;
@@ -480,13 +488,13 @@ fn a_run_other_than_the_first_is_named_in_the_status_line() {
             Event::RunStarted {
                 method,
                 planned_episodes,
-                sapnet,
+                library,
                 ..
             } => Event::RunStarted {
                 run: 2,
                 method,
                 planned_episodes,
-                sapnet,
+                library,
             },
             other => other,
         };

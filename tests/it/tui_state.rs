@@ -286,7 +286,12 @@ fn m_follows_the_next_method_and_late_events_of_the_old_one_are_left_out() {
     assert_eq!(d.runs.len(), 1);
     // UCB1's start takes the followed place, under its own scores.
     let mut start = tui_script::sapnet_start();
-    if let sapnet::trainer::Event::RunStarted { method, sapnet, .. } = &mut start {
+    if let sapnet::trainer::Event::RunStarted {
+        method,
+        library: sapnet,
+        ..
+    } = &mut start
+    {
         *method = sapnet::trainer::MethodId::new(7, &sapnet::reuse::Method::Ucb1);
         sapnet.as_mut().unwrap().score_name = "mean";
     }
@@ -344,7 +349,12 @@ fn lock_in_is_dated_from_the_first_snapshot_above_the_threshold() {
 fn a_method_that_picks_by_rule_never_shows_a_lock_in() {
     let ucb1 = sapnet::trainer::MethodId::new(7, &sapnet::reuse::Method::Ucb1);
     let mut start = tui_script::sapnet_start();
-    if let sapnet::trainer::Event::RunStarted { method, sapnet, .. } = &mut start {
+    if let sapnet::trainer::Event::RunStarted {
+        method,
+        library: sapnet,
+        ..
+    } = &mut start
+    {
         *method = ucb1.clone();
         sapnet.as_mut().unwrap().score_name = "mean";
     }

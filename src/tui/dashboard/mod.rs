@@ -160,13 +160,13 @@ impl Dashboard {
                 run,
                 method,
                 planned_episodes,
-                sapnet,
+                library,
             } => {
-                if self.is_stale(&method, sapnet.is_some()) {
+                if self.is_stale(&method, library.is_some()) {
                     return;
                 }
                 let run = RunView::new(method, run, planned_episodes);
-                if let Some(start) = sapnet {
+                if let Some(start) = library {
                     let n = start.net.len();
                     self.library = Some(LibraryView {
                         method: run.method.label().to_string(),

@@ -1,5 +1,5 @@
-//! Who acts and learns in a run: a copy of each source as a learner of its own (when
-//! sources learn) and the method's own learner (when it has one).
+//! The Q-networks of a run: the sources as recorded, a copy of each fine-tuned as a
+//! learner of its own (when sources learn), and the method's own learner (when it has one).
 
 use rand::rngs::StdRng;
 use rand::SeedableRng;
@@ -10,13 +10,13 @@ use crate::dqn::{Architecture, DqnAgent, DqnError, QNet};
 use crate::env::Environment;
 use crate::reuse::{Actor, Learning};
 
-pub(super) struct Learners<'a> {
+pub(super) struct RunNetworks<'a> {
     sources: &'a [SourcePolicy],
     agents: Vec<DqnAgent>,
     learner: Option<DqnAgent>,
 }
 
-impl<'a> Learners<'a> {
+impl<'a> RunNetworks<'a> {
     /// The learners `spec`'s method trains on `env`: the sources' copies measure the TD
     /// error when `td_error` asks for it; the learner's weights are drawn from the seed
     /// `weights`. All stop a long round of updates when `commands` is told to stop.
