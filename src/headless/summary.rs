@@ -53,7 +53,13 @@ pub fn print_comparison(summary: &results::Summary) -> Result<()> {
     let mut table = if summary.comparison.is_empty() {
         String::new()
     } else {
-        report::comparison::table(&summary.comparison, report::Units::Returns)
+        let mut table = report::comparison::table(&summary.comparison, report::Units::Returns);
+        let pairs = report::improvement::verdicts(&summary.pairs, "return");
+        if !pairs.is_empty() {
+            table.push('\n');
+            table.push_str(&pairs);
+        }
+        table
     };
     let stopped: Vec<String> = summary
         .runs

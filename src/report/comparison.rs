@@ -349,6 +349,7 @@ pub fn table(rows: &[MethodComparison], units: Units) -> String {
         [
             "return IQM [95% CI]",
             "test IQM [95% CI]",
+            "tested",
             "ranks",
             "lock-in step",
         ]
@@ -370,6 +371,8 @@ pub fn table(rows: &[MethodComparison], units: Units) -> String {
         for score in [&row.training, &row.test] {
             line.push(score.map_or("-".into(), |a| interval(&a.iqm, digits)));
         }
+        // A test score is the method and its handover rule together: said beside it.
+        line.push(row.tested.to_string());
         let ranks: Vec<String> = row.ranks.iter().map(ToString::to_string).collect();
         line.push(if ranks.is_empty() {
             "-".into()

@@ -155,7 +155,8 @@ impl Report {
             methods.push(method_runs(label, method.kind(), tasks, &per_task, units));
         }
         let comparison = comparison::compare(&methods, units);
-        let improvement = improvement::every_pair(&methods);
+        let task_names: Vec<String> = tasks.iter().map(|t| t.task.to_string()).collect();
+        let improvement = improvement::every_pair(&methods, &task_names);
         let levels = profile::levels();
         let profiles = methods
             .iter()
@@ -176,7 +177,7 @@ impl Report {
             .collect();
         let reference = methods
             .iter()
-            .find(|m| m.label == Method::SapNet.label())
+            .find(|m| m.label == Method::the_papers().label())
             .or_else(|| methods.first())
             .map(|m| m.label.clone());
         Self {
@@ -197,15 +198,22 @@ impl Report {
     pub fn write(&self, dir: &Path) -> Result<()> {
         let (header, records) = comparison::csv_records(&self.comparison, self.units);
         write_rows(&dir.join("comparison.csv"), &header, &records)?;
-        let (header, records) = improvement::records(&self.improvement);
+        let (header, records) = improvement::records(&self.improvement, &self.tasks);
         write_rows(&dir.join("improvement.csv"), &header, &records)?;
         write_scores(&dir.join("scores.csv"), &self.scores)?;
         plots::write_intervals(dir, self)
     }
 
-    /// The comparison as a table, for stdout.
+    /// The comparison as a table, for stdout, then the pairs of the training return (the
+    /// headline score: test scores are not ranked) by the separation rule.
     pub fn table(&self) -> String {
-        comparison::table(&self.comparison, self.units)
+        let mut text = comparison::table(&self.comparison, self.units);
+        let pairs = improvement::verdicts(&self.improvement, "return");
+        if !pairs.is_empty() {
+            text.push('\n');
+            text.push_str(&pairs);
+        }
+        text
     }
 }
 

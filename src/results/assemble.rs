@@ -82,6 +82,7 @@ pub fn assemble(
         rewards: &rewards,
     }]);
     summary.comparison = report.comparison.clone();
+    summary.pairs = report.improvement.clone();
     summary.library = (!library.is_empty()).then_some(library);
     // Everything the summary's status vouches for is on disk before it.
     if !summary.runs.is_empty() {

@@ -9,7 +9,7 @@ use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::config::Config;
-use crate::report::{LibraryEntry, MethodComparison, RunSummary};
+use crate::report::{Improvement, LibraryEntry, MethodComparison, RunSummary};
 
 /// Where a protocol stands, the first field of `summary.json`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -52,6 +52,10 @@ pub struct Summary {
     pub runs: Vec<RunSummary>,
     /// The methods side by side (`comparison.csv`).
     pub comparison: Vec<MethodComparison>,
+    /// Every ordered pair of methods by the separation rule (`improvement.csv`), for the
+    /// closing table; not in `summary.json`, whose readers take it from the CSV.
+    #[serde(skip)]
+    pub pairs: Vec<Improvement>,
     /// Seconds this process spent (a resumed protocol: since the resume).
     pub wall_s: f64,
     /// Why the experiment ended early, if it failed (the runs above finished before).
@@ -90,6 +94,7 @@ impl Summary {
             library: None,
             runs: Vec::new(),
             comparison: Vec::new(),
+            pairs: Vec::new(),
             wall_s: 0.0,
             error: None,
         }

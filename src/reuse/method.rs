@@ -42,6 +42,12 @@ pub enum Method {
 }
 
 impl Method {
+    /// The method the paper proposes: SAP-Net as it specifies it. Comparisons draw the
+    /// others against it when it ran.
+    pub fn the_papers() -> Self {
+        Self::SapNet
+    }
+
     /// What the method's file says of it: one arm per method.
     pub fn definition(&self) -> Box<dyn ReuseMethod + '_> {
         match self {

@@ -26,6 +26,7 @@ pub mod power;
 pub mod profile;
 pub mod proportion;
 pub mod rank_test;
+pub mod separation;
 
 use serde::Serialize;
 

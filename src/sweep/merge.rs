@@ -153,7 +153,7 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
         let lead = [axis.clone(), value.clone(), group.len().to_string()];
         let (header, records) = comparison::csv_records(&report.comparison, report.units);
         comparisons.extend(&["axis", "value", "cells"], &lead, &header, records);
-        let (header, records) = improvement::records(&report.improvement);
+        let (header, records) = improvement::records(&report.improvement, &report.tasks);
         improvements.extend(&["axis", "value"], &lead[..2], &header, records);
         let dir = if axis == ACROSS_TASKS {
             out.join(ACROSS_TASKS_FOLDER)

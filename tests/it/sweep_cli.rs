@@ -356,8 +356,21 @@ fn a_sweep_over_tasks_is_pooled_with_normalised_scores() {
     }
     let improvement = std::fs::read_to_string(s.join("merged/improvement.csv")).unwrap();
     assert!(
-        improvement.starts_with("axis,value,score,method,over,p,lo,hi\n"),
+        improvement.starts_with(
+            "axis,value,score,method,over,p,lo,hi,rank_p,holm_p,seeds_excluding,verdict,\
+             runs_needed,per_task\n"
+        ),
         "{improvement}"
+    );
+    // Pooled over the two tasks, each pair carries each task's verdict (two runs each
+    // separate nothing).
+    let pooled = improvement
+        .lines()
+        .find(|l| l.starts_with("*,every cell,test,sapnet,dqn[8],"))
+        .expect("the pooled pair's row");
+    assert!(
+        pooled.ends_with(",cartpole=not separated;cartpole(length=1.0)=not separated"),
+        "{pooled}"
     );
     assert!(
         improvement.contains("\n*,every cell,test,sapnet,dqn[8],"),
