@@ -243,10 +243,12 @@ fn run_experiment(cli: &Cli) -> Result<()> {
             || cli.run.force
             || cli.run.jobs.is_some()
             || cli.run.trace
+            || cli.run.tensorboard
             || cli.run.add_to_library
         {
             anyhow::bail!(
-                "--out, --force, --jobs, --trace and --add-to-library are for --headless runs: \
+                "--out, --force, --jobs, --trace, --tensorboard and --add-to-library are for \
+                 --headless runs: \
                  the dashboard writes no files (its teach mode, `t`, steps the spreading by hand)"
             );
         }
@@ -320,6 +322,7 @@ fn run_options(cli: &Cli) -> RunOptions {
         library: cli.run.library_root(),
         trace: cli.run.trace,
         copy_chosen: cli.run.add_to_library,
+        tensorboard: cli.run.tensorboard,
     }
 }
 

@@ -103,6 +103,12 @@ pub struct RunArgs {
     #[arg(long)]
     pub trace: bool,
 
+    /// With --headless: also write each run's TensorBoard event file, live, under
+    /// <out>/tensorboard/<method>-run<r>/ (CleanRL's tag names, SAP-Net's activations and
+    /// probabilities, the run's hyper-parameters): `tensorboard --logdir <out>/tensorboard`.
+    #[arg(long)]
+    pub tensorboard: bool,
+
     /// Runs trained at the same time (`sweep run --all`: cells). Default: one per core.
     #[arg(long, value_name = "N", global = true, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=4096))]
     pub jobs: Option<usize>,

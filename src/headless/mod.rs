@@ -34,8 +34,11 @@
 mod observer;
 mod output;
 mod summary;
+mod tensorboard_runs;
 
 pub use summary::{print_comparison, print_summary};
+use tensorboard_runs::TensorBoardRuns;
+pub use tensorboard_runs::TENSORBOARD_DIR;
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::Receiver;
@@ -74,6 +77,8 @@ pub struct RunOptions {
     /// Add each reusing run's chosen policy to the library (Algorithm 3's last step).
     /// Sweeps leave it off: their library is shared, read-only, by many processes.
     pub copy_chosen: bool,
+    /// Write each run's TensorBoard event file under `<out>/tensorboard/`.
+    pub tensorboard: bool,
 }
 
 /// Runs the protocol of `config`: trains the source library if SAP-Net needs one that is
@@ -257,7 +262,7 @@ fn protocol(
     results::write_json(&out.join("summary.json"), &summary)?;
     crate::failpoint::point("summary-started");
 
-    let names = plan
+    let names: Vec<String> = plan
         .sources
         .as_ref()
         .map(|s| s.iter().map(|p| p.name.clone()).collect())
@@ -273,6 +278,11 @@ fn protocol(
             plan.specs.iter().map(|s| u64::from(s.episodes)).sum(),
         ),
     };
+    let tensorboard = if options.tensorboard {
+        Some(TensorBoardRuns::new(out, names.clone(), &plan.specs)?)
+    } else {
+        None
+    };
     let mut files = ResultFiles::new(
         out.to_path_buf(),
         config.clone(),
@@ -280,6 +290,7 @@ fn protocol(
         Progress::new(planned, unit),
         summary,
         copies,
+        tensorboard,
     );
     let started = Instant::now();
     let outcome = crate::trainer::schedule(plan.specs, options.jobs, commands, &mut files);

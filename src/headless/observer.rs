@@ -14,6 +14,8 @@ use crate::report::RunSummary;
 use crate::results::records::{run_name, RunWriter};
 use crate::results::{self, Summary};
 use crate::trainer::Observer;
+
+use super::tensorboard_runs::TensorBoardRuns;
 use crate::trainer::{Divergence, Event, MethodId, RunOutcome, RunSpec, TrainerError};
 
 /// What the event stream writes: each run's record, progress, and `summary.json` after
@@ -30,6 +32,8 @@ pub(super) struct ResultFiles {
     summary: Summary,
     /// Where the chosen policies join the library, if they do.
     copies: Option<LibraryCopies>,
+    /// Each run's event file, with `--tensorboard`.
+    tensorboard: Option<TensorBoardRuns>,
 }
 
 impl ResultFiles {
@@ -41,6 +45,7 @@ impl ResultFiles {
         progress: Progress,
         summary: Summary,
         copies: Option<LibraryCopies>,
+        tensorboard: Option<TensorBoardRuns>,
     ) -> Self {
         Self {
             out,
@@ -50,6 +55,7 @@ impl ResultFiles {
             writers: BTreeMap::new(),
             summary,
             copies,
+            tensorboard,
         }
     }
 
@@ -84,13 +90,22 @@ impl Observer for ResultFiles {
                     .unwrap_or(u64::from(planned_episodes));
                 self.progress.run_started(method.label(), run, planned);
                 self.writer(&method, run)?;
+                if let Some(tensorboard) = &mut self.tensorboard {
+                    tensorboard.run_started(&self.config, &method, run)?;
+                }
             }
             Event::Activations(snapshot) => {
+                if let Some(tensorboard) = &mut self.tensorboard {
+                    tensorboard.snapshot(&snapshot)?;
+                }
                 let (method, run) = (snapshot.method.clone(), snapshot.run);
                 self.writer(&method, run)?.snapshot(snapshot);
             }
             Event::EpisodeEnded(record) => {
                 self.writer(&record.method, record.run)?.episode(&record)?;
+                if let Some(tensorboard) = &mut self.tensorboard {
+                    tensorboard.episode(&record)?;
+                }
                 self.progress.episode(&record);
             }
             Event::Trace(record) => {
@@ -106,6 +121,9 @@ impl Observer for ResultFiles {
         let record = outcome.record;
         self.progress
             .run_finished(record.method.label(), record.run);
+        if let Some(tensorboard) = &mut self.tensorboard {
+            tensorboard.run_finished(&record.method, record.run, record.stopped)?;
+        }
         let mut library_copy = None;
         // A run stopped before its first step trained nothing worth keeping.
         if record.steps > 0 {

@@ -135,6 +135,7 @@ fn attempt(
         },
         trace: false,
         copy_chosen: false,
+        tensorboard: false,
     };
     let reuses = config.protocol.methods.iter().any(|m| m.kind().reuses);
     if reuses && sources::needs_training(&config, &manifest.library)? {

@@ -37,6 +37,7 @@ mod signals_cli;
 mod sources_cli;
 mod sweep_cli;
 mod teach_cli;
+mod tensorboard_cli;
 mod tensorboard_files;
 mod trainer_failure;
 mod trainer_stop;
