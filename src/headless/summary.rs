@@ -16,7 +16,7 @@ pub fn print_summary(summary: &results::Summary, dir: &Path) -> Result<()> {
     if summary.stopped() {
         eprintln!("stopped by the user: what was done so far is in {dir} (episodes.csv, tests.csv, summary.json, plots); `sapnet --headless --resume --out {dir}` finishes it");
     } else {
-        eprintln!("results in {dir}: episodes.csv, tests.csv, activations.csv, comparison.csv, improvement.csv, scores.csv, summary.json, runs/, policies/, intervals.png, profiles.png, improvement.png, learning_curve.png, tests.png, activations.png, selections.png (the plots also as .svg)");
+        eprintln!("results in {dir}: episodes.csv, tests.csv, activations.csv, comparison.csv, improvement.csv, scores.csv, summary.json, runs/, policies/, intervals.png, profiles.png, improvement.png, learning_curve.png, sample_efficiency.csv, sample_efficiency.png, tests.png, activations.png, selections.png (the plots also as .svg)");
     }
     for run in &summary.runs {
         let tests: Vec<String> = run

@@ -10,6 +10,7 @@ pub mod comparison;
 pub mod improvement;
 pub mod plots;
 pub mod runs;
+pub mod sample_efficiency;
 pub mod scores;
 
 use std::collections::BTreeMap;

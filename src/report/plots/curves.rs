@@ -40,12 +40,12 @@ pub fn std_over_runs(series: &[Vec<f64>]) -> Vec<f64> {
 }
 
 /// The methods' pens, in the order listed.
-fn pens(curves: &[Curve]) -> Vec<Pen> {
+pub(super) fn pens(curves: &[Curve]) -> Vec<Pen> {
     method_pens(&curves.iter().map(|c| c.kind).collect::<Vec<_>>())
 }
 
 /// The chart's area and the legend's column beside it, a little below the title.
-fn beside_legend<DB: DrawingBackend>(
+pub(super) fn beside_legend<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
 ) -> (DrawingArea<DB, Shift>, DrawingArea<DB, Shift>) {
     let width = root.dim_in_pixel().0;

@@ -8,6 +8,7 @@
 
 mod axes;
 mod curves;
+mod efficiency;
 mod intervals;
 mod legend;
 mod library;
@@ -19,6 +20,7 @@ use std::sync::Once;
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 
+use super::sample_efficiency::{self, EfficiencyPoint};
 use crate::reuse::MethodKind;
 
 /// DejaVu Sans (licence in `assets/fonts/`): plotters' `ab_glyph` backend needs a font and
@@ -72,10 +74,39 @@ pub struct SelectionHistory {
     pub acted: Vec<Vec<u64>>,
 }
 
-/// Writes `learning_curve.png`, `learning_curve.svg`, `tests.png` and, with SAP-Net
-/// activations, `activations.png` into `dir`.
+/// Writes `learning_curve.png`, `learning_curve.svg`, `sample_efficiency.csv`, `.png` and
+/// `.svg`, `tests.png` and, with SAP-Net activations, `activations.png` into `dir`.
 pub fn write_all(dir: &Path, data: &PlotData) -> Result<()> {
     register_font()?;
+    let efficiency: Vec<Vec<EfficiencyPoint>> = data
+        .curves
+        .iter()
+        .map(|c| sample_efficiency::curve(&c.label, &c.returns, data.window))
+        .collect();
+    let labelled: Vec<(String, Vec<EfficiencyPoint>)> = data
+        .curves
+        .iter()
+        .map(|c| c.label.clone())
+        .zip(efficiency.iter().cloned())
+        .collect();
+    let (header, rows) = sample_efficiency::records(&labelled);
+    super::write_rows(&dir.join("sample_efficiency.csv"), &header, &rows)?;
+    atomically(&dir.join("sample_efficiency.png"), |path| {
+        efficiency::sample_efficiency(
+            BitMapBackend::new(path, WITH_LEGEND).into_drawing_area(),
+            data,
+            &efficiency,
+        )
+        .map_err(|e| e.to_string())
+    })?;
+    atomically(&dir.join("sample_efficiency.svg"), |path| {
+        efficiency::sample_efficiency(
+            SVGBackend::new(path, WITH_LEGEND).into_drawing_area(),
+            data,
+            &efficiency,
+        )
+        .map_err(|e| e.to_string())
+    })?;
     atomically(&dir.join("learning_curve.png"), |path| {
         curves::learning_curve(
             BitMapBackend::new(path, WITH_LEGEND).into_drawing_area(),
