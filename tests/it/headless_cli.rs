@@ -243,13 +243,15 @@ fn output_flags_without_headless_are_refused_before_the_dashboard_opens() {
     for flag in [
         &["--out", "somewhere"][..],
         &["--trace"],
+        &["--tensorboard"],
         &["--add-to-library"],
     ] {
         let output = sapnet(flag);
         assert_eq!(output.status.code(), Some(2));
         assert!(
             stderr(&output).contains(
-                "--out, --force, --jobs, --trace and --add-to-library are for --headless runs"
+                "--out, --force, --jobs, --trace, --tensorboard and --add-to-library are for \
+                 --headless runs"
             ),
             "{}",
             stderr(&output)

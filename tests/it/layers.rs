@@ -79,6 +79,33 @@ fn src_imports_only_downward_and_in_no_circle() {
     assert!(findings.is_empty(), "{findings}");
 }
 
+/// The seams issue 35 sealed, kept: policy reuse knows nothing of the DQN or of policies on
+/// disk (the trainer fills its feedback), and the DQN is told to stop by the trainer, never
+/// by the process's signals. The layers allow both imports; the seams do not.
+#[test]
+fn the_sealed_seams_stay_sealed() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let krate = Crate::read(&src);
+    let forbidden: [(&str, &[&str]); 2] =
+        [("reuse", &["dqn", "policy_store"]), ("dqn", &["signals"])];
+    let mut found = Vec::new();
+    for (from, to) in krate.imports() {
+        for (below, names) in to {
+            for (layer, sealed) in forbidden {
+                let reaches = sealed.iter().any(|s| below.first().is_some_and(|b| b == s));
+                if from.first().is_some_and(|f| f == layer) && reaches {
+                    found.push(format!(
+                        "{} imports {names:?} from {}",
+                        krate.name(&from),
+                        krate.name(&below)
+                    ));
+                }
+            }
+        }
+    }
+    assert!(found.is_empty(), "{}", found.join("\n"));
+}
+
 /// A module's path from the crate root: `["tui", "view"]` for `crate::tui::view`.
 type ModulePath = Vec<String>;
 
