@@ -8,6 +8,9 @@ use super::legend::{self, Entry, Swatch};
 use super::palette::{method_pens, Pen};
 use super::{axes, Curve, Drawn, PlotData, FAMILY};
 use crate::report::runs::moving_average;
+use crate::report::sample_efficiency::EfficiencyPoint;
+use crate::seeds::{self, Part};
+use crate::stats::{aggregate, bootstrap, Estimate, Scores};
 
 /// Element-wise mean of series of different lengths: index `i` averages the series that
 /// reach it (a stopped run is shorter).
@@ -21,20 +24,27 @@ pub fn mean_over_runs(series: &[Vec<f64>]) -> Vec<f64> {
         .collect()
 }
 
-/// Element-wise standard deviation over the runs that reach each index (0 where only one
-/// does).
-pub fn std_over_runs(series: &[Vec<f64>]) -> Vec<f64> {
-    let means = mean_over_runs(series);
-    means
-        .iter()
-        .enumerate()
-        .map(|(i, m)| {
+/// Resamples per interval of a figure's band or whiskers: many intervals drawn at once,
+/// where 2,000 suffice (as the sample-efficiency curves').
+const RESAMPLES: usize = 2_000;
+
+/// Element-wise mean over runs with its 95% bootstrap interval (the runs resampled), over
+/// the runs that reach each index; `label` seeds the resampling.
+pub fn mean_intervals(label: &str, series: &[Vec<f64>]) -> Vec<Estimate> {
+    let longest = series.iter().map(Vec::len).max().unwrap_or(0);
+    (0..longest)
+        .map(|i| {
             let values: Vec<f64> = series.iter().filter_map(|s| s.get(i).copied()).collect();
-            if values.len() < 2 {
-                return 0.0;
-            }
-            let ss: f64 = values.iter().map(|v| (v - m).powi(2)).sum();
-            (ss / (values.len() - 1) as f64).sqrt()
+            let scores = Scores::one_task(values).expect("the longest series reaches i");
+            let seed = seeds::derive(
+                0,
+                &[
+                    Part::Name("figure"),
+                    Part::Name(label),
+                    Part::Index(i as u64),
+                ],
+            );
+            bootstrap::interval_of(&scores, aggregate::mean, RESAMPLES, seed)
         })
         .collect()
 }
@@ -54,35 +64,34 @@ pub(super) fn beside_legend<DB: DrawingBackend>(
 }
 
 /// Fig. 5/7: moving average of `window` returns, averaged over runs, one line per method,
-/// with a band of ± one standard deviation of the runs' moving averages.
+/// with the 95% bootstrap interval of that mean as a band (`efficiency`: the
+/// sample-efficiency curves' points, one list per method, whose mean carries it).
 pub(super) fn learning_curve<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     data: &PlotData,
+    efficiency: &[Vec<EfficiencyPoint>],
 ) -> Drawn<DB> {
     root.fill(&WHITE)?;
     let w = data.window.max(1);
-    // Per method: the mean over runs of each run's moving average, and its spread.
-    let lines: Vec<(Vec<f64>, Vec<f64>)> = data
+    // Per method: the mean over runs of each run's moving average.
+    let lines: Vec<Vec<f64>> = data
         .curves
         .iter()
         .map(|c| {
             let averaged: Vec<Vec<f64>> = c.returns.iter().map(|r| moving_average(r, w)).collect();
-            (mean_over_runs(&averaged), std_over_runs(&averaged))
+            mean_over_runs(&averaged)
         })
         .collect();
-    let episodes = lines
-        .iter()
-        .map(|(l, _)| l.len() + w - 1)
-        .max()
-        .unwrap_or(w);
+    let episodes = lines.iter().map(|l| l.len() + w - 1).max().unwrap_or(w);
     let banded = |i: usize| data.curves[i].returns.len() > 1;
     let fit = axes::fit(
-        lines.iter().enumerate().flat_map(|(i, (mean, sd))| {
-            let sd = if banded(i) { sd.as_slice() } else { &[] };
-            mean.iter()
-                .copied()
-                .chain(mean.iter().zip(sd).flat_map(|(m, s)| [m - s, m + s]))
-        }),
+        lines.iter().flatten().copied().chain(
+            efficiency
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| banded(*i))
+                .flat_map(|(_, points)| points.iter().flat_map(|p| [p.mean.lo, p.mean.hi])),
+        ),
         data.return_range,
     );
     let (area, legend_area) = beside_legend(&root);
@@ -112,30 +121,26 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
         .label_style((FAMILY, 15))
         .draw()?;
     let pens = pens(&data.curves);
-    for (i, (mean, spread)) in lines.iter().enumerate() {
+    for (i, points) in efficiency.iter().enumerate() {
         if banded(i) {
-            let x = |e: usize| (e + w) as f64;
-            let band: Vec<(f64, f64)> = mean
+            let band: Vec<(f64, f64)> = points
                 .iter()
-                .zip(spread)
-                .enumerate()
-                .map(|(e, (m, s))| (x(e), fit.clamp(m + s)))
+                .map(|p| (p.episode as f64, fit.clamp(p.mean.hi)))
                 .chain(
-                    mean.iter()
-                        .zip(spread)
-                        .enumerate()
+                    points
+                        .iter()
                         .rev()
-                        .map(|(e, (m, s))| (x(e), fit.clamp(m - s))),
+                        .map(|p| (p.episode as f64, fit.clamp(p.mean.lo))),
                 )
                 .collect();
             chart.draw_series(std::iter::once(Polygon::new(
                 band,
-                pens[i].colour.mix(0.12).filled(),
+                pens[i].colour.mix(0.15).filled(),
             )))?;
         }
     }
     // The lines over every band.
-    for (i, (mean, _)) in lines.iter().enumerate() {
+    for (i, mean) in lines.iter().enumerate() {
         let points = mean
             .iter()
             .enumerate()
@@ -159,7 +164,7 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
         .collect();
     if !banded_runs.is_empty() {
         notes.push(format!(
-            "band: ± 1 sd over {}",
+            "band: 95% bootstrap CI of the mean over {}",
             legend::runs_phrase(banded_runs.iter().copied())
         ));
     }
@@ -172,20 +177,27 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
 }
 
 /// Fig. 6/8: the return of each greedy test episode, averaged over runs, as bars grouped
-/// by test and coloured by method, with ± one standard deviation over runs.
+/// by test and coloured by method, with the 95% bootstrap interval of that mean.
 pub(super) fn test_bars<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     data: &PlotData,
 ) -> Drawn<DB> {
     root.fill(&WHITE)?;
     let pens = pens(&data.curves);
-    // (method, its pen, mean over runs of each test, its spread).
-    let tested: Vec<(&Curve, Pen, Vec<f64>, Vec<f64>)> = data
+    // (method, its pen, mean over runs of each test, its 95% interval).
+    let tested: Vec<(&Curve, Pen, Vec<f64>, Vec<Estimate>)> = data
         .curves
         .iter()
         .zip(&pens)
         .filter(|(c, _)| !c.tests.is_empty())
-        .map(|(c, &pen)| (c, pen, mean_over_runs(&c.tests), std_over_runs(&c.tests)))
+        .map(|(c, &pen)| {
+            (
+                c,
+                pen,
+                mean_over_runs(&c.tests),
+                mean_intervals(&c.label, &c.tests),
+            )
+        })
         .collect();
     let tests = tested
         .iter()
@@ -198,12 +210,16 @@ pub(super) fn test_bars<DB: DrawingBackend>(
     let fit = axes::fit(
         tested
             .iter()
-            .flat_map(|(c, _, means, sd)| {
-                let sd = if whiskered(c) { sd.as_slice() } else { &[] };
+            .flat_map(|(c, _, means, intervals)| {
+                let intervals = if whiskered(c) {
+                    intervals.as_slice()
+                } else {
+                    &[]
+                };
                 means
                     .iter()
                     .copied()
-                    .chain(means.iter().zip(sd).flat_map(|(m, s)| [m - s, m + s]))
+                    .chain(intervals.iter().flat_map(|e| [e.lo, e.hi]))
             })
             .chain([0.0]),
         data.return_range,
@@ -235,7 +251,7 @@ pub(super) fn test_bars<DB: DrawingBackend>(
         .draw()?;
     let group = 0.8;
     let width = group / tested.len().max(1) as f64;
-    for (k, (curve, pen, means, spread)) in tested.iter().enumerate() {
+    for (k, (curve, pen, means, intervals)) in tested.iter().enumerate() {
         let left = |t: usize| t as f64 + 1.0 - group / 2.0 + k as f64 * width;
         chart.draw_series(
             means.iter().enumerate().flat_map(|(t, &v)| {
@@ -243,9 +259,9 @@ pub(super) fn test_bars<DB: DrawingBackend>(
             }),
         )?;
         if whiskered(curve) {
-            chart.draw_series(means.iter().zip(spread).enumerate().map(|(t, (&m, &sd))| {
+            chart.draw_series(means.iter().zip(intervals).enumerate().map(|(t, (&m, e))| {
                 let x = left(t) + width * 0.45;
-                ErrorBar::new_vertical(x, fit.clamp(m - sd), m, fit.clamp(m + sd), BLACK, 6)
+                ErrorBar::new_vertical(x, fit.clamp(e.lo), m, fit.clamp(e.hi), BLACK, 6)
             }))?;
         }
     }
@@ -264,7 +280,7 @@ pub(super) fn test_bars<DB: DrawingBackend>(
         .collect();
     if !whiskered_runs.is_empty() {
         notes.push(format!(
-            "whiskers: ± 1 sd over {}",
+            "whiskers: 95% bootstrap CI of the mean over {}",
             legend::runs_phrase(whiskered_runs)
         ));
     }
@@ -286,8 +302,8 @@ mod tests {
         assert!(mean_over_runs(&[]).is_empty());
     }
 
-    /// `tests.svg` drawn from two SAP-Net runs whose tests differ widely (mean 250 ± 353.6:
-    /// past both ends of CartPole's 0..500) and one DQN run.
+    /// `tests.svg` drawn from two SAP-Net runs whose tests differ widely (mean 250, its
+    /// interval from one run to the other: CartPole's whole 0..500) and one DQN run.
     #[test]
     fn the_test_bars_say_what_their_whiskers_are_and_where_they_stop() {
         let data = PlotData {
@@ -323,21 +339,26 @@ mod tests {
         for text in [
             "sapnet (2 runs)",
             "dqn[100] (1 run)",
-            "whiskers: ± 1 sd over 2 runs",
-            "whiskers clamped at the task",
-            "min 0",
-            "and max 500",
+            "whiskers: 95% bootstrap CI of the",
             "episode return",
         ] {
             assert!(svg.contains(text), "tests.svg lacks {text:?}");
         }
     }
 
+    /// Two runs resample to (a, a), (a, b) or (b, b): the mean's interval runs from one run
+    /// to the other; one run has none wider than itself.
     #[test]
-    fn spreads_are_sample_deviations_over_the_runs_that_reach_each_index() {
-        // Index 0: 1 and 3 → mean 2, (1 + 1)/1 → 1.4142; index 1: one run → 0.
-        let spread = std_over_runs(&[vec![1.0, 5.0], vec![3.0]]);
-        assert!((spread[0] - 2f64.sqrt()).abs() < 1e-12);
-        assert_eq!(spread[1], 0.0);
+    fn mean_intervals_cover_the_runs_that_reach_each_index() {
+        let intervals = mean_intervals("m", &[vec![0.0, 5.0], vec![500.0]]);
+        assert_eq!(intervals.len(), 2);
+        assert_eq!(
+            (intervals[0].point, intervals[0].lo, intervals[0].hi),
+            (250.0, 0.0, 500.0)
+        );
+        assert_eq!(
+            (intervals[1].point, intervals[1].lo, intervals[1].hi),
+            (5.0, 5.0, 5.0)
+        );
     }
 }

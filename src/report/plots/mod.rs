@@ -1,5 +1,6 @@
-//! The paper's figures, drawn with plotters: learning curves (Fig. 5 and 7) with a band of
-//! ± one standard deviation over runs, greedy test returns (Fig. 6 and 8), the activation
+//! The paper's figures, drawn with plotters: learning curves (Fig. 5 and 7) with the 95%
+//! bootstrap interval of the mean over runs as a band, how fast each method learns
+//! (`sample_efficiency.png`, the IQM's interval), greedy test returns (Fig. 6 and 8), the activation
 //! of every source policy over the episodes, and, per method that reuses the library, the
 //! share of the steps each source acted (`selections.png`). Every plot's y axis fits what
 //! it draws within the task's return range (`axes`), its legend sits beside the chart and
@@ -111,12 +112,17 @@ pub fn write_all(dir: &Path, data: &PlotData) -> Result<()> {
         curves::learning_curve(
             BitMapBackend::new(path, WITH_LEGEND).into_drawing_area(),
             data,
+            &efficiency,
         )
         .map_err(|e| e.to_string())
     })?;
     atomically(&dir.join("learning_curve.svg"), |path| {
-        curves::learning_curve(SVGBackend::new(path, WITH_LEGEND).into_drawing_area(), data)
-            .map_err(|e| e.to_string())
+        curves::learning_curve(
+            SVGBackend::new(path, WITH_LEGEND).into_drawing_area(),
+            data,
+            &efficiency,
+        )
+        .map_err(|e| e.to_string())
     })?;
     atomically(&dir.join("tests.png"), |path| {
         curves::test_bars(
@@ -177,7 +183,7 @@ pub(super) fn register_font() -> Result<()> {
 }
 
 pub use axes::return_bounds;
-pub use curves::{mean_over_runs, std_over_runs};
+pub use curves::mean_over_runs;
 pub use intervals::write_intervals;
 
 pub(super) type Drawn<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
@@ -231,7 +237,8 @@ mod tests {
         // What the band is, over the runs counted from the data (SAP-Net's two; DQN's one
         // run has none), the axis value in the title, the y label what it is.
         for text in [
-            "band: ± 1 sd over 2 runs",
+            "band: 95% bootstrap CI of the mean",
+            "over 2 runs",
             "a method of 1 run has no band",
             "sapnet.temperature = 1.0 · CartPole-v1",
             "episode return, MA2",
