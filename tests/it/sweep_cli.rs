@@ -186,7 +186,8 @@ fn a_sweep_through_gnu_parallel_survives_a_killed_cell() {
     let curve = std::fs::read_to_string(value.join("learning_curve.svg")).unwrap();
     for text in [
         "sapnet.temperature = 4.0 · ",
-        "band: ± 1 sd over 6 runs",
+        "band: 95% bootstrap CI of the mean",
+        "over 6 runs",
         "sapnet (6 runs)",
     ] {
         assert!(curve.contains(text), "learning_curve.svg lacks {text:?}");

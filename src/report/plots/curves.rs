@@ -1,12 +1,14 @@
 //! The paper's figures: learning curves (Fig. 5 and 7) with a band over runs, and the
 //! greedy test returns (Fig. 6 and 8).
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::axes::{self, Fit};
 use super::legend::{self, Entry, Swatch};
 use super::palette::{method_pens, Pen};
-use super::{axes, Curve, Drawn, PlotData, FAMILY};
+use super::{Curve, Drawn, PlotData, FAMILY};
 use crate::report::runs::moving_average;
 use crate::report::sample_efficiency::EfficiencyPoint;
 use crate::seeds::{self, Part};
@@ -47,6 +49,53 @@ pub fn mean_intervals(label: &str, series: &[Vec<f64>]) -> Vec<Estimate> {
             bootstrap::interval_of(&scores, aggregate::mean, RESAMPLES, seed)
         })
         .collect()
+}
+
+/// A chart of returns over episodes.
+pub(super) type EpisodeChart<'a, DB> =
+    ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// The chart of a curve over episodes in `area`: x the episodes `(last, window)`, y fitted
+/// by `fit`, labelled as every curve of these figures is.
+pub(super) fn episode_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: String,
+    y_desc: String,
+    (episodes, w): (usize, usize),
+    fit: &Fit,
+) -> Result<EpisodeChart<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, (FAMILY, 20))
+        .margin(12)
+        // Room for the last x label, which plotters centres on the axis's end.
+        .margin_right(30)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0f64..episodes as f64, fit.low..fit.high)?;
+    chart
+        .configure_mesh()
+        .x_desc(format!("episode (the last of each window of {w})"))
+        .y_desc(y_desc)
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .y_label_formatter(&|y| format!("{y:.0}"))
+        .label_style((FAMILY, 15))
+        .draw()?;
+    Ok(chart)
+}
+
+/// A translucent band of `pen`'s colour through the intervals `(episode, estimate)`,
+/// clamped to the chart's fit.
+pub(super) fn band_polygon(
+    intervals: impl Iterator<Item = (usize, Estimate)> + Clone,
+    fit: &Fit,
+    pen: Pen,
+) -> Polygon<(f64, f64)> {
+    let upper = intervals.clone().map(|(x, e)| (x as f64, fit.clamp(e.hi)));
+    let lower: Vec<(f64, f64)> = intervals
+        .map(|(x, e)| (x as f64, fit.clamp(e.lo)))
+        .collect();
+    let points = upper.chain(lower.into_iter().rev()).collect::<Vec<_>>();
+    Polygon::new(points, pen.colour.mix(0.15).filled())
 }
 
 /// The methods' pens, in the order listed.
@@ -95,48 +144,22 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
         data.return_range,
     );
     let (area, legend_area) = beside_legend(&root);
-    let mut chart = ChartBuilder::on(&area)
-        .caption(
-            legend::title(
-                data.subject.as_deref(),
-                &format!(
-                    "{}: episode return, moving average of {w}, mean over runs",
-                    data.task
-                ),
-            ),
-            (FAMILY, 20),
-        )
-        .margin(12)
-        // Room for the last x label, which plotters centres on the axis's end.
-        .margin_right(30)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0f64..episodes as f64, fit.low..fit.high)?;
-    chart
-        .configure_mesh()
-        .x_desc(format!("episode (the last of each window of {w})"))
-        .y_desc(format!("episode return, MA{w}"))
-        .x_label_formatter(&|x| format!("{x:.0}"))
-        .y_label_formatter(&|y| format!("{y:.0}"))
-        .label_style((FAMILY, 15))
-        .draw()?;
+    let caption = format!(
+        "{}: episode return, moving average of {w}, mean over runs",
+        data.task
+    );
+    let mut chart = episode_chart(
+        &area,
+        legend::title(data.subject.as_deref(), &caption),
+        format!("episode return, MA{w}"),
+        (episodes, w),
+        &fit,
+    )?;
     let pens = pens(&data.curves);
     for (i, points) in efficiency.iter().enumerate() {
         if banded(i) {
-            let band: Vec<(f64, f64)> = points
-                .iter()
-                .map(|p| (p.episode as f64, fit.clamp(p.mean.hi)))
-                .chain(
-                    points
-                        .iter()
-                        .rev()
-                        .map(|p| (p.episode as f64, fit.clamp(p.mean.lo))),
-                )
-                .collect();
-            chart.draw_series(std::iter::once(Polygon::new(
-                band,
-                pens[i].colour.mix(0.15).filled(),
-            )))?;
+            let band = points.iter().map(|p| (p.episode, p.mean));
+            chart.draw_series(std::iter::once(band_polygon(band, &fit, pens[i])))?;
         }
     }
     // The lines over every band.

@@ -4,9 +4,9 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::curves::{beside_legend, pens};
+use super::curves::{band_polygon, beside_legend, episode_chart, pens};
 use super::legend::{self, Entry, Swatch};
-use super::{axes, Drawn, PlotData, FAMILY};
+use super::{axes, Drawn, PlotData};
 use crate::report::sample_efficiency::EfficiencyPoint;
 
 /// Draws `points` (one curve per method of `data`, in its order).
@@ -30,50 +30,25 @@ pub(super) fn sample_efficiency<DB: DrawingBackend>(
         data.return_range,
     );
     let (area, legend_area) = beside_legend(&root);
-    let mut chart = ChartBuilder::on(&area)
-        .caption(
-            legend::title(
-                data.subject.as_deref(),
-                &format!(
-                    "{}: IQM over runs of the episode return's moving average of {w}",
-                    data.task
-                ),
-            ),
-            (FAMILY, 20),
-        )
-        .margin(12)
-        .margin_right(30)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0f64..episodes as f64, fit.low..fit.high)?;
-    chart
-        .configure_mesh()
-        .x_desc(format!("episode (the last of each window of {w})"))
-        .y_desc(format!("episode return, MA{w}: IQM over runs"))
-        .x_label_formatter(&|x| format!("{x:.0}"))
-        .y_label_formatter(&|y| format!("{y:.0}"))
-        .label_style((FAMILY, 15))
-        .draw()?;
+    let caption = format!(
+        "{}: IQM over runs of the episode return's moving average of {w}",
+        data.task
+    );
+    let mut chart = episode_chart(
+        &area,
+        legend::title(data.subject.as_deref(), &caption),
+        format!("episode return, MA{w}: IQM over runs"),
+        (episodes, w),
+        &fit,
+    )?;
     let pens = pens(&data.curves);
     let banded = |curve: &[EfficiencyPoint]| curve.iter().any(|p| p.runs > 1);
     for (curve, pen) in points.iter().zip(&pens) {
         if !banded(curve) {
             continue;
         }
-        let band: Vec<(f64, f64)> = curve
-            .iter()
-            .map(|p| (p.episode as f64, fit.clamp(p.iqm.hi)))
-            .chain(
-                curve
-                    .iter()
-                    .rev()
-                    .map(|p| (p.episode as f64, fit.clamp(p.iqm.lo))),
-            )
-            .collect();
-        chart.draw_series(std::iter::once(Polygon::new(
-            band,
-            pen.colour.mix(0.15).filled(),
-        )))?;
+        let band = curve.iter().map(|p| (p.episode, p.iqm));
+        chart.draw_series(std::iter::once(band_polygon(band, &fit, *pen)))?;
     }
     for (curve, &pen) in points.iter().zip(&pens) {
         let line = curve
