@@ -1,0 +1,36 @@
+"""Per run, the share of the acting steps each source task took, from a results folder's
+summary.json (`runs[].source_steps`, the library's `task` per source, as `sapnet` wrote
+them): for one task (a substring of its name), every run's share, how many runs gave it
+most of their steps, and the share over all runs' steps (comparison.csv's `share_<task>`).
+
+    python3 scripts/task_shares.py DIR TASK [METHOD ...]
+
+Only the standard library.
+"""
+import collections
+import json
+import sys
+
+directory, task = sys.argv[1], sys.argv[2]
+wanted = sys.argv[3:]
+with open(f"{directory}/summary.json") as f:
+    summary = json.load(f)
+tasks = [entry["task"] for entry in summary["library"]]
+hit = [i for i, t in enumerate(tasks) if task in t]
+if not hit:
+    raise SystemExit(f"no source task matches {task!r}: {sorted(set(tasks))}")
+by = collections.defaultdict(list)
+for run in summary["runs"]:
+    steps = run.get("source_steps") or []
+    if sum(steps):
+        by[run["method"]].append((run["run"], sum(steps[i] for i in hit), sum(steps), run.get("chosen")))
+for method, runs in by.items():
+    if wanted and method not in wanted:
+        continue
+    shares = [h / t for _, h, t, _ in runs]
+    most = sum(1 for s in shares if s > 0.5)
+    pooled = sum(h for _, h, _, _ in runs) / sum(t for _, _, t, _ in runs)
+    handed = sum(1 for *_, c in runs if c and c["index"] in hit)
+    print(f"{method:24} pooled {pooled:.0%}, runs above half {most}/{len(runs)}, "
+          f"handed over a {task} source {handed}/{len(runs)}, per run "
+          + " ".join(f"{s:.2f}" for s in shares))
