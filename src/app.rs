@@ -43,6 +43,16 @@ pub fn run(cli: Cli) -> Result<()> {
             }
             print_stdout(&report.table())
         }
+        Some(Command::Compare(args)) => {
+            let report = crate::compare::compare(args)?;
+            eprintln!(
+                "compared {} methods into {}: comparison.csv, improvement.csv, scores.csv, runs.csv, sample_efficiency.csv and the plots; `test` is each run's final score, the mean return of its last {} episodes",
+                report.comparison.len(),
+                args.out.display(),
+                args.last
+            );
+            print_stdout(&report.table())
+        }
         Some(Command::Plot(args)) => {
             let summary = results::replot(&args.dir)?;
             eprintln!(
@@ -68,6 +78,7 @@ fn refuse_non_utf8_paths(cli: &Cli) -> Result<()> {
     }
     match &cli.command {
         Some(Command::Pool(args)) => paths.push(("--out", &args.out)),
+        Some(Command::Compare(args)) => paths.push(("--out", &args.out)),
         Some(Command::Sweep(args)) => {
             if let SweepCommand::Plan { out, .. } = &args.command {
                 paths.push(("--out", out));
@@ -98,6 +109,7 @@ fn refuse_unread_flags(cli: &Cli, command: &Command) -> Result<()> {
         },
         Command::Plot(_) => "plot",
         Command::Pool(_) => "pool",
+        Command::Compare(_) => "compare",
         Command::Sweep(args) => match args.command {
             SweepCommand::Plan { .. } => "sweep plan",
             SweepCommand::Run { .. } => "sweep run",

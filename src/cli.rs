@@ -193,6 +193,12 @@ pub const SUBCOMMANDS: &[SubcommandFlags] = &[
         library: None,
     },
     SubcommandFlags {
+        name: "compare",
+        reads: &[],
+        config: None,
+        library: None,
+    },
+    SubcommandFlags {
         name: "pool",
         reads: &[],
         config: None,
@@ -377,6 +383,11 @@ pub enum Command {
     /// CartPole and of MountainCar): each method's scores normalised by each task's range
     /// of returns and resampled within each task; written to --out with its plots.
     Pool(PoolArgs),
+    /// Runs that already exist, made by other tools or by sapnet (SB3 monitor.csv files,
+    /// CleanRL / openrlbenchmark CSV exports, TensorBoard event files, results folders),
+    /// compared with the intervals, the separation rule and the plots of a protocol's
+    /// report, written to --out.
+    Compare(CompareArgs),
     /// Sweeps: a grid of configs as independent cells, run by Slurm array jobs, GNU
     /// parallel or this machine, then merged (docs/SWEEPS.md).
     Sweep(SweepArgs),
@@ -440,6 +451,55 @@ pub struct PlotArgs {
     /// The results directory (a headless run's --out).
     #[arg(value_name = "DIR")]
     pub dir: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// A method and its runs, each PATH one run: an SB3 monitor.csv, a CSV with a header
+    /// (an episodic-return column beside a step or episode column), a TensorBoard event
+    /// file or a folder of them; or a sapnet results folder, whose runs of the method NAME
+    /// (or LABEL, written DIR#LABEL) are taken. Repeat the flag for each method, or for
+    /// more runs of one.
+    #[arg(long = "method", value_name = "NAME=PATH[,PATH…]", required = true)]
+    pub methods: Vec<String>,
+    /// Where the report goes (a new or empty directory).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// The lowest and highest return of the task, which normalise the scores (the
+    /// optimality gap, the profiles). Default: a results folder's task, else the lowest
+    /// and highest return read (with a warning: adding a run would move every score).
+    #[arg(long, num_args = 2, value_names = ["LO", "HI"], allow_negative_numbers = true)]
+    pub range: Option<Vec<f64>>,
+    /// The final score is the mean return of each run's last K episodes.
+    #[arg(long, value_name = "K", default_value_t = 100)]
+    pub last: usize,
+    /// The moving average's window, in episodes, for the curves.
+    #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
+    pub window: u32,
+    /// The task's name in titles. Default: a results folder's task, else `runs`.
+    #[arg(long, value_name = "NAME")]
+    pub task: Option<String>,
+    /// A CSV's episodic-return column. Default: the first of charts/episodic_return,
+    /// episodic_return, return, r.
+    #[arg(long, value_name = "COLUMN")]
+    pub return_column: Option<String>,
+    /// A CSV's step column. Default: the first of global_step, step, _step.
+    #[arg(long, value_name = "COLUMN", conflicts_with = "episode_column")]
+    pub step_column: Option<String>,
+    /// A CSV's episode column, for files without a step column. Default: episode.
+    #[arg(long, value_name = "COLUMN")]
+    pub episode_column: Option<String>,
+    /// A CSV's episode-length column. Default: the first of charts/episodic_length,
+    /// episodic_length, length, l, if any.
+    #[arg(long, value_name = "COLUMN")]
+    pub length_column: Option<String>,
+    /// The tag of episodic returns in event files. Default: charts/episodic_return.
+    #[arg(long, value_name = "TAG")]
+    pub tag: Option<String>,
+    /// Event files without the return tag are read from SB3's rollout/ep_rew_mean (a
+    /// moving mean of 100 episodes, not each episode's return).
+    #[arg(long)]
+    pub rollout_mean: bool,
 }
 
 #[derive(Debug, Args)]

@@ -15,7 +15,8 @@
 //! - [`tensorboard`]: TensorBoard's event files, written (scalars, hyper-parameters) and
 //!   read; [`outside_runs`]: runs made by other tools (Stable-Baselines3's monitor files,
 //!   CSV exports, event files) read as episodes and scored as sapnet scores its own.
-//! - [`headless`]: the scripted front end over the trainer's events.
+//! - [`headless`]: the scripted front end over the trainer's events; [`compare`]: runs that
+//!   already exist (other tools' or sapnet's) through the same report.
 //! - [`teach`]: stepping activation and spreading by hand on a small graph.
 //! - [`tui`]: the terminal dashboard over the trainer's events, and interactive teach mode.
 //! - [`config`]: the RON run configuration, with the paper's values as defaults.
@@ -24,6 +25,7 @@ pub mod app;
 pub mod assets;
 pub mod checkpoints;
 pub mod cli;
+pub mod compare;
 pub mod config;
 pub mod dqn;
 pub mod env;

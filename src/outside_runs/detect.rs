@@ -1,8 +1,15 @@
 //! A run file's format, told from its first bytes: a name says what its writer meant, the
 //! bytes what it is.
 
-use super::Format;
 use crate::tensorboard;
+
+/// What a run's file can be told to be from its bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    Monitor,
+    Csv,
+    EventFiles,
+}
 
 /// How many bytes of a file its format is told from.
 pub const PREFIX_BYTES: u64 = 4096;

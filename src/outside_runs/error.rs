@@ -68,6 +68,15 @@ pub enum OutsideRunError {
         tried: Vec<String>,
         found: Vec<String>,
     },
+    #[error("{}: no run of method {method:?} (its methods are {})", path.display(), listed(found))]
+    NoSuchMethod {
+        path: PathBuf,
+        method: String,
+        found: Vec<String>,
+    },
+    #[error("{}: the folder's episodes are compressed; decompress them beside it first \
+             (`xz -dk {}`)", path.display(), path.display())]
+    Compressed { path: PathBuf },
     #[error("{}: {error}", path.display())]
     Csv { path: PathBuf, error: csv::Error },
     #[error(transparent)]

@@ -9,6 +9,9 @@
 //! - a TensorBoard event file, or a folder of them (`event_files.rs`): the scalars of one
 //!   tag, [`RETURN_TAG`] unless the caller names another.
 //!
+//! - a sapnet results folder (`results_folder.rs`): the runs of one of its methods, each
+//!   run one run.
+//!
 //! The format is told from the file's content (`detect.rs`), never from its name. Files are
 //! read through [`crate::safe_io`]: regular files only, bounded in size; the path given
 //! is the user's and may be a link, files found inside a folder may not.
@@ -21,6 +24,7 @@ mod error;
 mod event_files;
 mod exported_csv;
 mod monitor;
+pub mod results_folder;
 mod scores;
 mod table;
 
@@ -65,6 +69,8 @@ pub enum Format {
     Csv,
     /// A TensorBoard event file, or a folder of them.
     EventFiles,
+    /// A sapnet results folder's `episodes.csv`: one run of one method in it.
+    ResultsFolder,
 }
 
 /// What [`Episode::at`] counts.
@@ -149,9 +155,9 @@ pub fn read_run(path: &Path, options: &ReadOptions) -> Result<OutsideRun, Outsid
         .and_then(|_| file.rewind())
         .map_err(io_error)?;
     match detect::format(&prefix) {
-        Ok(Format::Monitor) => monitor::read(file, path),
-        Ok(Format::Csv) => exported_csv::read(file, path, options),
-        Ok(Format::EventFiles) => event_files::read_file(file, path, options),
+        Ok(detect::Format::Monitor) => monitor::read(file, path),
+        Ok(detect::Format::Csv) => exported_csv::read(file, path, options),
+        Ok(detect::Format::EventFiles) => event_files::read_file(file, path, options),
         Err(why) => Err(OutsideRunError::UnknownFormat {
             path: path.to_path_buf(),
             why,

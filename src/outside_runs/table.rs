@@ -103,11 +103,16 @@ pub struct Cell<'a> {
     column: usize,
 }
 
-impl Cell<'_> {
+impl<'a> Cell<'a> {
     /// Whether it holds nothing: in an export of several series, a row where this one was
     /// not logged.
     pub fn is_empty(&self) -> bool {
         self.text.is_empty()
+    }
+
+    /// Its text, trimmed.
+    pub fn text(&self) -> &'a str {
+        self.text
     }
 
     /// A finite episodic return.

@@ -11,6 +11,7 @@ pub mod improvement;
 pub mod plots;
 pub mod runs;
 pub mod sample_efficiency;
+pub mod scored;
 pub mod scores;
 
 use std::collections::BTreeMap;
@@ -155,9 +156,20 @@ impl Report {
             scores.extend(per_task.iter().flatten().map(|(_, s)| s.clone()));
             methods.push(method_runs(label, method.kind(), tasks, &per_task, units));
         }
-        let comparison = comparison::compare(&methods, units);
-        let task_names: Vec<String> = tasks.iter().map(|t| t.task.to_string()).collect();
-        let improvement = improvement::every_pair(&methods, &task_names);
+        let tasks: Vec<String> = tasks.iter().map(|t| t.task.to_string()).collect();
+        Self::of_methods(units, tasks, &methods, scores, left_out)
+    }
+
+    /// The report of `methods`' runs on `tasks`: every measure, pair and profile.
+    pub(crate) fn of_methods(
+        units: Units,
+        tasks: Vec<String>,
+        methods: &[MethodRuns],
+        scores: Vec<RunScores>,
+        left_out: Vec<String>,
+    ) -> Self {
+        let comparison = comparison::compare(methods, units);
+        let improvement = improvement::every_pair(methods, &tasks);
         let levels = profile::levels();
         let profiles = methods
             .iter()
@@ -183,7 +195,7 @@ impl Report {
             .map(|m| m.label.clone());
         Self {
             units,
-            tasks: tasks.iter().map(|t| t.task.to_string()).collect(),
+            tasks,
             comparison,
             improvement,
             scores,

@@ -87,6 +87,9 @@ pub enum Tested {
     BestRecorded,
     /// The method's own learner, not a source.
     Learner,
+    /// Nothing: a run of another tool (`sapnet compare`) has no greedy test, and the mean
+    /// return of its last episodes stands in the test score's place.
+    LastEpisodes,
 }
 
 impl Tested {
@@ -98,6 +101,7 @@ impl Tested {
             Self::MostPlayed => "most-played",
             Self::BestRecorded => "best-recorded",
             Self::Learner => "learner",
+            Self::LastEpisodes => "last-episodes",
         }
     }
 }

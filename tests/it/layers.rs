@@ -33,7 +33,14 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("the dispatch", &["app"]),
     (
         "front ends",
-        &["tui", "headless", "sweep", "teach", "env_command"],
+        &[
+            "tui",
+            "headless",
+            "sweep",
+            "teach",
+            "env_command",
+            "compare",
+        ],
     ),
     ("the command line's arguments", &["cli"]),
     ("results folders", &["results"]),

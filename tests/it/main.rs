@@ -13,6 +13,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod compare_cli;
 mod config_files;
 mod dqn_agent;
 mod dqn_learns;

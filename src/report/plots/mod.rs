@@ -124,13 +124,16 @@ pub fn write_all(dir: &Path, data: &PlotData) -> Result<()> {
         )
         .map_err(|e| e.to_string())
     })?;
-    atomically(&dir.join("tests.png"), |path| {
-        curves::test_bars(
-            BitMapBackend::new(path, WITH_LEGEND).into_drawing_area(),
-            data,
-        )
-        .map_err(|e| e.to_string())
-    })?;
+    // Runs of other tools (`sapnet compare`) have no greedy tests: no empty figure.
+    if data.curves.iter().any(|c| !c.tests.is_empty()) {
+        atomically(&dir.join("tests.png"), |path| {
+            curves::test_bars(
+                BitMapBackend::new(path, WITH_LEGEND).into_drawing_area(),
+                data,
+            )
+            .map_err(|e| e.to_string())
+        })?;
+    }
     if !data.activations.is_empty() {
         atomically(&dir.join("activations.png"), |path| {
             library::activation_lines(BitMapBackend::new(path, SIZE).into_drawing_area(), data)

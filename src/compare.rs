@@ -1,0 +1,255 @@
+//! `sapnet compare`: runs that already exist — Stable-Baselines3 monitor files, CSV exports
+//! of CleanRL or openrlbenchmark, TensorBoard event files, sapnet results folders — put
+//! through the report a protocol writes: each method's training return and final score
+//! with their 95% intervals, every pair by the separation rule, the sample-efficiency
+//! curves and the plots (issue 38, item 4).
+//!
+//! Scores are as for sapnet's own runs: a run's **training return** is the mean return of
+//! all its episodes, its **final score** the mean of its last `--last` episodes (in the
+//! report's `test` columns, `tested` = `last-episodes`). Runs of unequal length are each
+//! scored over their own episodes; the curves at an episode are over the runs that reach
+//! it. The bounds that normalise scores (the optimality gap, the profiles) are fixed by
+//! `--range`, else taken from the results folders' task, else from the data, with a
+//! warning: then adding a run can move every normalised score.
+
+use std::num::NonZeroUsize;
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+
+use crate::cli::CompareArgs;
+use crate::outside_runs::{self, results_folder, OutsideRun, PositionColumn, ReadOptions};
+use crate::report::plots::{Curve, PlotData};
+use crate::report::scored::{ScoredMethod, ScoredRun};
+use crate::report::{self, Report};
+use crate::reuse::{MethodKind, Tested};
+
+/// One `--method`: its name and the runs read for it.
+struct Method {
+    name: String,
+    runs: Vec<OutsideRun>,
+    /// The task of each results folder its runs came from (its return range and name).
+    tasks: Vec<(String, (f64, f64))>,
+}
+
+/// Reads every method's runs, writes the report into `--out` and returns it.
+pub fn compare(args: &CompareArgs) -> Result<Report> {
+    let last = NonZeroUsize::new(args.last).context("--last: expected at least 1 episode")?;
+    let options = read_options(args);
+    let mut methods: Vec<Method> = Vec::new();
+    for given in &args.methods {
+        let (name, paths) = parse_method(given)?;
+        let index = match methods.iter().position(|m| m.name == name) {
+            Some(index) => index,
+            None => {
+                methods.push(Method {
+                    name: name.clone(),
+                    runs: Vec::new(),
+                    tasks: Vec::new(),
+                });
+                methods.len() - 1
+            }
+        };
+        for path in paths {
+            read_path(&mut methods[index], &path, &options)?;
+        }
+    }
+    if methods.len() < 2 {
+        bail!("--method: expected at least two methods to compare (each `--method NAME=PATH`)");
+    }
+    let (task, range) = task_and_range(args, &methods)?;
+    let out = &args.out;
+    if out.exists() && std::fs::read_dir(out)?.next().is_some() {
+        bail!("--out {}: expected a new or empty directory", out.display());
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+
+    let kinds = kinds(methods.len());
+    let scored: Vec<ScoredMethod> = methods
+        .iter()
+        .zip(&kinds)
+        .map(|(m, &kind)| ScoredMethod {
+            label: m.name.clone(),
+            kind,
+            runs: m
+                .runs
+                .iter()
+                .map(|r| ScoredRun {
+                    training_return: r.training_return(),
+                    final_score: r.final_score(last),
+                    episodes: r.episodes.len(),
+                })
+                .collect(),
+        })
+        .collect();
+    let report = Report::of_scored(&task, range, &scored);
+    report.write(out)?;
+    let data = PlotData {
+        task: task.clone(),
+        subject: None,
+        return_range: Some(range),
+        window: args.window as usize,
+        curves: methods
+            .iter()
+            .zip(&kinds)
+            .map(|(m, &kind)| Curve {
+                label: m.name.clone(),
+                kind,
+                returns: m.runs.iter().map(|r| r.returns().collect()).collect(),
+                tests: Vec::new(),
+            })
+            .collect(),
+        policy_names: Vec::new(),
+        activations: Vec::new(),
+        acted: Vec::new(),
+    };
+    report::write_plots(out, &data)?;
+    write_runs(&out.join("runs.csv"), &methods, last)?;
+    Ok(report)
+}
+
+/// `NAME=PATH[,PATH…]`: the method's name (a portable name: it names columns and is
+/// matched against a results folder's labels) and its paths.
+fn parse_method(given: &str) -> Result<(String, Vec<PathBuf>)> {
+    let Some((name, paths)) = given.split_once('=') else {
+        bail!("--method {given:?}: expected NAME=PATH[,PATH…]");
+    };
+    crate::reuse::check_label("--method", name)
+        .map_err(|why| anyhow::anyhow!("--method {given:?}: {why}"))?;
+    let paths: Vec<PathBuf> = paths
+        .split(',')
+        .filter(|p| !p.is_empty())
+        .map(PathBuf::from)
+        .collect();
+    if paths.is_empty() {
+        bail!("--method {given:?}: expected at least one PATH after `{name}=`");
+    }
+    Ok((name.to_string(), paths))
+}
+
+/// A run's file, or a folder of event files (one run), or a results folder: the runs of
+/// the method named as this one, or of `LABEL` for `DIR#LABEL`.
+fn read_path(method: &mut Method, path: &Path, options: &ReadOptions) -> Result<()> {
+    let text = path.to_string_lossy();
+    let (dir, label) = match text.rsplit_once('#') {
+        Some((dir, label)) if results_folder::is_results_folder(Path::new(dir)) => {
+            (PathBuf::from(dir), label.to_string())
+        }
+        _ => (path.to_path_buf(), method.name.clone()),
+    };
+    if results_folder::is_results_folder(&dir) {
+        let header = crate::results::read_header(&dir)?;
+        let env = &header.config.env;
+        method.tasks.push((env.gym_id(), env.return_range()));
+        method
+            .runs
+            .extend(results_folder::read_method(&dir, &label)?);
+    } else {
+        method.runs.push(outside_runs::read_run(path, options)?);
+    }
+    Ok(())
+}
+
+fn read_options(args: &CompareArgs) -> ReadOptions {
+    ReadOptions {
+        return_column: args.return_column.clone(),
+        position_column: match (&args.step_column, &args.episode_column) {
+            (Some(step), _) => Some(PositionColumn::Step(step.clone())),
+            (None, Some(episode)) => Some(PositionColumn::Episode(episode.clone())),
+            (None, None) => None,
+        },
+        length_column: args.length_column.clone(),
+        tag: args.tag.clone(),
+        rollout_mean: args.rollout_mean,
+    }
+}
+
+/// The task's name and the bounds that normalise its returns: `--task` and `--range` when
+/// given, else the results folders' own when every run came from folders of one task, else
+/// `runs` and the lowest and highest return read, said in a warning.
+fn task_and_range(args: &CompareArgs, methods: &[Method]) -> Result<(String, (f64, f64))> {
+    let folders: Vec<&(String, (f64, f64))> = methods.iter().flat_map(|m| &m.tasks).collect();
+    let every_run_from_a_folder = methods
+        .iter()
+        .flat_map(|m| &m.runs)
+        .all(|r| r.format == outside_runs::Format::ResultsFolder);
+    let from_folders =
+        every_run_from_a_folder && !folders.is_empty() && folders.windows(2).all(|w| w[0] == w[1]);
+    let folder_task = from_folders.then(|| folders[0].clone());
+    let task = args
+        .task
+        .clone()
+        .or_else(|| folder_task.as_ref().map(|(t, _)| t.clone()))
+        .unwrap_or_else(|| "runs".to_string());
+    let range = match (&args.range, &folder_task) {
+        (Some(range), _) => (range[0], range[1]),
+        (None, Some((_, range))) => *range,
+        (None, None) => {
+            let returns = methods
+                .iter()
+                .flat_map(|m| &m.runs)
+                .flat_map(|r| r.returns());
+            let (lo, hi) = returns.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            });
+            eprintln!(
+                "warning: no --range: scores are normalised by the lowest and highest return \
+                 read ({lo} to {hi}), so adding a run can move every normalised score (the \
+                 optimality gap, the profiles); fix the bounds with --range LO HI"
+            );
+            (lo, hi)
+        }
+    };
+    if !(range.0.is_finite() && range.1.is_finite() && range.0 < range.1) {
+        bail!(
+            "--range {} {}: expected two finite returns, the lowest below the highest",
+            range.0,
+            range.1
+        );
+    }
+    Ok((task, range))
+}
+
+/// Each method a family of its own, its hue a golden angle from the last: methods from
+/// elsewhere are not variants of one another.
+fn kinds(count: usize) -> Vec<MethodKind> {
+    (0..count)
+        .map(|i| MethodKind {
+            family: "Outside",
+            hue: ((i as f64 * 137.508 + 210.0) % 360.0) as u16,
+            saturation: 65,
+            reuses: false,
+            tested: Tested::LastEpisodes,
+            picks_by_probability: false,
+            spreads: false,
+        })
+        .collect()
+}
+
+/// `runs.csv`: where each run came from and what it scored, one row per run.
+fn write_runs(path: &Path, methods: &[Method], last: NonZeroUsize) -> Result<()> {
+    let header: Vec<String> = [
+        "method", "run", "path", "format", "series", "axis", "episodes", "return", "final",
+    ]
+    .map(String::from)
+    .to_vec();
+    let records: Vec<Vec<String>> = methods
+        .iter()
+        .flat_map(|m| {
+            m.runs.iter().enumerate().map(move |(r, run)| {
+                vec![
+                    m.name.clone(),
+                    r.to_string(),
+                    run.path.to_string_lossy().into_owned(),
+                    format!("{:?}", run.format),
+                    run.series.clone(),
+                    format!("{:?}", run.axis),
+                    run.episodes.len().to_string(),
+                    format!("{:?}", run.training_return()),
+                    format!("{:?}", run.final_score(last)),
+                ]
+            })
+        })
+        .collect();
+    report::write_rows(path, &header, &records)
+}
