@@ -108,14 +108,29 @@ pub fn compare(args: &CompareArgs) -> Result<Report> {
     Ok(report)
 }
 
-/// `NAME=PATH[,PATH…]`: the method's name (a portable name: it names columns and is
-/// matched against a results folder's labels) and its paths.
+/// The longest method name: a legend's line.
+const LONGEST_NAME: usize = 120;
+
+/// Whether `name` may name a method: the characters of sapnet's own labels (a results
+/// folder's are matched against it), none that a terminal or a plot would take otherwise.
+fn is_method_name(name: &str) -> bool {
+    (1..=LONGEST_NAME).contains(&name.len())
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "._-[],+".contains(c))
+}
+
+/// `NAME=PATH[,PATH…]`: the method's name and its paths.
 fn parse_method(given: &str) -> Result<(String, Vec<PathBuf>)> {
     let Some((name, paths)) = given.split_once('=') else {
         bail!("--method {given:?}: expected NAME=PATH[,PATH…]");
     };
-    crate::reuse::check_label("--method", name)
-        .map_err(|why| anyhow::anyhow!("--method {given:?}: {why}"))?;
+    if !is_method_name(name) {
+        bail!(
+            "--method {given:?}: expected NAME=PATH[,PATH…] with NAME of 1 to {LONGEST_NAME} \
+             ASCII letters, digits and `._-[],+` (as sapnet's own labels: `dqn[100,100]`)"
+        );
+    }
     let paths: Vec<PathBuf> = paths
         .split(',')
         .filter(|p| !p.is_empty())

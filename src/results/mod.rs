@@ -9,6 +9,7 @@ pub mod plot_data;
 pub mod pool;
 pub mod records;
 pub mod replot;
+pub mod shipped;
 pub mod summary;
 
 use std::collections::BTreeMap;
@@ -33,12 +34,21 @@ pub(crate) fn require_records(dir: &Path, header: &SummaryHeader) -> Result<()> 
     if !header.listed_runs.is_empty() && !records::any(dir)? {
         anyhow::bail!(
             "{}: summary.json lists {} runs but the folder holds none of their records \
-             ({}/{}/<run>/run.json): a report shipped without them can be read (its CSV \
-             files) but not made again or pooled; use the protocol's own output folder",
+             ({}/{}/<run>/run.json): a report shipped without them is made again by \
+             `sapnet plot` from its episodes.csv ({}), but not pooled or resumed; use the \
+             protocol's own output folder",
             dir.display(),
             header.listed_runs.len(),
             dir.display(),
-            records::RUNS
+            records::RUNS,
+            if dir.join("episodes.csv.xz").exists() {
+                format!(
+                    "decompress it first: xz -dk {}",
+                    dir.join("episodes.csv.xz").display()
+                )
+            } else {
+                "absent here".to_string()
+            }
         );
     }
     Ok(())

@@ -2,7 +2,9 @@
 //! `summary.json` (the config: task, methods, moving-average window) and the run records
 //! — exactly as the run that wrote them made them: for a run stopped before its plots, a
 //! folder of an older version, or one whose process was killed (`summary.json` still says
-//! `running`: its finished runs are put together and it is marked `interrupted`).
+//! `running`: its finished runs are put together and it is marked `interrupted`); for a
+//! finished protocol shipped without its run records, from its top-level files
+//! ([`super::shipped`]).
 
 use std::path::Path;
 
@@ -20,6 +22,12 @@ pub fn replot(dir: &Path) -> Result<Summary> {
     // A folder whose protocol still runs is that process's to write: refused, naming it.
     let _lock = crate::folder_lock::FolderLock::acquire(dir, "sapnet plot")?;
     let header = read_header(dir)?;
+    if !header.listed_runs.is_empty()
+        && !super::records::any(dir)?
+        && super::shipped::can_replot(dir)
+    {
+        return super::shipped::replot(dir, header);
+    }
     super::require_records(dir, &header)?;
     let status = match header.status {
         Some(Status::Running) => Status::Interrupted,

@@ -127,7 +127,7 @@ pub fn read_header(dir: &Path) -> Result<SummaryHeader> {
 
 /// The largest `summary.json` read: every run's totals, a few kilobytes each, for the most
 /// runs a protocol may have.
-const MAX_SUMMARY_BYTES: u64 = 1 << 30;
+pub(super) const MAX_SUMMARY_BYTES: u64 = 1 << 30;
 
 /// Writes `summary` (or a run's `run.json`) atomically: a reader never sees half a file.
 pub fn write_json(path: &Path, summary: &impl Serialize) -> Result<()> {

@@ -297,6 +297,56 @@ fn a_report_shipped_without_its_run_records_is_refused_and_kept() {
     );
 }
 
+/// A finished protocol shipped with its top-level files and without its run records (as
+/// `docs/`'s folders are, their episodes decompressed) is made again by `plot` from those
+/// files: the same scores and comparison, today's improvement.csv; the data kept as it was.
+#[test]
+fn a_report_shipped_with_its_episodes_is_made_again_from_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    let config = tmp.path().join("protocol.ron");
+    std::fs::write(
+        &config,
+        "(env: CartPole(), dqn: (replay_start_size: 20), protocol: (episodes: 6, runs: 3, \
+         test_episodes: 2, methods: [Dqn(hidden: [8]), Dqn(hidden: [16])]))",
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args(["--headless", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    let read = |f: &str| std::fs::read(out.join(f)).unwrap();
+    let made: Vec<Vec<u8>> = ["scores.csv", "comparison.csv", "improvement.csv"]
+        .map(read)
+        .to_vec();
+    let data: Vec<Vec<u8>> = ["episodes.csv", "tests.csv"].map(read).to_vec();
+    std::fs::remove_dir_all(out.join("runs")).unwrap();
+    for f in [
+        "scores.csv",
+        "comparison.csv",
+        "improvement.csv",
+        "learning_curve.png",
+    ] {
+        std::fs::remove_file(out.join(f)).unwrap();
+    }
+    let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .arg("plot")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    let again: Vec<Vec<u8>> = ["scores.csv", "comparison.csv", "improvement.csv"]
+        .map(read)
+        .to_vec();
+    assert!(made == again, "the report made again differs");
+    assert!(data == ["episodes.csv", "tests.csv"].map(read).to_vec());
+    assert!(out.join("learning_curve.png").is_file());
+}
+
 #[test]
 fn a_present_library_is_reused_unchanged() {
     let tmp = tempfile::tempdir().unwrap();

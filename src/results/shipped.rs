@@ -1,0 +1,124 @@
+//! A finished protocol's folder shipped with its top-level files only (`docs/`'s folders:
+//! `summary.json`, `episodes.csv`, `tests.csv`, no run records): `sapnet plot` makes its
+//! report and plots again from those files — every run's summary from `summary.json`, its
+//! training returns from `episodes.csv`, its tests from `tests.csv` — so that a report
+//! shipped by an older version can be read by today's rules. The data files are read, never
+//! written; `activations.csv`, if it did not ship, leaves the figures drawn from it as they
+//! were.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use serde::Deserialize;
+
+use super::plot_data;
+use super::summary::{self, Status, Summary, SummaryHeader, MAX_SUMMARY_BYTES};
+use crate::report::{plots, Report, RunSummary, TaskRuns};
+use crate::safe_io::{self, Links};
+use crate::trainer::MethodId;
+
+/// The runs `summary.json` lists, as run summaries.
+#[derive(Deserialize)]
+struct ListedRuns {
+    runs: Vec<RunSummary<String>>,
+}
+
+#[derive(Deserialize)]
+struct EpisodeRow {
+    run: u32,
+    method: String,
+    episode: u32,
+    reward: f64,
+}
+
+/// Whether `dir` is a shipped folder this module can make again: no run records, but the
+/// episodes of the runs its summary lists.
+pub fn can_replot(dir: &Path) -> bool {
+    std::fs::symlink_metadata(dir.join("episodes.csv")).is_ok_and(|m| m.is_file())
+}
+
+/// Makes `dir`'s report, plots and `summary.json` again from its top-level files.
+pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
+    if !matches!(header.status, None | Some(Status::Complete)) {
+        bail!(
+            "{}: a protocol that did not finish (summary.json: status {:?}) and has no run \
+             records: its top-level files may hold part of a run, and `--resume` needs the \
+             records",
+            dir.display(),
+            header.status
+        );
+    }
+    let path = dir.join("summary.json");
+    let text = safe_io::read_text(&path, Links::Refuse, MAX_SUMMARY_BYTES)
+        .with_context(|| format!("reading {}", path.display()))?;
+    let listed: ListedRuns =
+        serde_json::from_str(&text).with_context(|| format!("reading {}", path.display()))?;
+    let config = header.config;
+    let methods = MethodId::all(&config.protocol.methods);
+    let mut runs = Vec::new();
+    for run in listed.runs {
+        let Some(method) = methods.iter().find(|m| m.label() == run.record.method) else {
+            bail!(
+                "{}: run {} of method {:?}, which the config does not list",
+                path.display(),
+                run.record.run,
+                run.record.method
+            );
+        };
+        runs.push(run.with_method(method.clone()));
+    }
+    let rewards = rewards(&dir.join("episodes.csv"), &methods)?;
+    let library = header.library.unwrap_or_default();
+    let task = config.env.label();
+    let report = Report::of(&[TaskRuns {
+        task: &task,
+        config: &config,
+        library: &library,
+        runs: &runs,
+        rewards: &rewards,
+    }]);
+    report.write(dir)?;
+    let data = plot_data::read(dir)?;
+    plots::write_all(dir, &data)
+        .with_context(|| format!("drawing the plots in {}", dir.display()))?;
+    let mut summary = Summary::new(&config, header.trace);
+    summary.status = Status::Complete;
+    summary.wall_s = header.wall_s;
+    summary.error = header.error;
+    summary.runs = runs;
+    summary.comparison = report.comparison.clone();
+    summary.pairs = report.improvement.clone();
+    summary.library = (!library.is_empty()).then_some(library);
+    summary::write_json(&path, &summary)?;
+    Ok(summary)
+}
+
+/// Each run's training returns from the folder's `episodes.csv`, in episode order.
+fn rewards(path: &Path, methods: &[MethodId]) -> Result<BTreeMap<(MethodId, u32), Vec<f64>>> {
+    let mut reader =
+        safe_io::csv_reader(path).with_context(|| format!("reading {}", path.display()))?;
+    let mut keyed: BTreeMap<(MethodId, u32), Vec<(u32, f64)>> = BTreeMap::new();
+    for (i, row) in reader.deserialize::<EpisodeRow>().enumerate() {
+        let row = row.with_context(|| format!("{}: row {}", path.display(), i + 2))?;
+        let Some(method) = methods.iter().find(|m| m.label() == row.method) else {
+            bail!(
+                "{}: row {}: method {:?}, which the config does not list",
+                path.display(),
+                i + 2,
+                row.method
+            );
+        };
+        keyed
+            .entry((method.clone(), row.run))
+            .or_default()
+            .push((row.episode, row.reward));
+    }
+    Ok(keyed
+        .into_iter()
+        .map(|(key, mut episodes)| {
+            episodes.sort_by_key(|&(episode, _)| episode);
+            (key, episodes.into_iter().map(|(_, r)| r).collect())
+        })
+        .collect())
+}
