@@ -56,7 +56,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Plot(args)) => {
             let summary = results::replot(&args.dir)?;
             eprintln!(
-                "{} made again: comparison.csv, improvement.csv, scores.csv, sample_efficiency.csv, intervals.png, profiles.png, improvement.png, learning_curve.png, sample_efficiency.png, tests.png, activations.png, selections.png",
+                "{} made again: comparison.csv, improvement.csv, scores.csv, sample_efficiency.csv, summary.json and the plots of what the folder holds (activations.png and selections.png only from an activations.csv)",
                 args.dir.display()
             );
             headless::print_comparison(&summary)
