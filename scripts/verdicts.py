@@ -5,6 +5,9 @@ runs_needed), as the docs quote them. Only the standard library.
     python3 scripts/verdicts.py DIR              # counts of verdicts per score
     python3 scripts/verdicts.py DIR X            # Markdown table of P(X > Y) for every Y
     python3 scripts/verdicts.py DIR X Y [SCORE]  # one pair, as a sentence's numbers
+    python3 scripts/verdicts.py DIR --grid X1,X2,.. Y1,Y2,.. [SCORE]
+                                                 # P(X > Y) for each X (rows) and Y (columns):
+                                                 # ** separated, * fragile, unmarked not separated
 
 SCORE is `return` (the training return, default) or `test`. `runs_needed` is the runs
 per method that would detect the observed P at 80% power; empty when P is 0.5.
@@ -52,6 +55,15 @@ if len(sys.argv) == 2:
                 counts[r["verdict"]] += 1
         print(f"{score}: {len(seen)} pairs: " + ", ".join(
             f"{counts[v]} {v}" for v in ("separated", "fragile", "not separated")))
+elif sys.argv[2] == "--grid":
+    xs, ys = sys.argv[3].split(","), sys.argv[4].split(",")
+    score = sys.argv[5] if len(sys.argv) > 5 else "return"
+    mark = {"separated": " **", "fragile": " *", "not separated": ""}
+    print(f"| P(X > Y), {score} | " + " | ".join(ys) + " |")
+    print("| --- |" + " --- |" * len(ys))
+    for x in xs:
+        cells = [interval(pair[(score, x, y)]) + mark[pair[(score, x, y)]["verdict"]] for y in ys]
+        print(f"| {x} | " + " | ".join(cells) + " |")
 elif len(sys.argv) == 3:
     x = sys.argv[2]
     print(f"| Y | P({x} > Y), training return [95% CI] | Holm p | seeds excluding 0.5 | verdict | runs needed | test score [95% CI] | test verdict |")
