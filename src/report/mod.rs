@@ -93,6 +93,8 @@ pub struct Report {
     pub units: Units,
     /// The tasks pooled, in order.
     pub tasks: Vec<String>,
+    /// The same tasks as the figures' titles name them ([`plots::task_title`]).
+    pub task_titles: Vec<String>,
     pub comparison: Vec<MethodComparison>,
     pub improvement: Vec<Improvement>,
     pub scores: Vec<RunScores>,
@@ -184,6 +186,10 @@ impl Report {
         Self {
             units,
             tasks: tasks.iter().map(|t| t.task.to_string()).collect(),
+            task_titles: tasks
+                .iter()
+                .map(|t| plots::task_title(&t.config.env))
+                .collect(),
             comparison,
             improvement,
             scores,
