@@ -94,6 +94,8 @@ pub struct Report {
     pub units: Units,
     /// The tasks pooled, in order.
     pub tasks: Vec<String>,
+    /// The same tasks as the figures' titles name them ([`plots::task_title`]).
+    pub task_titles: Vec<String>,
     pub comparison: Vec<MethodComparison>,
     pub improvement: Vec<Improvement>,
     pub scores: Vec<RunScores>,
@@ -156,14 +158,19 @@ impl Report {
             scores.extend(per_task.iter().flatten().map(|(_, s)| s.clone()));
             methods.push(method_runs(label, method.kind(), tasks, &per_task, units));
         }
+        let titles = tasks
+            .iter()
+            .map(|t| plots::task_title(&t.config.env))
+            .collect();
         let tasks: Vec<String> = tasks.iter().map(|t| t.task.to_string()).collect();
-        Self::of_methods(units, tasks, &methods, scores, left_out)
+        Self::of_methods(units, (tasks, titles), &methods, scores, left_out)
     }
 
-    /// The report of `methods`' runs on `tasks`: every measure, pair and profile.
+    /// The report of `methods`' runs on `tasks` (as results and as titles name them):
+    /// every measure, pair and profile.
     pub(crate) fn of_methods(
         units: Units,
-        tasks: Vec<String>,
+        (tasks, task_titles): (Vec<String>, Vec<String>),
         methods: &[MethodRuns],
         scores: Vec<RunScores>,
         left_out: Vec<String>,
@@ -196,6 +203,7 @@ impl Report {
         Self {
             units,
             tasks,
+            task_titles,
             comparison,
             improvement,
             scores,

@@ -51,7 +51,7 @@ impl Report {
         }
         Self::of_methods(
             Units::Returns,
-            vec![task.to_string()],
+            (vec![task.to_string()], vec![task.to_string()]),
             &measured,
             scores,
             left_out,

@@ -71,14 +71,16 @@ pub fn read(dir: &Path) -> Result<PlotData> {
     };
     let activations = methods
         .iter()
-        .find(|m| m.kind.spreads)
+        .filter(|m| m.kind.spreads)
         .map(|m| {
-            of_method(m.label())
+            let runs: Vec<Vec<Vec<f64>>> = of_method(m.label())
                 .into_iter()
                 .map(|h| h.scores.clone())
-                .collect()
+                .collect();
+            (m.label().to_string(), runs)
         })
-        .unwrap_or_default();
+        .filter(|(_, runs)| !runs.is_empty())
+        .collect();
     let acted = methods
         .iter()
         .filter(|m| m.kind.reuses)
@@ -92,7 +94,7 @@ pub fn read(dir: &Path) -> Result<PlotData> {
         .filter(|(_, runs)| !runs.is_empty())
         .collect();
     Ok(PlotData {
-        task: config.env.gym_id(),
+        task: crate::report::plots::task_title(&config.env),
         subject: None,
         return_range: crate::report::plots::return_bounds(&config.env),
         window: config.protocol.moving_average,

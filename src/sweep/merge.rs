@@ -372,7 +372,7 @@ fn plot_data(pooled: &Results, subject: Option<String>) -> PlotData {
         })
         .collect();
     PlotData {
-        task: pooled.config.env.gym_id(),
+        task: report::plots::task_title(&pooled.config.env),
         subject,
         return_range: report::plots::return_bounds(&pooled.config.env),
         window: pooled.config.protocol.moving_average,

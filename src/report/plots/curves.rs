@@ -7,7 +7,7 @@ use plotters::prelude::*;
 
 use super::axes::{self, Fit};
 use super::legend::{self, Entry, Swatch};
-use super::palette::{method_pens, Pen};
+use super::palette::{emphasised, method_pens, Pen, MANY};
 use super::{Curve, Drawn, PlotData, FAMILY};
 use crate::report::runs::moving_average;
 use crate::report::sample_efficiency::EfficiencyPoint;
@@ -98,9 +98,51 @@ pub(super) fn band_polygon(
     Polygon::new(points, pen.colour.mix(0.15).filled())
 }
 
-/// The methods' pens, in the order listed.
+/// The methods' pens, in the order listed; of many methods, those not
+/// [`emphasised`] by their mean training return faded.
 pub(super) fn pens(curves: &[Curve]) -> Vec<Pen> {
-    method_pens(&curves.iter().map(|c| c.kind).collect::<Vec<_>>())
+    let kinds: Vec<_> = curves.iter().map(|c| c.kind).collect();
+    let labels: Vec<String> = curves.iter().map(|c| c.label.clone()).collect();
+    let scores: Vec<f64> = curves
+        .iter()
+        .map(|c| {
+            let means: Vec<f64> = c
+                .returns
+                .iter()
+                .filter(|r| !r.is_empty())
+                .map(|r| r.iter().sum::<f64>() / r.len() as f64)
+                .collect();
+            if means.is_empty() {
+                f64::NEG_INFINITY
+            } else {
+                means.iter().sum::<f64>() / means.len() as f64
+            }
+        })
+        .collect();
+    method_pens(&kinds)
+        .into_iter()
+        .zip(emphasised(&kinds, &labels, &scores))
+        .map(|(pen, full)| if full { pen } else { pen.faded() })
+        .collect()
+}
+
+/// What the faint pens mean, for the legend, when there are any.
+pub(super) fn emphasis_note(pens: &[Pen]) -> Option<String> {
+    pens.iter().any(|p| p.faint).then(|| {
+        format!(
+            "of more than {MANY} methods, the paper's {} and the best of each family (mean \
+             training return) in full; the others faint, without band",
+            crate::reuse::Method::the_papers().label()
+        )
+    })
+}
+
+/// The methods' indices, the faint ones first: drawn in this order, no faint line lies
+/// over a method drawn in full.
+pub(super) fn in_drawing_order(pens: &[Pen]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..pens.len()).collect();
+    order.sort_by_key(|&i| !pens[i].faint);
+    order
 }
 
 /// The chart's area and the legend's column beside it, a little below the title.
@@ -157,14 +199,14 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
     )?;
     let pens = pens(&data.curves);
     for (i, points) in efficiency.iter().enumerate() {
-        if banded(i) {
+        if banded(i) && !pens[i].faint {
             let band = points.iter().map(|p| (p.episode, p.mean));
             chart.draw_series(std::iter::once(band_polygon(band, &fit, pens[i])))?;
         }
     }
-    // The lines over every band.
-    for (i, mean) in lines.iter().enumerate() {
-        let points = mean
+    // The lines over every band, the faint ones under the others.
+    for i in in_drawing_order(&pens) {
+        let points = lines[i]
             .iter()
             .enumerate()
             .map(|(e, &v)| ((e + w) as f64, v))
@@ -194,6 +236,7 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
     if banded_runs.len() < data.curves.len() {
         notes.push("a method of 1 run has no band".into());
     }
+    notes.extend(emphasis_note(&pens));
     notes.extend(fit.note().map(|n| format!("band {n}")));
     legend::draw(&legend_area, &entries, &notes)?;
     root.present()
@@ -307,6 +350,7 @@ pub(super) fn test_bars<DB: DrawingBackend>(
             legend::runs_phrase(whiskered_runs)
         ));
     }
+    notes.extend(emphasis_note(&pens));
     notes.extend(fit.note().map(|n| format!("whiskers {n}")));
     legend::draw(&legend_area, &entries, &notes)?;
     root.present()

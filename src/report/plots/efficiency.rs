@@ -4,7 +4,9 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::curves::{band_polygon, beside_legend, episode_chart, pens};
+use super::curves::{
+    band_polygon, beside_legend, emphasis_note, episode_chart, in_drawing_order, pens,
+};
 use super::legend::{self, Entry, Swatch};
 use super::{axes, Drawn, PlotData};
 use crate::report::sample_efficiency::EfficiencyPoint;
@@ -44,18 +46,18 @@ pub(super) fn sample_efficiency<DB: DrawingBackend>(
     let pens = pens(&data.curves);
     let banded = |curve: &[EfficiencyPoint]| curve.iter().any(|p| p.runs > 1);
     for (curve, pen) in points.iter().zip(&pens) {
-        if !banded(curve) {
+        if !banded(curve) || pen.faint {
             continue;
         }
         let band = curve.iter().map(|p| (p.episode, p.iqm));
         chart.draw_series(std::iter::once(band_polygon(band, &fit, *pen)))?;
     }
-    for (curve, &pen) in points.iter().zip(&pens) {
-        let line = curve
+    for i in in_drawing_order(&pens) {
+        let line = points[i]
             .iter()
             .map(|p| (p.episode as f64, p.iqm.point))
             .collect();
-        legend::draw_line(&mut chart, line, pen)?;
+        legend::draw_line(&mut chart, line, pens[i])?;
     }
     let entries: Vec<Entry> = data
         .curves
@@ -70,6 +72,7 @@ pub(super) fn sample_efficiency<DB: DrawingBackend>(
         "band: 95% bootstrap CI of the IQM over {}",
         legend::runs_phrase(data.curves.iter().map(|c| c.returns.len()))
     )];
+    notes.extend(emphasis_note(&pens));
     notes.extend(fit.note().map(|n| format!("band {n}")));
     legend::draw(&legend_area, &entries, &notes)?;
     root.present()

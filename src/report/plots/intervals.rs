@@ -1,9 +1,8 @@
 //! The pictures researchers read since Agarwal et al. (NeurIPS 2021), in `rliable`'s
-//! style: `intervals.png`, each aggregate of each method as a bar from the low to the
-//! high end of its 95% interval with the point marked; `profiles.png`, the share of runs
-//! whose normalised test score exceeds τ, with its band; `improvement.png`, the
-//! probability that the reference method's run beats each other method's, with its
-//! interval, against the coin toss at 0.5. Each also as `.svg`.
+//! style, written together: `intervals.png`, each aggregate of each method as a bar from
+//! the low to the high end of its 95% interval with the point marked (drawn here);
+//! `profiles.png` ([`super::profiles`]); `improvement.png` ([`super::improvement`]). Each
+//! also as `.svg`. The titles, pens and run counts the three share are here.
 
 use std::path::Path;
 
@@ -11,11 +10,11 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::legend::{self, Entry, Swatch};
+use super::legend;
 use super::palette::{method_pens, Pen};
-use super::{atomically, axes, register_font, Drawn, FAMILY};
+use super::{atomically, axes, png, register_font, Drawn, FAMILY};
 use crate::report::{Aggregates, Report, Units};
-use crate::stats::{bootstrap, profile, Estimate};
+use crate::stats::{bootstrap, Estimate};
 
 /// Writes `intervals`, `profiles` and `improvement` (`.png` and `.svg`) into `dir`.
 pub fn write_intervals(dir: &Path, report: &Report) -> Result<()> {
@@ -23,12 +22,11 @@ pub fn write_intervals(dir: &Path, report: &Report) -> Result<()> {
     let methods = report.comparison.len().max(1) as u32;
     let panels = (1400, 2 * (40 + 26 * methods) + 80);
     let square = (1000 + legend::WIDTH, 650);
-    let improvement = (1200, 100 + 26 * methods);
+    let improvement = super::improvement::size(report.comparison.len());
     macro_rules! both {
         ($name:literal, $size:expr, $draw:expr) => {
             atomically(&dir.join(concat!($name, ".png")), |path| {
-                $draw(BitMapBackend::new(path, $size).into_drawing_area(), report)
-                    .map_err(|e| e.to_string())
+                $draw(png(path, $size), report).map_err(|e| e.to_string())
             })?;
             atomically(&dir.join(concat!($name, ".svg")), |path| {
                 $draw(SVGBackend::new(path, $size).into_drawing_area(), report)
@@ -37,8 +35,12 @@ pub fn write_intervals(dir: &Path, report: &Report) -> Result<()> {
         };
     }
     both!("intervals", panels, aggregates);
-    both!("profiles", square, profiles);
-    both!("improvement", improvement, probabilities);
+    both!("profiles", square, super::profiles::profiles);
+    both!(
+        "improvement",
+        improvement,
+        super::improvement::probabilities
+    );
     Ok(())
 }
 
@@ -51,20 +53,20 @@ fn units(report: &Report) -> &'static str {
 }
 
 /// A title: the sweep's axis value if any, the tasks, then `rest`.
-fn title(report: &Report, rest: &str) -> String {
+pub(super) fn title(report: &Report, rest: &str) -> String {
     legend::title(
         report.subject.as_deref(),
-        &format!("{}: {rest}", report.tasks.join(", ")),
+        &format!("{}: {rest}", report.task_titles.join(", ")),
     )
 }
 
 /// "2 runs" (or "2–5 runs") per method.
-fn runs(report: &Report) -> String {
+pub(super) fn runs(report: &Report) -> String {
     legend::runs_phrase(report.comparison.iter().map(|m| m.runs))
 }
 
 /// The methods' pens, as the learning curves give them.
-fn pens(report: &Report) -> Vec<Pen> {
+pub(super) fn pens(report: &Report) -> Vec<Pen> {
     method_pens(&report.comparison.iter().map(|m| m.kind).collect::<Vec<_>>())
 }
 
@@ -143,6 +145,8 @@ fn interval_panel<DB: DrawingBackend>(
     let mut chart = ChartBuilder::on(area)
         .caption(caption, (FAMILY, 16))
         .margin(8)
+        // Room for the last x label ("1.00"), which plotters centres on the axis's end.
+        .margin_right(24)
         .x_label_area_size(36)
         .y_label_area_size(if with_names { 150 } else { 10 })
         .build_cartesian_2d(low..high, -0.5f64..n as f64 - 0.5)?;
@@ -188,157 +192,4 @@ fn interval_panel<DB: DrawingBackend>(
         )))?;
     }
     Ok(())
-}
-
-/// Performance profiles of the normalised test score: the share of runs above τ, with a
-/// 95% band; the legend beside.
-fn profiles<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Report) -> Drawn<DB> {
-    root.fill(&WHITE)?;
-    let levels = profile::levels();
-    let pens = pens(report);
-    let width = root.dim_in_pixel().0;
-    let (area, legend_area) = root.split_horizontally(width.saturating_sub(legend::WIDTH));
-    let mut chart = ChartBuilder::on(&area)
-        .caption(
-            title(report, "performance profiles of the greedy test score"),
-            (FAMILY, 20),
-        )
-        .margin(12)
-        .margin_right(30)
-        .x_label_area_size(55)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0f64..1f64, 0f64..1.02f64)?;
-    chart
-        .configure_mesh()
-        .x_desc("normalised test score τ: (return − lowest) / (highest − lowest) of the task")
-        .y_desc("share of runs with score > τ")
-        .light_line_style(WHITE)
-        .label_style((FAMILY, 15))
-        .draw()?;
-    let mut entries = Vec::new();
-    for profile in &report.profiles {
-        let Some(i) = report
-            .comparison
-            .iter()
-            .position(|m| m.method == profile.method)
-        else {
-            continue;
-        };
-        let pen = pens[i];
-        let band: Vec<(f64, f64)> = levels
-            .iter()
-            .zip(&profile.shares)
-            .map(|(&t, e)| (t, e.hi))
-            .chain(
-                levels
-                    .iter()
-                    .zip(&profile.shares)
-                    .rev()
-                    .map(|(&t, e)| (t, e.lo)),
-            )
-            .collect();
-        chart.draw_series(std::iter::once(Polygon::new(
-            band,
-            pen.colour.mix(0.1).filled(),
-        )))?;
-        let points = levels
-            .iter()
-            .zip(&profile.shares)
-            .map(|(&t, e)| (t, e.point))
-            .collect();
-        legend::draw_line(&mut chart, points, pen)?;
-        entries.push(Entry {
-            label: legend::with_runs(&profile.method, report.comparison[i].runs),
-            swatch: Swatch::Line(pen),
-        });
-    }
-    let notes = [format!(
-        "band: 95% stratified bootstrap CI ({} resamples) over {}",
-        bootstrap::RESAMPLES,
-        runs(report)
-    )];
-    legend::draw(&legend_area.margin(48, 0, 4, 0), &entries, &notes)?;
-    root.present()
-}
-
-/// P(reference > other) for the test score and the training return, each with its 95%
-/// interval, the coin toss (0.5) marked.
-fn probabilities<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Report) -> Drawn<DB> {
-    root.fill(&WHITE)?;
-    let Some(reference) = &report.reference else {
-        return root.present();
-    };
-    let (heading, body) = root.split_vertically(46);
-    heading.titled(
-        &title(
-            report,
-            &format!(
-                "P(a run of {reference} beats a run of each method), 95% stratified \
-                 bootstrap intervals over {}",
-                runs(report)
-            ),
-        ),
-        (FAMILY, 18),
-    )?;
-    let panels = body.split_evenly((1, 2));
-    let colours = colours(report);
-    for (panel, score, caption) in [
-        (&panels[0], "test", "greedy test score"),
-        (&panels[1], "return", "training return"),
-    ] {
-        let mut names = Vec::new();
-        let mut estimates = Vec::new();
-        let mut shades = Vec::new();
-        for (i, m) in report.comparison.iter().enumerate() {
-            let row = report
-                .improvement
-                .iter()
-                .find(|r| r.score == score && &r.method == reference && r.over == m.method);
-            if let Some(row) = row {
-                names.push(format!("{reference} > {}", m.method));
-                estimates.push(Some(row.p));
-                shades.push(colours[i]);
-            }
-        }
-        let n = names.len().max(1);
-        let mut chart = ChartBuilder::on(panel)
-            .caption(caption, (FAMILY, 16))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(230)
-            .build_cartesian_2d(0f64..1f64, -0.5f64..n as f64 - 0.5)?;
-        let shown = names.clone();
-        chart
-            .configure_mesh()
-            .disable_y_mesh()
-            .y_labels(n)
-            .y_label_formatter(&move |y| {
-                let i = y.round();
-                if (y - i).abs() < 1e-6 && i >= 0.0 {
-                    shown.get(n - 1 - i as usize).cloned().unwrap_or_default()
-                } else {
-                    String::new()
-                }
-            })
-            .x_desc("P(X > Y)")
-            .label_style((FAMILY, 13))
-            .draw()?;
-        chart.draw_series(std::iter::once(PathElement::new(
-            [(0.5, -0.5), (0.5, n as f64 - 0.5)],
-            BLACK.mix(0.6).stroke_width(1),
-        )))?;
-        for (i, e) in estimates.iter().enumerate() {
-            let Some(e) = e else { continue };
-            let y = (n - 1 - i) as f64;
-            chart.draw_series(std::iter::once(Rectangle::new(
-                [(e.lo, y - 0.32), (e.hi.max(e.lo), y + 0.32)],
-                shades[i].mix(0.8).filled(),
-            )))?;
-            chart.draw_series(std::iter::once(PathElement::new(
-                [(e.point, y - 0.4), (e.point, y + 0.4)],
-                BLACK.stroke_width(2),
-            )))?;
-        }
-    }
-    root.present()
 }

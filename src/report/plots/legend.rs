@@ -8,6 +8,7 @@ use plotters::prelude::*;
 
 use super::palette::{Dash, Pen};
 use super::{Drawn, FAMILY};
+use crate::env::EnvConfig;
 
 /// The width of the legend column beside a chart.
 pub(super) const WIDTH: u32 = 300;
@@ -55,13 +56,25 @@ pub(super) fn title(subject: Option<&str>, rest: &str) -> String {
     }
 }
 
+/// A task as every figure's title names it: its Gymnasium id, then what differs from the
+/// task's defaults (`CartPole-v1`, `CartPole-v1(length=1.0)`; results label it
+/// `cartpole(length=1.0)`).
+pub fn task_title(env: &EnvConfig) -> String {
+    let label = env.label();
+    match label.strip_prefix(env.task_name().as_str()) {
+        Some(changed) => format!("{}{changed}", env.gym_id()),
+        // A Gymnasium task's label starts with its id already.
+        None => label,
+    }
+}
+
 /// A line of `pen` through `points`.
 pub(super) fn draw_line<DB: DrawingBackend>(
     chart: &mut ChartContext<DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     points: Vec<(f64, f64)>,
     pen: Pen,
 ) -> Drawn<DB> {
-    let style = pen.colour.stroke_width(2);
+    let style = pen.colour.stroke_width(pen.width());
     match pen.dash {
         Dash::Solid => chart.draw_series(LineSeries::new(points, style))?,
         Dash::Dashed => chart.draw_series(DashedLineSeries::new(points, 9, 5, style))?,
@@ -150,6 +163,21 @@ mod tests {
             "sapnet.temperature = 1.0 · CartPole-v1: tests"
         );
         assert_eq!(title(None, "CartPole-v1: tests"), "CartPole-v1: tests");
+    }
+
+    #[test]
+    fn tasks_are_named_by_their_gymnasium_id() {
+        let cartpole = EnvConfig::CartPole(Default::default());
+        assert_eq!(task_title(&cartpole), "CartPole-v1");
+        let EnvConfig::CartPole(mut longer) = cartpole else {
+            unreachable!()
+        };
+        longer.length = 1.0;
+        let longer = EnvConfig::CartPole(longer);
+        assert_eq!(longer.label(), "cartpole(length=1.0)");
+        assert_eq!(task_title(&longer), "CartPole-v1(length=1.0)");
+        let acrobot = EnvConfig::Acrobot(Default::default());
+        assert_eq!(task_title(&acrobot), "Acrobot-v1");
     }
 
     #[test]

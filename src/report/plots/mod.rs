@@ -1,24 +1,30 @@
 //! The paper's figures, drawn with plotters: learning curves (Fig. 5 and 7) with the 95%
 //! bootstrap interval of the mean over runs as a band, how fast each method learns
-//! (`sample_efficiency.png`, the IQM's interval), greedy test returns (Fig. 6 and 8), the activation
-//! of every source policy over the episodes, and, per method that reuses the library, the
-//! share of the steps each source acted (`selections.png`). Every plot's y axis fits what
+//! (`sample_efficiency.png`, the IQM's interval), greedy test returns (Fig. 6 and 8), the
+//! activation of every source policy over the episodes per method that spreads
+//! (`activations.png`), and, per run of each method that reuses the library, the share of
+//! the steps each source acted (`selections.png`). Every plot's y axis fits what
 //! it draws within the task's return range (`axes`), its legend sits beside the chart and
 //! says what the band or whiskers are over how many runs (`legend`), and its colours come
 //! from one palette (`palette`).
 
+mod activations;
 mod axes;
 mod curves;
 mod efficiency;
+mod improvement;
 mod intervals;
 mod legend;
-mod library;
 mod palette;
+mod profiles;
+mod selections;
+mod text;
 
 use std::path::Path;
 use std::sync::Once;
 
 use anyhow::{anyhow, Result};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::sample_efficiency::{self, EfficiencyPoint};
@@ -58,9 +64,9 @@ pub struct PlotData {
     /// In the protocol's order; SAP-Net first if it ran.
     pub curves: Vec<Curve>,
     pub policy_names: Vec<String>,
-    /// SAP-Net (the first SAP-Net method listed): activations at the end of each episode
-    /// (run → episode → policy).
-    pub activations: Vec<Vec<Vec<f64>>>,
+    /// Per method that spreads activation (SAP-Net and its variants): the activations at
+    /// the end of each episode (run → episode → policy).
+    pub activations: Vec<(String, Vec<Vec<Vec<f64>>>)>,
     /// Per method that reuses the library: the steps each source acted in each episode
     /// (run → episode → policy).
     pub acted: Vec<(String, Vec<Vec<Vec<u64>>>)>,
@@ -76,7 +82,9 @@ pub struct SelectionHistory {
 }
 
 /// Writes `learning_curve.png`, `learning_curve.svg`, `sample_efficiency.csv`, `.png` and
-/// `.svg`, `tests.png` and, with SAP-Net activations, `activations.png` into `dir`.
+/// `.svg`, `tests.png` and, with SAP-Net activations, `activations.png` (a panel per
+/// method that spreads), with methods that reuse the library `selections.png` (a strip per
+/// run), into `dir`.
 pub fn write_all(dir: &Path, data: &PlotData) -> Result<()> {
     register_font()?;
     let efficiency: Vec<Vec<EfficiencyPoint>> = data
@@ -93,12 +101,8 @@ pub fn write_all(dir: &Path, data: &PlotData) -> Result<()> {
     let (header, rows) = sample_efficiency::records(&labelled);
     super::write_rows(&dir.join("sample_efficiency.csv"), &header, &rows)?;
     atomically(&dir.join("sample_efficiency.png"), |path| {
-        efficiency::sample_efficiency(
-            BitMapBackend::new(path, WITH_LEGEND).into_drawing_area(),
-            data,
-            &efficiency,
-        )
-        .map_err(|e| e.to_string())
+        efficiency::sample_efficiency(png(path, WITH_LEGEND), data, &efficiency)
+            .map_err(|e| e.to_string())
     })?;
     atomically(&dir.join("sample_efficiency.svg"), |path| {
         efficiency::sample_efficiency(
@@ -109,12 +113,7 @@ pub fn write_all(dir: &Path, data: &PlotData) -> Result<()> {
         .map_err(|e| e.to_string())
     })?;
     atomically(&dir.join("learning_curve.png"), |path| {
-        curves::learning_curve(
-            BitMapBackend::new(path, WITH_LEGEND).into_drawing_area(),
-            data,
-            &efficiency,
-        )
-        .map_err(|e| e.to_string())
+        curves::learning_curve(png(path, WITH_LEGEND), data, &efficiency).map_err(|e| e.to_string())
     })?;
     atomically(&dir.join("learning_curve.svg"), |path| {
         curves::learning_curve(
@@ -127,27 +126,22 @@ pub fn write_all(dir: &Path, data: &PlotData) -> Result<()> {
     // Runs of other tools (`sapnet compare`) have no greedy tests: no empty figure.
     if data.curves.iter().any(|c| !c.tests.is_empty()) {
         atomically(&dir.join("tests.png"), |path| {
-            curves::test_bars(
-                BitMapBackend::new(path, WITH_LEGEND).into_drawing_area(),
-                data,
-            )
-            .map_err(|e| e.to_string())
+            curves::test_bars(png(path, WITH_LEGEND), data).map_err(|e| e.to_string())
         })?;
     }
     if !data.activations.is_empty() {
         atomically(&dir.join("activations.png"), |path| {
-            library::activation_lines(BitMapBackend::new(path, SIZE).into_drawing_area(), data)
-                .map_err(|e| e.to_string())
+            let size = activations::size(data.activations.len());
+            activations::activation_panels(png(path, size), data).map_err(|e| e.to_string())
         })?;
     }
     if !data.acted.is_empty() {
-        let height = 220 * data.acted.len() as u32 + 60;
+        let size = (
+            SIZE.0 + activations::SOURCES_LEGEND,
+            selections::height(&data.acted),
+        );
         atomically(&dir.join("selections.png"), |path| {
-            library::selection_shares(
-                BitMapBackend::new(path, (SIZE.0, height)).into_drawing_area(),
-                data,
-            )
-            .map_err(|e| e.to_string())
+            selections::selection_strips(png(path, size), data).map_err(|e| e.to_string())
         })?;
     }
     Ok(())
@@ -175,6 +169,11 @@ pub(super) fn atomically(
     result.map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
+/// A PNG of `size` pixels at `path`, its text set on the baseline ([`text`]).
+fn png(path: &Path, size: (u32, u32)) -> DrawingArea<text::Typeset<BitMapBackend<'_>>, Shift> {
+    DrawingArea::from(text::Typeset(BitMapBackend::new(path, size)))
+}
+
 pub(super) fn register_font() -> Result<()> {
     static REGISTER: Once = Once::new();
     let mut result = Ok(());
@@ -188,6 +187,7 @@ pub(super) fn register_font() -> Result<()> {
 pub use axes::return_bounds;
 pub use curves::mean_over_runs;
 pub use intervals::write_intervals;
+pub use legend::task_title;
 
 pub(super) type Drawn<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
@@ -218,7 +218,7 @@ mod tests {
                 },
             ],
             policy_names: vec!["source-0".into(), "source-1".into()],
-            activations: vec![vec![vec![0.0, 1.0], vec![1.5, 1.0]]],
+            activations: vec![("sapnet".into(), vec![vec![vec![0.0, 1.0], vec![1.5, 1.0]]])],
             acted: vec![(
                 "sapnet".into(),
                 vec![vec![vec![0, 0], vec![3, 1], vec![0, 4]]],

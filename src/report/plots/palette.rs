@@ -1,8 +1,9 @@
 //! Every colour the plots use. Methods come in families, one hue each (SAP-Net and its
 //! variants red, the random selectors blue, UCB1 green, PRQ-learning purple, the best
-//! source orange, DQN grey); the members of a family differ in lightness and, on lines,
-//! in dash, so that eleven methods or more stay apart. Source policies get twenty
-//! categorical colours.
+//! source orange); the members of a family differ in lightness and, on lines, in dash, so
+//! that eleven methods or more stay apart. The DQN baselines get a colour each. A chart of
+//! many methods draws the paper's SAP-Net and the best of each family in full, the others
+//! faint ([`emphasised`]). Source policies get twenty categorical colours.
 
 use plotters::prelude::*;
 
@@ -20,6 +21,9 @@ pub(super) enum Dash {
 pub(super) struct Pen {
     pub colour: RGBColor,
     pub dash: Dash,
+    /// A method drawn in the background of a figure of many ([`emphasised`]): a thin
+    /// line, a pale bar, no band.
+    pub faint: bool,
 }
 
 impl Pen {
@@ -28,6 +32,27 @@ impl Pen {
         Self {
             colour,
             dash: Dash::Solid,
+            faint: false,
+        }
+    }
+
+    /// This pen in the background: its colour halfway to white, thin.
+    pub fn faded(self) -> Self {
+        let pale = |c: u8| ((f64::from(c) + 255.0) / 2.0).round() as u8;
+        let RGBColor(r, g, b) = self.colour;
+        Self {
+            colour: RGBColor(pale(r), pale(g), pale(b)),
+            faint: true,
+            ..self
+        }
+    }
+
+    /// A line's width in pixels.
+    pub fn width(&self) -> u32 {
+        if self.faint {
+            1
+        } else {
+            2
         }
     }
 
@@ -63,6 +88,11 @@ const MEMBERS: [(f64, Dash); 5] = [
     (0.55, Dash::Dashed),
 ];
 
+/// A family without a hue (DQN from scratch: the baselines) would be greys too alike to
+/// tell apart (three DQN sizes in the paper's protocol): each member gets a colour of its
+/// own, a grey then hues no family uses (teal, olive), solid, then the same dashed.
+const BASELINES: [(f64, f64, f64); 3] = [(0.0, 0.0, 0.40), (175.0, 0.60, 0.32), (60.0, 0.60, 0.33)];
+
 /// The pens of methods of these kinds, in order: member `k` of its family is the `k`-th
 /// method of that family listed.
 pub(super) fn method_pens(kinds: &[MethodKind]) -> Vec<Pen> {
@@ -75,6 +105,19 @@ pub(super) fn method_pens(kinds: &[MethodKind]) -> Vec<Pen> {
                 .iter()
                 .filter(|&&k| family(k) == (hue, saturation))
                 .count();
+            if saturation == 0.0 {
+                let (hue, saturation, lightness) = BASELINES[member % BASELINES.len()];
+                let dash = if (member / BASELINES.len()).is_multiple_of(2) {
+                    Dash::Solid
+                } else {
+                    Dash::Dashed
+                };
+                return Pen {
+                    colour: hsl(hue, saturation, lightness),
+                    dash,
+                    faint: false,
+                };
+            }
             let (lightness, dash) = MEMBERS[member % MEMBERS.len()];
             let dash = match (member / MEMBERS.len() % 2, dash) {
                 (0, dash) => dash,
@@ -84,7 +127,29 @@ pub(super) fn method_pens(kinds: &[MethodKind]) -> Vec<Pen> {
             Pen {
                 colour: hsl(hue, saturation, lightness),
                 dash,
+                faint: false,
             }
+        })
+        .collect()
+}
+
+/// More methods than this in one chart and the chart draws most of them faint.
+pub(super) const MANY: usize = 6;
+
+/// Which methods a chart draws in full, the others faint ([`Pen::faded`]): all of up to
+/// [`MANY`]; of more, the paper's SAP-Net and the best of each family by `scores` (the
+/// mean training return), so that eleven lines read as one per family.
+pub(super) fn emphasised(kinds: &[MethodKind], labels: &[String], scores: &[f64]) -> Vec<bool> {
+    if kinds.len() <= MANY {
+        return vec![true; kinds.len()];
+    }
+    let papers = crate::reuse::Method::the_papers().label();
+    (0..kinds.len())
+        .map(|i| {
+            let best_of_family = (0..kinds.len())
+                .filter(|&j| family(kinds[j]) == family(kinds[i]))
+                .max_by(|&a, &b| scores[a].total_cmp(&scores[b]).then(b.cmp(&a)));
+            labels[i] == papers || best_of_family == Some(i)
         })
         .collect()
 }
@@ -189,7 +254,8 @@ mod tests {
     }
 
     /// The reuse comparison's eleven methods (five SAP-Net, two random, UCB1, PRQ, the best
-    /// source, DQN) and two more DQNs: every pen differs, every family shares one hue.
+    /// source, DQN) and two more DQNs: every pen differs, every family but the baselines
+    /// shares one hue.
     #[test]
     fn thirteen_methods_get_distinct_pens_with_families_by_hue() {
         use crate::reuse::Method;
@@ -215,10 +281,11 @@ mod tests {
             for j in 0..i {
                 let apart = distance(pens[i].colour, pens[j].colour);
                 assert!(apart > 30.0, "methods {j} and {i}: {apart:.1} apart");
-                if family(kinds[i]) == family(kinds[j]) {
+                if kinds[i].saturation == 0 && kinds[j].saturation == 0 {
+                    // The baselines: a colour each (asserted below).
+                } else if family(kinds[i]) == family(kinds[j]) {
                     match (hue(pens[i].colour), hue(pens[j].colour)) {
                         (Some(a), Some(b)) => assert!((a - b).abs() < 1.5, "{i} {j}: {a} {b}"),
-                        (None, None) => {}
                         other => panic!("{i} and {j} of one family: hues {other:?}"),
                     }
                 } else if let (Some(a), Some(b)) = (hue(pens[i].colour), hue(pens[j].colour)) {
@@ -234,6 +301,56 @@ mod tests {
         assert_eq!(pens[7].dash, Solid);
         // The two random selectors are one family: the second is its darker member.
         assert_eq!(pens[6].colour, hsl(212.0, 0.65, 0.25));
+        // The three DQN baselines: a grey, a teal and an olive, no hue of a family's
+        // within 25°, all solid.
+        assert_eq!(hue(pens[10].colour), None);
+        for pen in &pens[11..] {
+            let h = hue(pen.colour).expect("a baseline past the first has a hue");
+            for family in [0.0, 30.0, 125.0, 212.0, 280.0] {
+                let apart = (h - family).abs().min(360.0 - (h - family).abs());
+                assert!(apart > 25.0, "baseline hue {h} near {family}");
+            }
+            assert_eq!(pen.dash, Dash::Solid);
+        }
+    }
+
+    /// The reuse comparison's eleven methods: the paper's SAP-Net, the best SAP-Net
+    /// variant, the better random selector and each lone family's method in full; the
+    /// other SAP-Net variants and the other random selector faint. Four methods: all.
+    #[test]
+    fn of_many_methods_the_papers_and_the_best_of_each_family_stand_out() {
+        use crate::reuse::Method;
+        let sapnet = Method::SapNet.kind();
+        let kinds = [
+            sapnet,
+            sapnet,
+            sapnet,
+            Method::Random.kind(),
+            Method::RandomPerEpisode.kind(),
+            Method::Ucb1.kind(),
+            Method::BestSource.kind(),
+        ];
+        let labels: Vec<String> = [
+            "sapnet",
+            "sapnet-k50",
+            "sapnet-episode",
+            "random",
+            "random-episode",
+            "ucb1",
+            "best-source",
+        ]
+        .map(String::from)
+        .to_vec();
+        let scores = [100.0, 90.0, 150.0, 120.0, 130.0, 50.0, 10.0];
+        assert_eq!(
+            emphasised(&kinds, &labels, &scores),
+            [true, false, true, false, true, true, true]
+        );
+        assert!(emphasised(&kinds[..4], &labels[..4], &scores[..4])
+            .iter()
+            .all(|&e| e));
+        let faded = method_pens(&kinds)[1].faded();
+        assert!(faded.faint && faded.width() < method_pens(&kinds)[1].width());
     }
 
     #[test]
