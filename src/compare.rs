@@ -82,7 +82,7 @@ pub fn compare(args: &CompareArgs) -> Result<Report> {
                 .collect(),
         })
         .collect();
-    let report = Report::of_scored(&task, range, &scored);
+    let report = Report::of_scored(&task, range, last.get(), &scored);
     report.write(out)?;
     let data = PlotData {
         task: task.clone(),

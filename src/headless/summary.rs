@@ -53,7 +53,11 @@ pub fn print_comparison(summary: &results::Summary) -> Result<()> {
     let mut table = if summary.comparison.is_empty() {
         String::new()
     } else {
-        let mut table = report::comparison::table(&summary.comparison, report::Units::Returns);
+        let mut table = report::comparison::table(
+            &summary.comparison,
+            report::Units::Returns,
+            report::TestScore::Greedy,
+        );
         let pairs = report::improvement::verdicts(&summary.pairs, "return");
         if !pairs.is_empty() {
             table.push('\n');

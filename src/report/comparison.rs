@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use serde::Serialize;
 
 use super::runs::LibraryEntry;
-use super::{MethodRuns, Units};
+use super::{MethodRuns, TestScore, Units};
 use crate::reuse::MethodKind;
 use crate::seeds::{self, Part};
 use crate::stats::{aggregate, bootstrap, proportion, Estimate, Scores};
@@ -334,7 +334,7 @@ fn interval(e: &Estimate, digits: usize) -> String {
 }
 
 /// The comparison as a plain-text table, for stdout: IQMs with their 95% intervals.
-pub fn table(rows: &[MethodComparison], units: Units) -> String {
+pub fn table(rows: &[MethodComparison], units: Units, test_score: TestScore) -> String {
     let digits = match units {
         Units::Returns => 1,
         Units::Normalised => 3,
@@ -345,16 +345,13 @@ pub fn table(rows: &[MethodComparison], units: Units) -> String {
             header.push(format!("ep→{}", t.threshold));
         }
     }
-    header.extend(
-        [
-            "return IQM [95% CI]",
-            "test IQM [95% CI]",
-            "tested",
-            "ranks",
-            "lock-in step",
-        ]
-        .map(String::from),
-    );
+    header.extend([
+        "return IQM [95% CI]".to_string(),
+        format!("{} IQM [95% CI]", test_score.short()),
+        "tested".to_string(),
+        "ranks".to_string(),
+        "lock-in step".to_string(),
+    ]);
     let tasks = share_tasks(rows);
     if !tasks.is_empty() {
         header.push("% steps by task".into());

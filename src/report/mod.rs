@@ -80,6 +80,34 @@ impl Units {
     }
 }
 
+/// What a report's `test` columns measure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TestScore {
+    /// The mean return of a run's greedy test episodes (sapnet's own runs).
+    Greedy,
+    /// The mean return of a run's last `k` training episodes (`sapnet compare`'s runs of
+    /// other tools, which have no greedy test).
+    LastEpisodes(usize),
+}
+
+impl TestScore {
+    /// In a table's header: `test` or `final`.
+    pub fn short(self) -> &'static str {
+        match self {
+            TestScore::Greedy => "test",
+            TestScore::LastEpisodes(_) => "final",
+        }
+    }
+
+    /// In a figure's title.
+    pub fn long(self) -> String {
+        match self {
+            TestScore::Greedy => "greedy test score".into(),
+            TestScore::LastEpisodes(k) => format!("final score (last {k} episodes)"),
+        }
+    }
+}
+
 /// A method's performance profile: the share of its runs whose normalised test score is
 /// above each level ([`profile::levels`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -97,6 +125,8 @@ pub struct Report {
     /// The same tasks as the figures' titles name them ([`plots::task_title`]).
     pub task_titles: Vec<String>,
     pub comparison: Vec<MethodComparison>,
+    /// What the comparison's and the pairs' `test` score is.
+    pub test_score: TestScore,
     pub improvement: Vec<Improvement>,
     pub scores: Vec<RunScores>,
     pub profiles: Vec<Profile>,
@@ -205,6 +235,7 @@ impl Report {
             tasks,
             task_titles,
             comparison,
+            test_score: TestScore::Greedy,
             improvement,
             scores,
             profiles,
@@ -228,7 +259,7 @@ impl Report {
     /// The comparison as a table, for stdout, then the pairs of the training return (the
     /// headline score: test scores are not ranked) by the separation rule.
     pub fn table(&self) -> String {
-        let mut text = comparison::table(&self.comparison, self.units);
+        let mut text = comparison::table(&self.comparison, self.units, self.test_score);
         let pairs = improvement::verdicts(&self.improvement, "return");
         if !pairs.is_empty() {
             text.push('\n');

@@ -4,7 +4,7 @@
 //! protocol's own runs; the final score stands where a protocol's greedy test score does
 //! (the method's kind says so: [`crate::reuse::Tested::LastEpisodes`]).
 
-use super::{MethodRuns, Report, RunScores, Units};
+use super::{MethodRuns, Report, RunScores, TestScore, Units};
 use crate::reuse::MethodKind;
 use crate::stats::Scores;
 
@@ -29,7 +29,8 @@ pub struct ScoredRun {
 impl Report {
     /// The report of `methods` on `task`, in the task's returns, normalised (for the
     /// optimality gap and the profiles) by `range`. A method without runs is left out.
-    pub fn of_scored(task: &str, range: (f64, f64), methods: &[ScoredMethod]) -> Self {
+    /// `last`: the episodes each run's final score is the mean of.
+    pub fn of_scored(task: &str, range: (f64, f64), last: usize, methods: &[ScoredMethod]) -> Self {
         let mut scores = Vec::new();
         let mut measured = Vec::new();
         let mut left_out = Vec::new();
@@ -49,13 +50,15 @@ impl Report {
             }));
             measured.push(runs);
         }
-        Self::of_methods(
+        let mut report = Self::of_methods(
             Units::Returns,
             (vec![task.to_string()], vec![task.to_string()]),
             &measured,
             scores,
             left_out,
-        )
+        );
+        report.test_score = TestScore::LastEpisodes(last);
+        report
     }
 }
 
@@ -119,6 +122,7 @@ mod tests {
         let report = Report::of_scored(
             "CartPole-v1",
             (0.0, 500.0),
+            20,
             &[
                 method("a", &[10.0, 20.0, 30.0, 40.0]),
                 method("b", &[100.0, 200.0, 300.0, 400.0]),
@@ -144,5 +148,7 @@ mod tests {
             .collect();
         assert_eq!(b_over_a, [1.0, 1.0]);
         assert_eq!(report.reference.as_deref(), Some("a"));
+        assert_eq!(report.test_score, TestScore::LastEpisodes(20));
+        assert!(report.table().contains("final IQM [95% CI]"));
     }
 }

@@ -76,6 +76,7 @@ fn sb3_monitor_files_give_rliables_intervals() {
     assert!(output.status.success(), "{}", stderr(&output));
     let table = String::from_utf8_lossy(&output.stdout);
     assert!(table.contains("dqn") && table.contains("ppo"), "{table}");
+    assert!(table.contains("final IQM [95% CI]"), "{table}");
 
     let expected: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(fixtures().join("rliable.json")).unwrap())

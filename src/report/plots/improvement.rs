@@ -109,9 +109,10 @@ pub(super) fn probabilities<DB: DrawingBackend>(
     let (body, notes) = body.split_vertically(height.saturating_sub(NOTES));
     let panels = body.split_evenly((1, 2));
     let order: Vec<String> = report.comparison.iter().map(|m| m.method.clone()).collect();
+    let test_score = report.test_score.long();
     for (panel, (score, caption)) in panels
         .iter()
-        .zip([("test", "greedy test score"), ("return", "training return")])
+        .zip([("test", test_score.as_str()), ("return", "training return")])
     {
         draw_matrix(panel, caption, &matrix(&order, &report.improvement, score))?;
     }

@@ -100,9 +100,10 @@ fn aggregates<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, report: &Report)
         ("mean", |a| a.mean),
         ("optimality gap (normalised)", |a| a.optimality_gap),
     ];
+    let test_score = report.test_score.long();
     for (r, (score, pick_score)) in [
         (
-            "test score",
+            test_score.as_str(),
             (|m| m.test) as fn(&crate::report::MethodComparison) -> Option<Aggregates>,
         ),
         ("training return", |m| m.training),

@@ -70,7 +70,10 @@ pub(super) fn profiles<DB: DrawingBackend>(
     let (area, legend_area) = root.split_horizontally(width.saturating_sub(legend::WIDTH));
     let mut chart = ChartBuilder::on(&area)
         .caption(
-            title(report, "performance profiles of the greedy test score"),
+            title(
+                report,
+                &format!("performance profiles of the {}", report.test_score.long()),
+            ),
             (FAMILY, 20),
         )
         .margin(12)
@@ -80,7 +83,10 @@ pub(super) fn profiles<DB: DrawingBackend>(
         .build_cartesian_2d(low..high, 0f64..1.02f64)?;
     chart
         .configure_mesh()
-        .x_desc("normalised test score τ: (return − lowest) / (highest − lowest) of the task")
+        .x_desc(format!(
+            "normalised {} τ: (return − lowest) / (highest − lowest) of the task",
+            report.test_score.short()
+        ))
         .y_desc("share of runs with score > τ")
         .x_label_formatter(&|x| format!("{x:.2}"))
         .y_label_formatter(&|y| format!("{y:.1}"))
