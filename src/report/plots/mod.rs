@@ -10,6 +10,7 @@
 
 mod activations;
 mod axes;
+mod comparison_style;
 mod curves;
 mod efficiency;
 mod improvement;
