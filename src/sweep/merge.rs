@@ -7,6 +7,8 @@
 //!   every cell pooled (its report in `across-tasks/`);
 //! - `improvement.csv`: the probability of improvement of every method over every other,
 //!   per axis value (`axis, value, score, method, over, p, lo, hi`);
+//! - `sweep.png` / `.svg`: each method's IQM of both scores, with its interval, against
+//!   each axis value ([`report::plots::write_sweep`]);
 //! - `episodes.csv`: every episode of every cell, long format, the cell and its axis values
 //!   as leading columns (ready for pandas or R);
 //! - `<axis>=<value>/`: that value's report (`comparison.csv`, `improvement.csv`,
@@ -22,6 +24,7 @@ use anyhow::{Context, Result};
 
 use super::{cell_name, cell_results, Manifest};
 use crate::config::Config;
+use crate::report::plots::SweepAxis;
 use crate::report::{self, comparison, improvement, Curve, PlotData, Report, RunSummary, TaskRuns};
 use crate::results::{self, Results};
 use crate::reuse::Method;
@@ -108,6 +111,9 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
     let mut comparisons = Table::default();
     let mut improvements = Table::default();
     let mut tables = Vec::new();
+    // Per axis (the pooled rows of `*` aside), each value's comparison: `sweep.png`.
+    let mut plotted: Vec<SweepAxis> = Vec::new();
+    let mut task_titles: Vec<String> = Vec::new();
     let mut groups: Vec<(String, String, Vec<&Results>)> = Vec::new();
     for (a, axis) in axes.iter().enumerate() {
         let mut values: Vec<&String> = Vec::new();
@@ -150,6 +156,28 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
         } else {
             format!("{axis} = {value}")
         });
+        for title in &report.task_titles {
+            if !task_titles.contains(title) {
+                task_titles.push(title.clone());
+            }
+        }
+        if axis != ACROSS_TASKS {
+            let at = match plotted.iter().position(|p| &p.axis == axis) {
+                Some(at) => at,
+                None => {
+                    plotted.push(SweepAxis {
+                        axis: axis.clone(),
+                        values: Vec::new(),
+                        comparisons: Vec::new(),
+                    });
+                    plotted.len() - 1
+                }
+            };
+            plotted[at].values.push(value.clone());
+            plotted[at]
+                .comparisons
+                .push((report.comparison.clone(), report.units));
+        }
         let lead = [axis.clone(), value.clone(), group.len().to_string()];
         let (header, records) = comparison::csv_records(&report.comparison, report.units);
         comparisons.extend(&["axis", "value", "cells"], &lead, &header, records);
@@ -187,6 +215,7 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
     }
     comparisons.write(&out.join("comparison.csv"))?;
     improvements.write(&out.join("improvement.csv"))?;
+    report::plots::write_sweep(&out, &task_titles, &plotted).context("drawing sweep.png")?;
     crate::failpoint::point("merge-written");
     if std::fs::symlink_metadata(&merged).is_ok() {
         std::fs::remove_dir_all(&merged)

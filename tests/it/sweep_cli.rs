@@ -195,6 +195,16 @@ fn a_sweep_through_gnu_parallel_survives_a_killed_cell() {
     let intervals = std::fs::read_to_string(value.join("intervals.svg")).unwrap();
     assert!(intervals.contains("sapnet.temperature = 4.0 · "));
     assert!(intervals.contains("over 6 runs per method"));
+    // Each score against each axis's values, beside the merged results.
+    assert!(a.join("merged/sweep.png").exists());
+    let sweep_plot = std::fs::read_to_string(a.join("merged/sweep.svg")).unwrap();
+    for text in [
+        "greedy test score against sapnet.temperature",
+        "training return against seed",
+        "95% stratified bootstrap CI",
+    ] {
+        assert!(sweep_plot.contains(text), "sweep.svg lacks {text:?}");
+    }
 }
 
 #[test]

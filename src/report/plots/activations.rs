@@ -7,7 +7,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::legend::{self, Entry, Swatch};
-use super::palette::{marker, source_colour, Pen, SOURCE_COLOURS};
+use super::palette::{marker, source_colour, SOURCE_COLOURS};
 use super::{mean_over_runs, Drawn, PlotData, FAMILY};
 
 /// The width of the sources' legend beside the panels.
@@ -15,11 +15,14 @@ pub(super) const SOURCES_LEGEND: u32 = 200;
 /// A panel's height.
 const PANEL_HEIGHT: u32 = 330;
 
-/// The figure's size for `methods` panels, two a row beside the sources' legend.
+/// The figure's size for `methods` panels, two a row beside the sources' legend (one
+/// alone as tall as a learning curve).
 pub(super) fn size(methods: usize) -> (u32, u32) {
-    let rows = methods.div_ceil(2).max(1) as u32;
-    let width = if methods > 1 { 1300 } else { 900 };
-    (width + SOURCES_LEGEND, 50 + rows * PANEL_HEIGHT)
+    if methods <= 1 {
+        return (1000 + SOURCES_LEGEND, 600);
+    }
+    let rows = methods.div_ceil(2) as u32;
+    (1300 + SOURCES_LEGEND, 50 + rows * PANEL_HEIGHT)
 }
 
 /// The log axis' ends for activations `values`: from the smallest positive one (or a
@@ -93,7 +96,7 @@ pub(super) fn activation_panels<DB: DrawingBackend>(
         .enumerate()
         .map(|(p, name)| Entry {
             label: name.clone(),
-            swatch: Swatch::Line(Pen::solid(source_colour(p))),
+            swatch: Swatch::Marked(source_colour(p), shape(p)),
         })
         .collect();
     legend::draw(&legend_area.margin(30, 0, 0, 0), &entries, &[])?;
@@ -110,6 +113,11 @@ pub(super) fn activation_panels<DB: DrawingBackend>(
         draw_panel(panel, &legend::with_runs(label, *runs), lines, (floor, top))?;
     }
     root.present()
+}
+
+/// Source `p`'s marker: a shape of its own beside every source of its colour.
+fn shape(p: usize) -> usize {
+    p / SOURCE_COLOURS.len() + p
 }
 
 /// One method's activations, a line per source, markers to tell coinciding lines apart.
@@ -151,7 +159,7 @@ fn draw_panel<DB: DrawingBackend>(
     let sources = lines.len();
     for (p, line) in lines.iter().enumerate() {
         let colour = source_colour(p);
-        let shape = p / SOURCE_COLOURS.len() + p;
+        let shape = shape(p);
         chart.draw_series(LineSeries::new(
             line.iter()
                 .enumerate()

@@ -7,7 +7,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::intervals::{runs, title};
+use super::comparison_style::{runs, title};
 use super::{Drawn, FAMILY};
 use crate::report::{Improvement, Report};
 use crate::stats::separation::Verdict;

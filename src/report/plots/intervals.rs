@@ -2,7 +2,7 @@
 //! style, written together: `intervals.png`, each aggregate of each method as a bar from
 //! the low to the high end of its 95% interval with the point marked (drawn here);
 //! `profiles.png` ([`super::profiles`]); `improvement.png` ([`super::improvement`]). Each
-//! also as `.svg`. The titles, pens and run counts the three share are here.
+//! also as `.svg`.
 
 use std::path::Path;
 
@@ -10,8 +10,8 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::comparison_style::{pens, runs, title};
 use super::legend;
-use super::palette::{method_pens, Pen};
 use super::{atomically, axes, png, register_font, Drawn, FAMILY};
 use crate::report::{Aggregates, Report, Units};
 use crate::stats::{bootstrap, Estimate};
@@ -50,24 +50,6 @@ fn units(report: &Report) -> &'static str {
         Units::Returns => "return",
         Units::Normalised => "normalised score",
     }
-}
-
-/// A title: the sweep's axis value if any, the tasks, then `rest`.
-pub(super) fn title(report: &Report, rest: &str) -> String {
-    legend::title(
-        report.subject.as_deref(),
-        &format!("{}: {rest}", report.task_titles.join(", ")),
-    )
-}
-
-/// "2 runs" (or "2–5 runs") per method.
-pub(super) fn runs(report: &Report) -> String {
-    legend::runs_phrase(report.comparison.iter().map(|m| m.runs))
-}
-
-/// The methods' pens, as the learning curves give them.
-pub(super) fn pens(report: &Report) -> Vec<Pen> {
-    method_pens(&report.comparison.iter().map(|m| m.kind).collect::<Vec<_>>())
 }
 
 fn colours(report: &Report) -> Vec<RGBColor> {

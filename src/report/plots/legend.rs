@@ -6,7 +6,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::palette::{Dash, Pen};
+use super::palette::{marker, Dash, Pen};
 use super::{Drawn, FAMILY};
 use crate::env::EnvConfig;
 
@@ -17,6 +17,8 @@ pub(super) const WIDTH: u32 = 300;
 pub(super) enum Swatch {
     Line(Pen),
     Bar(Pen),
+    /// A line of a colour with marker shape `usize` on it ([`super::palette::marker`]).
+    Marked(RGBColor, usize),
 }
 
 /// A bar of `pen` between two corners: filled, and outlined for a dashed pen.
@@ -107,6 +109,13 @@ pub(super) fn draw<DB: DrawingBackend>(
                 for shape in bar([(x + 7, y - 6), (x + 21, y + 6)], pen) {
                     area.draw(&shape)?;
                 }
+            }
+            Swatch::Marked(colour, shape) => {
+                area.draw(&PathElement::new(
+                    vec![(x, y), (x + 28, y)],
+                    colour.stroke_width(2),
+                ))?;
+                area.draw(&(EmptyElement::at((x + 14, y)) + marker(shape, (0, 0), colour)))?;
             }
         }
         area.draw(&Text::new(

@@ -10,6 +10,7 @@
 
 mod activations;
 mod axes;
+mod comparison_style;
 mod curves;
 mod efficiency;
 mod improvement;
@@ -18,6 +19,7 @@ mod legend;
 mod palette;
 mod profiles;
 mod selections;
+mod sweep;
 mod text;
 
 use std::path::Path;
@@ -188,6 +190,7 @@ pub use axes::return_bounds;
 pub use curves::mean_over_runs;
 pub use intervals::write_intervals;
 pub use legend::task_title;
+pub use sweep::{write_sweep, SweepAxis};
 
 pub(super) type Drawn<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 

@@ -4,8 +4,8 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::comparison_style::{pens, runs, title};
 use super::curves::{emphasis_note, in_drawing_order};
-use super::intervals::{pens, runs, title};
 use super::legend::{self, Entry, Swatch};
 use super::palette::{emphasised, Pen};
 use super::{Drawn, FAMILY};
