@@ -212,8 +212,22 @@ fn run_env(cli: &Cli, args: &EnvArgs) -> Result<()> {
 }
 
 fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
+    let (lesson, origin) = edited_lesson(cli, args)?;
+    if let Some(path) = &args.save {
+        lesson.save(path)?;
+        eprintln!(
+            "wrote {} ({origin} with {}): `sapnet teach --config {}` opens it",
+            path.display(),
+            edits_said(args),
+            path.display()
+        );
+        return Ok(());
+    }
+    let lesson = lesson.lesson().map_err(|message| ConfigError::Invalid {
+        origin: format!("{origin} with {}", edits_said(args)),
+        message,
+    })?;
     if !args.headless {
-        let lesson = TeachConfig::load(cli.run.config.as_deref())?;
         let n = lesson.net.len();
         if let Some(&i) = args.activate.iter().find(|&&i| i >= n) {
             anyhow::bail!(
@@ -238,11 +252,41 @@ fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
         }
         return tui::run_teach(teach);
     }
-    crate::teach::headless::run(
-        cli.run.config.as_deref(),
-        args,
-        &mut std::io::stdout().lock(),
-    )
+    crate::teach::headless::run_lesson(lesson, &origin, args, &mut std::io::stdout().lock())
+}
+
+/// The lesson `--config` names (Fig. 2 without one) with `--add-edge` and `--cut-edge`
+/// applied in order, each refused naming itself; a lesson to save is built first, so that
+/// one the net refuses is never written.
+fn edited_lesson(cli: &Cli, args: &TeachArgs) -> Result<(TeachConfig, String)> {
+    let (mut lesson, origin) = TeachConfig::read(cli.run.config.as_deref())?;
+    for (flag, values) in &args.edits {
+        let edit = crate::teach::edit::GraphEdit::parse(flag, values)
+            .map_err(|why| anyhow::anyhow!("{flag} {}: {why}", values.join(" ")))?;
+        lesson
+            .apply(edit)
+            .map_err(|why| anyhow::anyhow!("{}: {why} ({origin})", edit.flag()))?;
+    }
+    if args.save.is_some() {
+        lesson.lesson().map_err(|message| ConfigError::Invalid {
+            origin: format!("{origin} with {}", edits_said(args)),
+            message,
+        })?;
+    }
+    Ok((lesson, origin))
+}
+
+/// The edits as given, for messages.
+fn edits_said(args: &TeachArgs) -> String {
+    if args.edits.is_empty() {
+        return "no edits".into();
+    }
+    let said: Vec<String> = args
+        .edits
+        .iter()
+        .map(|(flag, values)| format!("{flag} {}", values.join(" ")))
+        .collect();
+    said.join(" ")
 }
 
 fn run_experiment(cli: &Cli) -> Result<()> {

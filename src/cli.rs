@@ -301,7 +301,35 @@ fn mut_path(
 /// or `--help`.
 pub fn parse() -> Cli {
     let matches = command().get_matches();
-    Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
+    let mut cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    if let (Some(Command::Teach(args)), Some(teach)) =
+        (&mut cli.command, matches.subcommand_matches("teach"))
+    {
+        args.edits = edits_in_order(teach);
+    }
+    cli
+}
+
+/// `teach`'s `--add-edge` and `--cut-edge`, each with its values, in the order given: clap
+/// keeps each flag's values apart, and their positions say the order.
+fn edits_in_order(teach: &clap::ArgMatches) -> Vec<(&'static str, Vec<String>)> {
+    let mut edits: Vec<(usize, &'static str, Vec<String>)> = Vec::new();
+    for (id, flag, arity) in [("add_edge", "--add-edge", 3), ("cut_edge", "--cut-edge", 2)] {
+        let (Some(indices), Some(values)) = (teach.indices_of(id), teach.get_many::<String>(id))
+        else {
+            continue;
+        };
+        let indices: Vec<usize> = indices.collect();
+        let values: Vec<String> = values.cloned().collect();
+        for (at, chunk) in indices.chunks(arity).zip(values.chunks(arity)) {
+            edits.push((at[0], flag, chunk.to_vec()));
+        }
+    }
+    edits.sort_by_key(|&(at, _, _)| at);
+    edits
+        .into_iter()
+        .map(|(_, flag, values)| (flag, values))
+        .collect()
 }
 
 /// The library root when `--library` is not given.
@@ -580,4 +608,22 @@ pub struct TeachArgs {
     /// With --headless: print one JSON object {activations, probabilities, trace}.
     #[arg(long, requires = "headless")]
     pub json: bool,
+
+    /// Add an edge of weight W between policies I and J (or set its weight) before the
+    /// lesson opens; repeatable, applied in order with --cut-edge.
+    #[arg(long = "add-edge", num_args = 3, value_names = ["I", "J", "W"], action = clap::ArgAction::Append, allow_negative_numbers = true)]
+    pub add_edge: Vec<String>,
+
+    /// Remove the edge between policies I and J before the lesson opens; repeatable,
+    /// applied in order with --add-edge.
+    #[arg(long = "cut-edge", num_args = 2, value_names = ["I", "J"], action = clap::ArgAction::Append)]
+    pub cut_edge: Vec<String>,
+
+    /// Write the lesson, its edits applied, to FILE in the format --config reads, and exit.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["headless", "activate", "run"])]
+    pub save: Option<PathBuf>,
+
+    /// The edits in the order given on the command line: (flag, its values).
+    #[arg(skip)]
+    pub edits: Vec<(&'static str, Vec<String>)>,
 }

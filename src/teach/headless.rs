@@ -21,10 +21,21 @@ struct JsonTrace<'a> {
 /// Loads the teach file (the embedded Fig. 2 without one), activates `args.activate` in
 /// order as positive transitions, and writes the trace and the final state to `out`.
 pub fn run(config: Option<&Path>, args: &TeachArgs, out: &mut impl Write) -> Result<()> {
-    let Lesson { names, mut net, .. } = TeachConfig::load(config)?;
+    let lesson = TeachConfig::load(config)?;
     let origin = config.map_or("the embedded Fig. 2".to_string(), |p| {
         p.display().to_string()
     });
+    run_lesson(lesson, &origin, args, out)
+}
+
+/// [`run`] on a lesson already built (`origin` names it in messages).
+pub fn run_lesson(
+    lesson: Lesson,
+    origin: &str,
+    args: &TeachArgs,
+    out: &mut impl Write,
+) -> Result<()> {
+    let Lesson { names, mut net, .. } = lesson;
     if let Some(&i) = args.activate.iter().find(|&&i| i >= net.len()) {
         bail!(
             "--activate {i}: there is no policy {i}; {origin} has {} policies, numbered 0 to {}",

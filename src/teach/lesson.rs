@@ -97,9 +97,35 @@ impl TeachConfig {
         }
     }
 
+    /// Reads a teach file, or the embedded Fig. 2 without one, unbuilt (to be edited
+    /// first), with what names it in errors.
+    pub fn read(path: Option<&Path>) -> Result<(Self, String), ConfigError> {
+        match path {
+            Some(path) => {
+                let origin = path.display().to_string();
+                let text = crate::ron_file::read_text(path)?;
+                Ok((Self::from_ron(&text, &origin)?, origin))
+            }
+            None => {
+                let origin = "the embedded Fig. 2".to_string();
+                Ok((Self::from_ron(FIG2, &origin)?, origin))
+            }
+        }
+    }
+
     /// Reads and builds a teach file from RON text; `origin` names it in errors.
     pub fn lesson_from_ron(text: &str, origin: &str) -> Result<Lesson, ConfigError> {
-        let config: TeachConfig = parse_ron(text, origin).map_err(|e| {
+        Self::from_ron(text, origin)?
+            .lesson()
+            .map_err(|message| ConfigError::Invalid {
+                origin: origin.to_string(),
+                message,
+            })
+    }
+
+    /// Reads a teach file from RON text, unbuilt.
+    fn from_ron(text: &str, origin: &str) -> Result<Self, ConfigError> {
+        parse_ron(text, origin).map_err(|e| {
             // A training config given where a lesson is expected: say what teach reads.
             if crate::config::Config::from_ron(text, origin).is_ok() {
                 ConfigError::Invalid {
@@ -113,10 +139,6 @@ impl TeachConfig {
             } else {
                 e
             }
-        })?;
-        config.lesson().map_err(|message| ConfigError::Invalid {
-            origin: origin.to_string(),
-            message,
         })
     }
 
@@ -191,7 +213,7 @@ impl TeachConfig {
     }
 
     /// N, from whichever of `policies`, `names` and `descriptions` are given; they must agree.
-    fn count(&self) -> Result<usize, String> {
+    pub(super) fn count(&self) -> Result<usize, String> {
         let given = [
             ("policies", self.policies),
             ("names", self.names.len()),

@@ -7,10 +7,13 @@
 //! - [`knobs`]: the session's live edits (T_ω, 𝒜, τ, paths, an edge's weight) and what
 //!   each changed.
 //! - [`labels`]: short names for policies and tasks, for a graph node or a narrow column.
+//! - [`edit`]: the graph's edits made before a lesson is taught (`--add-edge`,
+//!   `--cut-edge`) and the lesson saved (`--save`).
 //! - [`headless`]: `sapnet teach --headless`, the trace as a table or as JSON.
 //!
 //! Nothing here draws: the terminal UI (`tui`) imports this module, never the reverse.
 
+pub mod edit;
 pub mod headless;
 pub mod knobs;
 pub mod labels;
@@ -28,6 +31,7 @@ mod tests {
     fn teaching_imports_no_front_end() {
         let files = [
             ("mod.rs", include_str!("mod.rs")),
+            ("edit.rs", include_str!("edit.rs")),
             ("lesson.rs", include_str!("lesson.rs")),
             ("headless.rs", include_str!("headless.rs")),
             ("knobs.rs", include_str!("knobs.rs")),

@@ -199,3 +199,80 @@ fn a_training_config_is_told_teach_reads_a_lesson() {
     assert!(stderr.contains("this is a training config"), "{stderr}");
     assert!(stderr.contains("assets/teach_fig2.ron"), "{stderr}");
 }
+
+/// Fig. 2 with an edge π0–π3 of weight 0.3, written by hand as a lesson file.
+const FIG2_WITH_0_3: &str = "(policies: 4, edges: [(0, 1, 0.4), (0, 2, 0.4), (1, 2, 0.4), \
+    (1, 3, 0.4), (0, 3, 0.3)], threshold: 1.0, coefficient: 1.0, temperature: 1.0, \
+    paths: Literal)";
+
+#[test]
+fn an_edge_added_by_flag_or_saved_walks_as_the_lesson_written_by_hand() {
+    let tmp = tempfile::tempdir().unwrap();
+    let by_hand = tmp.path().join("by_hand.ron");
+    std::fs::write(&by_hand, FIG2_WITH_0_3).unwrap();
+    let walk = |extra: &[&str]| {
+        let mut args = vec!["teach", "--headless", "--activate", "1", "--json"];
+        args.extend_from_slice(extra);
+        let output = sapnet(&args);
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        output.stdout
+    };
+    let reference = walk(&["--config", by_hand.to_str().unwrap()]);
+    assert_eq!(walk(&["--add-edge", "0", "3", "0.3"]), reference);
+    assert_ne!(walk(&[]), reference, "the edge changes the walk");
+
+    let saved = tmp.path().join("lesson.ron");
+    let output = sapnet(&[
+        "teach",
+        "--add-edge",
+        "0",
+        "3",
+        "0.3",
+        "--save",
+        saved.to_str().unwrap(),
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_eq!(walk(&["--config", saved.to_str().unwrap()]), reference);
+    // Applied in order: added then cut leaves Fig. 2.
+    assert_eq!(
+        walk(&["--add-edge", "0", "3", "0.3", "--cut-edge", "3", "0"]),
+        walk(&[])
+    );
+}
+
+#[test]
+fn edits_the_lesson_refuses_are_said_and_nothing_is_saved() {
+    let tmp = tempfile::tempdir().unwrap();
+    let saved = tmp.path().join("lesson.ron");
+    let out = saved.to_str().unwrap();
+    for (edits, says) in [
+        (
+            vec!["--cut-edge", "0", "3", "--add-edge", "0", "3", "0.3"],
+            "--cut-edge 0 3: there is no edge between 0 and 3",
+        ),
+        (vec!["--add-edge", "0", "7", "0.3"], "there is no policy 7"),
+        (vec!["--add-edge", "2", "2", "0.3"], "to itself"),
+        (vec!["--add-edge", "0", "3", "-0.3"], "above 0"),
+        (
+            vec!["--add-edge", "0", "x", "0.3"],
+            "J: expected a policy's index",
+        ),
+    ] {
+        let mut args = vec!["teach"];
+        args.extend(edits.iter().copied());
+        args.extend(["--save", out]);
+        let output = sapnet(&args);
+        assert_eq!(output.status.code(), Some(2), "{edits:?}");
+        let error = String::from_utf8_lossy(&output.stderr);
+        assert!(error.contains(says), "{edits:?}: {error}");
+        assert!(!saved.exists(), "{edits:?}: a refused lesson was saved");
+    }
+}
