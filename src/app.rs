@@ -216,15 +216,15 @@ fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
     if let Some(path) = &args.save {
         lesson.save(path)?;
         eprintln!(
-            "wrote {} ({origin} with {}): `sapnet teach --config {}` opens it",
+            "wrote {} ({}): `sapnet teach --config {}` opens it",
             path.display(),
-            edits_said(args),
+            edited_origin(&origin, args),
             path.display()
         );
         return Ok(());
     }
     let lesson = lesson.lesson().map_err(|message| ConfigError::Invalid {
-        origin: format!("{origin} with {}", edits_said(args)),
+        origin: edited_origin(&origin, args),
         message,
     })?;
     if !args.headless {
@@ -269,24 +269,24 @@ fn edited_lesson(cli: &Cli, args: &TeachArgs) -> Result<(TeachConfig, String)> {
     }
     if args.save.is_some() {
         lesson.lesson().map_err(|message| ConfigError::Invalid {
-            origin: format!("{origin} with {}", edits_said(args)),
+            origin: edited_origin(&origin, args),
             message,
         })?;
     }
     Ok((lesson, origin))
 }
 
-/// The edits as given, for messages.
-fn edits_said(args: &TeachArgs) -> String {
+/// The lesson's origin with the edits made to it, as given, for messages.
+fn edited_origin(origin: &str, args: &TeachArgs) -> String {
     if args.edits.is_empty() {
-        return "no edits".into();
+        return origin.to_string();
     }
     let said: Vec<String> = args
         .edits
         .iter()
         .map(|(flag, values)| format!("{flag} {}", values.join(" ")))
         .collect();
-    said.join(" ")
+    format!("{origin} with {}", said.join(" "))
 }
 
 fn run_experiment(cli: &Cli) -> Result<()> {
