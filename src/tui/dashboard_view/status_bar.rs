@@ -19,7 +19,7 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: 
         Mode::Paused => ("PAUSED", "space resume · n step · t teach · ? keys"),
         Mode::Teach => (
             "TEACH",
-            "a · s · r · u · c · 1–5 +/− edit · t back · ? keys",
+            "a · s · r · u · c · 1–5 +/− edit · Esc/t back · ? keys",
         ),
     };
     let run = dashboard.main_run();
@@ -38,6 +38,9 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: 
         "q quit"
     } else if let Some(notice) = dashboard.notice {
         notice
+    } else if area.width < 100 && dashboard.mode == Mode::Teach {
+        // `q` here would quit the training too: the way back is what teach mode offers.
+        "Esc/t back · ? keys"
     } else if area.width < 100 {
         "? keys · q quit"
     } else if finished && dashboard.mode != Mode::Teach {
