@@ -31,11 +31,7 @@ struct TestRow {
 /// The plots' data, from the files of a results directory.
 pub fn read(dir: &Path) -> Result<PlotData> {
     let config = read_header(dir)?.config;
-    let returns = by_run(
-        rows::<EpisodeRow>(&dir.join("episodes.csv"))?
-            .into_iter()
-            .map(|r| (r.method, r.run, r.episode, r.reward)),
-    );
+    let returns = training_returns(&dir.join("episodes.csv"))?;
     let tests = by_run(
         rows::<TestRow>(&dir.join("tests.csv"))?
             .into_iter()
@@ -106,7 +102,16 @@ pub fn read(dir: &Path) -> Result<PlotData> {
 }
 
 /// (method, run) → that run's values in order.
-type ByRun = BTreeMap<(String, u32), Vec<f64>>;
+pub(super) type ByRun = BTreeMap<(String, u32), Vec<f64>>;
+
+/// Each run's training returns from a results folder's `episodes.csv`, in episode order.
+pub(super) fn training_returns(path: &Path) -> Result<ByRun> {
+    Ok(by_run(
+        rows::<EpisodeRow>(path)?
+            .into_iter()
+            .map(|r| (r.method, r.run, r.episode, r.reward)),
+    ))
+}
 
 /// Groups `(method, run, index, value)` rows by run, each run's values in order of their
 /// index (episode or test): runs side by side interleave their rows.

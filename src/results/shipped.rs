@@ -24,14 +24,6 @@ struct ListedRuns {
     runs: Vec<RunSummary<String>>,
 }
 
-#[derive(Deserialize)]
-struct EpisodeRow {
-    run: u32,
-    method: String,
-    episode: u32,
-    reward: f64,
-}
-
 /// Whether `dir` is a shipped folder this module can make again: no run records, but the
 /// episodes of the runs its summary lists.
 pub fn can_replot(dir: &Path) -> bool {
@@ -94,31 +86,18 @@ pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
     Ok(summary)
 }
 
-/// Each run's training returns from the folder's `episodes.csv`, in episode order.
+/// Each run's training returns from the folder's `episodes.csv`, keyed by its method.
 fn rewards(path: &Path, methods: &[MethodId]) -> Result<BTreeMap<(MethodId, u32), Vec<f64>>> {
-    let mut reader =
-        safe_io::csv_reader(path).with_context(|| format!("reading {}", path.display()))?;
-    let mut keyed: BTreeMap<(MethodId, u32), Vec<(u32, f64)>> = BTreeMap::new();
-    for (i, row) in reader.deserialize::<EpisodeRow>().enumerate() {
-        let row = row.with_context(|| format!("{}: row {}", path.display(), i + 2))?;
-        let Some(method) = methods.iter().find(|m| m.label() == row.method) else {
-            bail!(
-                "{}: row {}: method {:?}, which the config does not list",
-                path.display(),
-                i + 2,
-                row.method
-            );
-        };
-        keyed
-            .entry((method.clone(), row.run))
-            .or_default()
-            .push((row.episode, row.reward));
-    }
-    Ok(keyed
+    plot_data::training_returns(path)?
         .into_iter()
-        .map(|(key, mut episodes)| {
-            episodes.sort_by_key(|&(episode, _)| episode);
-            (key, episodes.into_iter().map(|(_, r)| r).collect())
+        .map(|((label, run), returns)| {
+            let Some(method) = methods.iter().find(|m| m.label() == label) else {
+                bail!(
+                    "{}: runs of method {label:?}, which the config does not list",
+                    path.display()
+                );
+            };
+            Ok(((method.clone(), run), returns))
         })
-        .collect())
+        .collect()
 }
