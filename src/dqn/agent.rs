@@ -94,6 +94,13 @@ impl DqnAgent {
             .choose(self.steps, actions, rng, || self.online.greedy_action(obs))
     }
 
+    /// The random action of this step's ε-greedy exploration, or `None` when the step is
+    /// greedy: for a method that makes the greedy choice itself ([`act`](Self::act)'s draws).
+    pub fn explore(&self, rng: &mut impl Rng) -> Option<usize> {
+        let actions = self.online.architecture().action_count;
+        self.explorer.explore(self.steps, actions, rng)
+    }
+
     /// From now on, every [`UpdateReport`] carries the [`TdError`] of the transition stored
     /// last in the replay buffer: three forward passes of one observation per round (the
     /// target net once, the online net before and after), so it is off unless asked for.

@@ -38,11 +38,16 @@ impl EpsilonGreedy {
         rng: &mut impl Rng,
         greedy: impl FnOnce() -> Result<usize, E>,
     ) -> Result<usize, E> {
-        if rng.random::<f64>() < self.epsilon(step) {
-            Ok(rng.random_range(0..action_count))
-        } else {
-            greedy()
+        match self.explore(step, action_count, rng) {
+            Some(action) => Ok(action),
+            None => greedy(),
         }
+    }
+
+    /// The coin of [`choose`](Self::choose) alone: the random action when it falls on
+    /// exploring at `step`, `None` when the step is greedy. The same draws as `choose`.
+    pub fn explore(&self, step: u64, action_count: usize, rng: &mut impl Rng) -> Option<usize> {
+        (rng.random::<f64>() < self.epsilon(step)).then(|| rng.random_range(0..action_count))
     }
 }
 

@@ -87,6 +87,9 @@ pub enum Tested {
     BestRecorded,
     /// The method's own learner, not a source.
     Learner,
+    /// The method's learner combined with the sources as the method acts greedily (GPI's
+    /// `argmax_a max(Q_L, max_i Q_i)`): the library and the learner together.
+    Combined,
     /// Nothing: a run of another tool (`sapnet compare`) has no greedy test, and the mean
     /// return of its last episodes stands in the test score's place.
     LastEpisodes,
@@ -101,6 +104,7 @@ impl Tested {
             Self::MostPlayed => "most-played",
             Self::BestRecorded => "best-recorded",
             Self::Learner => "learner",
+            Self::Combined => "combined",
             Self::LastEpisodes => "last-episodes",
         }
     }

@@ -9,7 +9,9 @@ use serde::{Deserialize, Serialize};
 use super::best_source::Oracle;
 use super::definition::{MethodKind, ReuseMethod};
 use super::from_scratch::FromScratch;
+use super::gpi::GpiKnobs;
 use super::prql::PrqlKnobs;
+use super::qswitch::QSwitchKnobs;
 use super::random::{PerEpisode, PerStep};
 use super::sapnet::SapNetKnobs;
 use super::ucb1::Bandit;
@@ -34,6 +36,12 @@ pub enum Method {
     /// PRQ-learning: a new learner, guided by sources through π-reuse
     /// (`Prql()` for the paper's defaults).
     Prql(PrqlKnobs),
+    /// Generalized policy improvement (Barreto et al., 2017): a new learner joins the frozen
+    /// sources, acting ε-greedily on the largest Q-value of any of them (`Gpi()`).
+    Gpi(GpiKnobs),
+    /// The Q-switch of CUP and QMP: a new learner's critic picks, each step, whose proposed
+    /// action is followed (`QSwitch()`; `QSwitch(proposal: Greedy)` the literal reading).
+    QSwitch(QSwitchKnobs),
     /// Fine-tune the library's best source by its recorded score: the selection oracle.
     BestSource,
     /// DQN from scratch with these hidden layers (the paper's baselines: `[100]`,
@@ -57,6 +65,8 @@ impl Method {
             Self::RandomPerEpisode => Box::new(PerEpisode),
             Self::Ucb1 => Box::new(Bandit),
             Self::Prql(knobs) => Box::new(knobs.clone()),
+            Self::Gpi(knobs) => Box::new(knobs.clone()),
+            Self::QSwitch(knobs) => Box::new(knobs.clone()),
             Self::BestSource => Box::new(Oracle),
             Self::Dqn { hidden } => Box::new(FromScratch { hidden }),
         }

@@ -17,16 +17,18 @@
 //! acts).
 //!
 //! One file per method: [`sapnet`], [`random`], [`ucb1`], [`prql`], [`best_source`],
-//! [`from_scratch`], each defining its [`ReuseMethod`]. Adding one is a new file here, a variant
+//! [`from_scratch`], [`gpi`], [`qswitch`], each defining its [`ReuseMethod`]. Adding one is a new file here, a variant
 //! of [`Method`] and its arm in [`Method::definition`]; the compiler points at the rest.
 
 pub mod best_source;
 mod definition;
 pub mod exclusion;
 pub mod from_scratch;
+pub mod gpi;
 mod method;
 pub mod parameter_schedule;
 pub mod prql;
+pub mod qswitch;
 pub mod random;
 pub mod sapnet;
 pub mod ucb1;
@@ -49,6 +51,10 @@ pub enum Actor {
     SourceGreedy(usize),
     /// The method's own learner, ε-greedily.
     Learner,
+    /// An action chosen by the selector from every network's Q-values of the state
+    /// ([`Selector::combine`]), around the learner's ε-greedy exploration: GPI's maximum
+    /// over the library, the Q-switch's critic.
+    Combined,
 }
 
 impl Actor {
@@ -56,9 +62,31 @@ impl Actor {
     pub fn source(self) -> Option<usize> {
         match self {
             Self::Source(i) | Self::SourceGreedy(i) => Some(i),
-            Self::Learner => None,
+            Self::Learner | Self::Combined => None,
         }
     }
+}
+
+/// What an [`Actor::Combined`] step is chosen from: every network's Q-values of the state,
+/// and the learner's exploration.
+#[derive(Debug, Clone, Copy)]
+pub struct StateValues<'a> {
+    /// `Q_L(s, ·)` of the method's own learner (its online network).
+    pub learner: &'a [f32],
+    /// `Q_i(s, ·)` of each source, in the library's order.
+    pub sources: &'a [Vec<f32>],
+    /// The random action of the learner's ε-greedy exploration, when its coin fell on
+    /// exploring at this step; `None` on a greedy step (and always when testing).
+    pub explored: Option<usize>,
+}
+
+/// The action of an [`Actor::Combined`] step, and whose policy it followed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Combined {
+    pub action: usize,
+    /// The source whose Q-value or action was followed, or `None` for the learner (and
+    /// for an exploring step).
+    pub followed: Option<usize>,
 }
 
 /// Who learns from the steps of a run.
@@ -161,6 +189,22 @@ pub trait Selector: Send + fmt::Debug {
     /// Who chooses the action of the next step (after the warm-up).
     fn act(&mut self, rng: &mut StdRng) -> Actor;
 
+    /// The action of an [`Actor::Combined`] step from every network's Q-values of the
+    /// state. Pure: the run also asks it for the greedy tests of a method that hands over
+    /// its combination ([`Tested::Combined`]). By default the learner's own ε-greedy
+    /// action: a selector that combines nothing follows its learner.
+    fn combine(&self, values: &StateValues<'_>) -> Combined {
+        Combined {
+            action: values
+                .explored
+                .unwrap_or_else(|| argmax_f32(values.learner)),
+            followed: None,
+        }
+    }
+
+    /// A step acted as [`Actor::Combined`] followed this source (`None`: the learner).
+    fn on_followed(&mut self, _followed: Option<usize>) {}
+
     /// What the run must measure for this selector.
     fn needs(&self) -> Needs {
         Needs::default()
@@ -255,6 +299,17 @@ pub fn build(
     sapnet: &SapNetParams,
 ) -> Result<Box<dyn Selector>, ReuseError> {
     method.definition().selector(library, sapnet)
+}
+
+/// Index of the largest Q-value, the lowest on a tie, as a network's greedy action is.
+pub(crate) fn argmax_f32(values: &[f32]) -> usize {
+    let mut best = 0;
+    for (i, &v) in values.iter().enumerate() {
+        if v > values[best] {
+            best = i;
+        }
+    }
+    best
 }
 
 /// Index of the largest value, the lowest on a tie.

@@ -8,12 +8,45 @@ use super::spec::{RunSpec, SourcePolicy};
 use super::CommandReceiver;
 use crate::dqn::{Architecture, DqnAgent, DqnError, QNet};
 use crate::env::Environment;
-use crate::reuse::{Actor, Learning};
+use crate::reuse::{Actor, Combined, Learning, Selector, StateValues};
 
 pub(super) struct RunNetworks<'a> {
     sources: &'a [SourcePolicy],
     agents: Vec<DqnAgent>,
     learner: Option<DqnAgent>,
+    /// The Q-values a combining method chooses from, kept between steps.
+    values: ValueBuffers,
+}
+
+/// Every network's Q-values of one state, in buffers kept between steps.
+#[derive(Default)]
+pub(super) struct ValueBuffers {
+    learner: Vec<f32>,
+    sources: Vec<Vec<f32>>,
+}
+
+impl ValueBuffers {
+    /// The choice `selector` makes from `learner`'s and the (frozen) `sources`' Q-values of
+    /// `obs`, with `explored` the learner's exploring action, if its coin fell on one.
+    pub fn combine(
+        &mut self,
+        selector: &dyn Selector,
+        learner: &QNet,
+        sources: &[SourcePolicy],
+        obs: &[f32],
+        explored: Option<usize>,
+    ) -> Result<Combined, DqnError> {
+        self.learner = learner.q_values(obs)?;
+        self.sources.resize_with(sources.len(), Vec::new);
+        for (values, source) in self.sources.iter_mut().zip(sources) {
+            *values = source.net.q_values(obs)?;
+        }
+        Ok(selector.combine(&StateValues {
+            learner: &self.learner,
+            sources: &self.sources,
+            explored,
+        }))
+    }
 }
 
 impl<'a> RunNetworks<'a> {
@@ -59,14 +92,37 @@ impl<'a> RunNetworks<'a> {
             sources: &spec.sources,
             agents,
             learner,
+            values: ValueBuffers::default(),
         })
     }
 
-    pub fn act(&self, actor: Actor, obs: &[f32], rng: &mut StdRng) -> Result<usize, DqnError> {
+    /// The action of `actor` on `obs`, and the source it followed; `selector` makes the
+    /// choice of an [`Actor::Combined`] step, around the learner's exploration.
+    pub fn act(
+        &mut self,
+        actor: Actor,
+        selector: &dyn Selector,
+        obs: &[f32],
+        rng: &mut StdRng,
+    ) -> Result<Combined, DqnError> {
+        let own = |action| Combined {
+            action,
+            followed: actor.source(),
+        };
         match actor {
-            Actor::Source(i) => self.agents[i].act(obs, rng),
-            Actor::SourceGreedy(i) => self.sources[i].net.greedy_action(obs),
-            Actor::Learner => self.learner().act(obs, rng),
+            Actor::Source(i) => self.agents[i].act(obs, rng).map(own),
+            Actor::SourceGreedy(i) => self.sources[i].net.greedy_action(obs).map(own),
+            Actor::Learner => self.learner().act(obs, rng).map(own),
+            Actor::Combined => {
+                let learner = self
+                    .learner
+                    .as_ref()
+                    .expect("a method that combines has a learner");
+                let explored = learner.explore(rng);
+                let net = learner.online();
+                self.values
+                    .combine(selector, net, self.sources, obs, explored)
+            }
         }
     }
 
@@ -75,7 +131,7 @@ impl<'a> RunNetworks<'a> {
         match actor {
             Actor::Source(i) => self.agents[i].value(obs),
             Actor::SourceGreedy(i) => self.sources[i].net.max_q(obs).map(f64::from),
-            Actor::Learner => self.learner().value(obs),
+            Actor::Learner | Actor::Combined => self.learner().value(obs),
         }
     }
 

@@ -12,12 +12,14 @@ use super::events::{
     ActivationSnapshot, ChosenPolicy, EpisodeRecord, Event, LibraryStart, LockIn, RunRecord,
     SourceSummary, StepRecord, TraceRecord,
 };
-use super::networks::RunNetworks;
+use super::networks::{RunNetworks, ValueBuffers};
 use super::spec::{selector, RunSpec};
 use super::{CommandReceiver, Divergence, RunOutcome, TrainerError};
 use crate::dqn::{DqnError, QNet, ReplayBuffer, Transition, UpdateReport};
 use crate::env::{self, Environment};
-use crate::reuse::{Actor, Deposit, EpisodeEnd, Feedback, Learning, Needs, Selector, TdError};
+use crate::reuse::{
+    Actor, Combined, Deposit, EpisodeEnd, Feedback, Learning, Needs, Selector, TdError, Tested,
+};
 use crate::sapnet::SapNet;
 use crate::seeds;
 
@@ -249,7 +251,12 @@ impl<'a> Run<'a> {
         } else {
             self.selector.act(&mut self.selection_rng)
         };
-        let action = self.networks.act(actor, &self.obs, &mut self.rng)?;
+        let Combined { action, followed } =
+            self.networks
+                .act(actor, self.selector.as_ref(), &self.obs, &mut self.rng)?;
+        if actor == Actor::Combined {
+            self.selector.on_followed(followed);
+        }
         // V_i(s_t) of the acting source as it acts, before its update.
         let value = match actor.source() {
             Some(i) if self.needs.values && !in_warm_up => {
@@ -278,13 +285,13 @@ impl<'a> Run<'a> {
         let learned = if in_warm_up {
             Learned::default()
         } else {
-            self.learn(actor)?
+            self.learn(actor, followed)?
         };
         self.send_step(StepRecord {
             run: self.spec.run,
             step: self.steps,
             episode,
-            policy: actor.source(),
+            policy: followed,
             action,
             reward,
             update: learned.report,
@@ -309,8 +316,10 @@ impl<'a> Run<'a> {
     /// After the warm-up: the update of whoever learns from the step `actor` took
     /// (`T_a = E_{t+1} − E_t`, eq. 7), the selector's judgment of it (eq. 8–11), and the
     /// lock-in, the first time one source's probability passes [`LOCK_IN`].
-    fn learn(&mut self, actor: Actor) -> Result<Learned, TrainerError> {
-        if let Some(i) = actor.source() {
+    /// `followed` is the source whose action the step took, `actor` itself but for a
+    /// combining method's step.
+    fn learn(&mut self, actor: Actor, followed: Option<usize>) -> Result<Learned, TrainerError> {
+        if let Some(i) = followed {
             self.tally.count(i);
         }
         let learner = match self.learning {
@@ -432,12 +441,19 @@ impl<'a> Run<'a> {
         let net = self.networks.take_net(chosen);
         if !record.stopped {
             let mut test_env = env::make(&spec.env)?;
-            record.test_returns = test_greedy(
-                &net,
-                test_env.as_mut(),
-                spec.test_episodes,
-                self.seeds.test_env,
-            )?;
+            let (episodes, seed) = (spec.test_episodes, self.seeds.test_env);
+            record.test_returns = if spec.reuse.kind().tested == Tested::Combined {
+                // The learner with the library, as the method acts greedily.
+                let mut values = ValueBuffers::default();
+                let selector = self.selector.as_ref();
+                let greedy = |obs: &[f32]| {
+                    let choice = values.combine(selector, &net, &spec.sources, obs, None)?;
+                    Ok(choice.action)
+                };
+                test_policy(greedy, test_env.as_mut(), episodes, seed)?
+            } else {
+                test_greedy(&net, test_env.as_mut(), episodes, seed)?
+            };
         }
         record.wall_s = self.started.elapsed().as_secs_f64();
         let _ = self.events.send(Event::RunEnded(record.clone()));
@@ -534,9 +550,19 @@ fn feedback(report: &UpdateReport) -> Feedback {
     }
 }
 
-/// Returns of `episodes` greedy episodes (the paper's "Number of test").
+/// Returns of `episodes` greedy episodes of `net` (the paper's "Number of test").
 pub fn test_greedy(
     net: &QNet,
+    env: &mut dyn Environment,
+    episodes: u32,
+    seed: u64,
+) -> Result<Vec<f64>, TrainerError> {
+    test_policy(|obs| net.greedy_action(obs), env, episodes, seed)
+}
+
+/// Returns of `episodes` episodes acted by `policy`, the first reset with `seed`.
+fn test_policy(
+    mut policy: impl FnMut(&[f32]) -> Result<usize, DqnError>,
     env: &mut dyn Environment,
     episodes: u32,
     seed: u64,
@@ -548,7 +574,7 @@ pub fn test_greedy(
         obs.extend_from_slice(env.reset((episode == 0).then_some(seed))?);
         let mut total = 0.0;
         loop {
-            let step = env.step(net.greedy_action(&obs)?)?;
+            let step = env.step(policy(&obs)?)?;
             total += step.reward;
             if step.done() {
                 break;

@@ -1,0 +1,309 @@
+//! Generalized policy improvement (Barreto et al., "Successor Features for Transfer in
+//! Reinforcement Learning", NeurIPS 2017), on a library of DQN policies.
+//!
+//! The sources stay frozen. A learner of the method's own, a fresh DQN, learns from every
+//! step and joins the maximum, as SFQL's new task does: each step acts ε-greedily (the
+//! learner's schedule) on
+//!
+//! ```text
+//! π(s) ∈ argmax_a max( Q_L(s, a), max_i Q_i(s, a) )          (Barreto et al., eq. 10)
+//! ```
+//!
+//! and the run hands over that policy, the learner with the library, for its greedy tests.
+//!
+//! Choices a DQN library forced (docs/BASELINES.md):
+//! - SFQL learns successor features ψ and reward weights w, so its Q_i are `ψ_iᵀw` of the new
+//!   task; a library of Q-networks has only each source's Q of its own task. GPI here takes
+//!   the sources' Q as they are: exact when sources and target share the reward (the
+//!   single-task libraries), an approximation across the variants library.
+//! - The learner's update is DQN's own (`max_a' Q_target(s', a')` of the learner), not
+//!   SFQL's bootstrap on the GPI action at `s'`: the learner is the config's DQN, updated as
+//!   every other method's learner is.
+//! - Ties between Q-values go to the learner, then to the lowest source index.
+
+use serde::{Deserialize, Serialize};
+
+use rand::rngs::StdRng;
+
+use super::definition::{check_label, MethodKind, ReuseMethod, Tested};
+use super::{Actor, Combined, Learning, Library, ReuseError, Selector, SelectorView, StateValues};
+use crate::sapnet::SapNetParams;
+
+/// GPI's knobs (`Gpi()` in `protocol.methods`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GpiKnobs {
+    /// The learner's hidden layers: the paper's DQN baseline's by default.
+    pub hidden: Vec<usize>,
+    /// The label of results; default `gpi`, or `gpi[64,64]` for another learner.
+    pub label: Option<String>,
+}
+
+impl Default for GpiKnobs {
+    fn default() -> Self {
+        Self {
+            hidden: vec![100],
+            label: None,
+        }
+    }
+}
+
+/// GPI in `protocol.methods`, in teal.
+pub const KIND: MethodKind = MethodKind {
+    family: "Gpi",
+    hue: 180,
+    saturation: 60,
+    reuses: true,
+    tested: Tested::Combined,
+    picks_by_probability: false,
+    spreads: false,
+};
+
+impl ReuseMethod for GpiKnobs {
+    fn label(&self) -> String {
+        learner_label("gpi", &self.hidden, self.label.as_deref())
+    }
+
+    fn kind(&self) -> MethodKind {
+        KIND
+    }
+
+    fn learner_hidden(&self) -> Option<&[usize]> {
+        Some(&self.hidden)
+    }
+
+    fn validate(&self, field: &str) -> Result<(), String> {
+        check_learner(field, &self.hidden, self.label.as_deref())
+    }
+
+    fn selector(
+        &self,
+        library: Library<'_>,
+        _: &SapNetParams,
+    ) -> Result<Box<dyn Selector>, ReuseError> {
+        Ok(Box::new(Gpi::new(library.descriptions.len())))
+    }
+}
+
+/// `family` with the learner's layers when they are not the paper's `[100]`, or the given
+/// label: the label rule of the methods with a learner of their own.
+pub(super) fn learner_label(family: &str, hidden: &[usize], label: Option<&str>) -> String {
+    if let Some(label) = label {
+        return label.into();
+    }
+    if hidden == [100] {
+        return family.into();
+    }
+    let layers: Vec<String> = hidden.iter().map(ToString::to_string).collect();
+    format!("{family}[{}]", layers.join(","))
+}
+
+/// The checks of a learner's layers and a given label, `field` being where the knobs sit.
+pub(super) fn check_learner(
+    field: &str,
+    hidden: &[usize],
+    label: Option<&str>,
+) -> Result<(), String> {
+    crate::ron_file::check(
+        !hidden.is_empty() && hidden.iter().all(|&u| u > 0),
+        &format!("{field}.hidden"),
+        "a non-empty list of layer sizes > 0",
+        format!("{hidden:?}"),
+    )?;
+    match label {
+        Some(label) => check_label(field, label),
+        None => Ok(()),
+    }
+}
+
+/// GPI's choice and its counts of whose Q-value won.
+#[derive(Debug)]
+pub struct Gpi {
+    /// Steps whose action took its Q-value from each source, and from the learner.
+    wins: Vec<u64>,
+    learner_wins: u64,
+}
+
+impl Gpi {
+    pub fn new(n: usize) -> Self {
+        Self {
+            wins: vec![0; n],
+            learner_wins: 0,
+        }
+    }
+}
+
+/// `argmax_a max(Q_L(s, a), max_i Q_i(s, a))`, and whose Q-value is that maximum: the
+/// learner on a tie, then the lowest source.
+pub fn choose(learner: &[f32], sources: &[Vec<f32>]) -> Combined {
+    let mut best = Combined {
+        action: 0,
+        followed: None,
+    };
+    let mut best_q = f32::NEG_INFINITY;
+    for (a, &q) in learner.iter().enumerate() {
+        if q > best_q {
+            (best_q, best) = (
+                q,
+                Combined {
+                    action: a,
+                    followed: None,
+                },
+            );
+        }
+    }
+    for (i, values) in sources.iter().enumerate() {
+        for (a, &q) in values.iter().enumerate() {
+            if q > best_q {
+                best_q = q;
+                best = Combined {
+                    action: a,
+                    followed: Some(i),
+                };
+            }
+        }
+    }
+    best
+}
+
+impl Selector for Gpi {
+    fn learning(&self) -> Learning {
+        Learning::Learner
+    }
+
+    fn act(&mut self, _rng: &mut StdRng) -> Actor {
+        Actor::Combined
+    }
+
+    /// ε-greedy around the maximum: an exploring step follows nobody.
+    fn combine(&self, values: &StateValues<'_>) -> Combined {
+        match values.explored {
+            Some(action) => Combined {
+                action,
+                followed: None,
+            },
+            None => choose(values.learner, values.sources),
+        }
+    }
+
+    fn on_followed(&mut self, followed: Option<usize>) {
+        match followed {
+            Some(i) => self.wins[i] += 1,
+            None => self.learner_wins += 1,
+        }
+    }
+
+    /// Scores: the steps each source's Q-value won the maximum; probabilities: their share
+    /// of all steps (the learner and exploring steps hold the rest).
+    fn view(&self) -> SelectorView {
+        followed_view("wins", &self.wins, self.learner_wins)
+    }
+
+    fn chosen(&self) -> Option<usize> {
+        None
+    }
+}
+
+/// A view of per-source counts of followed steps, for the methods that combine: the count
+/// as the score, its share of all steps as the probability.
+pub(super) fn followed_view(
+    score_name: &'static str,
+    counts: &[u64],
+    learner: u64,
+) -> SelectorView {
+    let n = counts.len();
+    let total = (counts.iter().sum::<u64>() + learner) as f64;
+    let probabilities = counts
+        .iter()
+        .map(|&c| if total > 0.0 { c as f64 / total } else { 0.0 })
+        .collect();
+    SelectorView {
+        score_name,
+        scores: counts.iter().map(|&c| c as f64).collect(),
+        probabilities,
+        positive: vec![0; n],
+        negative: vec![0; n],
+        excluded: Vec::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn acts_on_the_largest_q_value_of_any_network() {
+        // Two actions, two sources. max over networks per action: a0 = max(1, 3, 2) = 3
+        // (source 0), a1 = max(2, 0.5, 2.5) = 2.5 (source 1): a0 by source 0's value.
+        let learner = [1.0, 2.0];
+        let sources = vec![vec![3.0, 0.5], vec![2.0, 2.5]];
+        assert_eq!(
+            choose(&learner, &sources),
+            Combined {
+                action: 0,
+                followed: Some(0)
+            }
+        );
+        // The learner grows past them: its own greedy action, followed by nobody else.
+        let learner = [1.0, 4.0];
+        assert_eq!(
+            choose(&learner, &sources),
+            Combined {
+                action: 1,
+                followed: None
+            }
+        );
+        // A tie goes to the learner, then to the lowest source.
+        assert_eq!(choose(&[3.0, 0.0], &sources).followed, None);
+        let sources = vec![vec![0.0, 5.0], vec![5.0, 0.0]];
+        assert_eq!(
+            choose(&[0.0, 0.0], &sources),
+            Combined {
+                action: 1,
+                followed: Some(0)
+            }
+        );
+    }
+
+    #[test]
+    fn explores_around_the_maximum_and_counts_whose_value_won() {
+        let mut gpi = Gpi::new(2);
+        let sources = vec![vec![3.0, 0.5], vec![2.0, 2.5]];
+        let values = |explored| StateValues {
+            learner: &[1.0, 2.0],
+            sources: &sources,
+            explored,
+        };
+        assert_eq!(
+            gpi.combine(&values(Some(1))),
+            Combined {
+                action: 1,
+                followed: None
+            }
+        );
+        for followed in [Some(0), Some(0), Some(1), None] {
+            gpi.on_followed(followed);
+        }
+        let view = gpi.view();
+        assert_eq!(view.scores, [2.0, 1.0]);
+        assert_eq!(view.probabilities, [0.5, 0.25]);
+        assert_eq!(gpi.chosen(), None);
+    }
+
+    #[test]
+    fn the_label_names_a_learner_other_than_the_papers() {
+        assert_eq!(GpiKnobs::default().label(), "gpi");
+        let knobs = GpiKnobs {
+            hidden: vec![64, 64],
+            label: None,
+        };
+        assert_eq!(knobs.label(), "gpi[64,64]");
+        let err = GpiKnobs {
+            hidden: vec![],
+            label: None,
+        }
+        .validate("protocol.methods[3]")
+        .unwrap_err();
+        assert!(err.contains("protocol.methods[3].hidden"), "{err}");
+    }
+}
