@@ -360,9 +360,21 @@ fn resume_experiment(cli: &Cli) -> Result<()> {
         .out
         .as_deref()
         .context("--resume needs --out DIR, the results to continue")?;
+    let added = match &cli.run.add_methods {
+        Some(path) => {
+            let mut config = training_config(path)?;
+            config.run_with(&cli.run.python_settings());
+            Some(headless::AddedMethods {
+                config,
+                origin: path.clone(),
+            })
+        }
+        None => None,
+    };
     let summary = headless::resume(
         dir,
         cli.run.runs,
+        added.as_ref(),
         &cli.run.python_settings(),
         &run_options(cli),
         &on_interrupt()?,

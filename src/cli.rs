@@ -61,6 +61,13 @@ pub struct RunArgs {
     )]
     pub resume: bool,
 
+    /// With --resume: add to DIR's protocol the methods CONFIG lists after DIR's own (CONFIG
+    /// must equal the config DIR began with in all else, its methods first and in order).
+    /// Finished runs are kept: a run's seeds come from its method's label, never from the
+    /// list, so the result is the protocol that had every method from the start.
+    #[arg(long, value_name = "CONFIG", requires = "resume")]
+    pub add_methods: Option<PathBuf>,
+
     /// A smoke run (seconds for the paper's protocol, about ten for the comparison of
     /// assets/reuse_cartpole.ron, on 2 cores): the protocol cut to 1/20 of its episodes and
     /// at most 2 runs per method (on the same source library). With --episodes, its N

@@ -129,6 +129,7 @@ pub fn run(
 pub fn resume(
     dir: &Path,
     runs: Option<u32>,
+    added: Option<&AddedMethods>,
     python: &PythonSettings,
     options: &RunOptions,
     commands: &Receiver<Command>,
@@ -167,6 +168,11 @@ pub fn resume(
             header.status = Some(Status::Stopped);
         }
     }
+    if let Some(added) = added {
+        add_methods(&mut header.config, added)
+            .map_err(|e| anyhow::anyhow!("--add-methods {}: {e}", added.origin.display()))?;
+        header.status = Some(Status::Stopped);
+    }
     match header.status {
         None | Some(Status::Complete) => bail!(
             "{} holds a finished protocol (summary.json: status {}): nothing to resume",
@@ -195,6 +201,59 @@ pub fn resume(
     )?;
     output::finish_replacement(dir)?;
     Ok(summary)
+}
+
+/// A config whose methods extend a folder's protocol (`--resume --add-methods`).
+pub struct AddedMethods {
+    pub config: Config,
+    /// Where it was read from, for errors.
+    pub origin: std::path::PathBuf,
+}
+
+/// `stored` with the methods `added` lists after its own. Refused unless `added` lists
+/// `stored`'s methods first, in order, and equals it in every other field but the number of
+/// runs: then every finished run is the run the extended protocol would have made, since a
+/// run's seeds come from its method's label and its index, never from the list.
+fn add_methods(stored: &mut Config, added: &AddedMethods) -> Result<(), String> {
+    let had = &stored.protocol.methods;
+    let wanted = &added.config.protocol.methods;
+    if wanted.len() <= had.len() || !wanted.starts_with(had) {
+        let labels = |methods: &[crate::reuse::Method]| {
+            methods
+                .iter()
+                .map(|m| m.label())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        return Err(format!(
+            "field `protocol.methods`: expected the folder's methods first, in order ({}), then \
+             the methods to add; got {}",
+            labels(had),
+            labels(wanted)
+        ));
+    }
+    let mut same = added.config.clone();
+    same.protocol.methods.clone_from(had);
+    same.protocol.runs = stored.protocol.runs;
+    let fields = [
+        ("env", same.env == stored.env),
+        ("dqn", same.dqn == stored.dqn),
+        ("sapnet", same.sapnet == stored.sapnet),
+        ("sources", same.sources == stored.sources),
+        ("protocol", same.protocol == stored.protocol),
+        ("seed", same.seed == stored.seed),
+    ];
+    if let Some((field, _)) = fields.iter().find(|(_, equal)| !equal) {
+        return Err(format!(
+            "field `{field}`: expected the folder's own (in its summary.json's config): the \
+             runs it holds were trained with it"
+        ));
+    }
+    if same != *stored {
+        return Err("expected the folder's config in every field but `protocol.methods`".into());
+    }
+    stored.protocol.methods.clone_from(wanted);
+    stored.validate()
 }
 
 /// The protocol into `out`. `resumed` is `None` for a new protocol, else the library the

@@ -216,6 +216,73 @@ fn the_same_seed_gives_the_same_files_whatever_the_jobs() {
     assert_eq!(one, run("2"));
 }
 
+/// tiny_reuse.ron with `methods` in place of its own list.
+fn with_methods(tmp: &Path, name: &str, methods: &str) -> PathBuf {
+    let text = std::fs::read_to_string(config("tiny_reuse.ron")).unwrap();
+    let start = text.find("methods: [").unwrap();
+    let end = start + text[start..].find("\n        ],").unwrap() + "\n        ]".len();
+    let path = tmp.join(name);
+    std::fs::write(
+        &path,
+        format!("{}methods: [{methods}]{}", &text[..start], &text[end..]),
+    )
+    .unwrap();
+    path
+}
+
+/// A finished protocol extended by `--add-methods` holds the numbers of the protocol that
+/// had every method from the start; a config that differs elsewhere, or lists the methods
+/// in another order, is refused naming its field, and the folder is left as it was.
+#[test]
+fn methods_added_to_a_finished_protocol_give_the_protocol_that_had_them_all() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = library(tmp.path());
+    let two = with_methods(tmp.path(), "two.ron", "SapNet, Dqn(hidden: [8])");
+    let four = with_methods(
+        tmp.path(),
+        "four.ron",
+        "SapNet, Dqn(hidden: [8]), Gpi(hidden: [8]), QSwitch(hidden: [8])",
+    );
+    let (extended, whole) = (tmp.path().join("extended"), tmp.path().join("whole"));
+    let run = |mut command: Command| {
+        let output = command.output().unwrap();
+        assert!(output.status.success(), "{}", stderr(&output));
+    };
+    run(headless(
+        &["--config", two.to_str().unwrap()],
+        &library,
+        &extended,
+    ));
+    let before = numbers(&extended);
+    let refused = |config: &Path, expected: &str| {
+        let added = ["--resume", "--add-methods", config.to_str().unwrap()];
+        let output = headless(&added, &library, &extended).output().unwrap();
+        assert_eq!(output.status.code(), Some(2), "{}", stderr(&output));
+        assert!(stderr(&output).contains(expected), "{}", stderr(&output));
+        assert_eq!(numbers(&extended), before);
+    };
+    let swapped = with_methods(tmp.path(), "swapped.ron", "Dqn(hidden: [8]), SapNet, Gpi()");
+    refused(
+        &swapped,
+        "field `protocol.methods`: expected the folder's methods first",
+    );
+    let reseeded = tmp.path().join("reseeded.ron");
+    let text = std::fs::read_to_string(&four).unwrap();
+    assert!(text.contains("seed: 5,"));
+    std::fs::write(&reseeded, text.replace("seed: 5,", "seed: 6,")).unwrap();
+    refused(&reseeded, "field `seed`: expected the folder's own");
+
+    let added = ["--resume", "--add-methods", four.to_str().unwrap()];
+    run(headless(&added, &library, &extended));
+    run(headless(
+        &["--config", four.to_str().unwrap()],
+        &library,
+        &whole,
+    ));
+    assert_eq!(numbers(&extended), numbers(&whole));
+    assert!(numbers(&whole)[0].1.contains(",gpi[8],"));
+}
+
 #[test]
 fn resume_takes_its_config_from_the_results_not_the_command_line() {
     let tmp = tempfile::tempdir().unwrap();
