@@ -8,7 +8,10 @@ use rand::Rng;
 use super::backprop::Workspace;
 use super::kernels::Isa;
 use super::scratch::{with_scratch, UpdateWork};
-use super::{td_huber_loss, Adam, Batch, DqnError, EpsilonGreedy, QNet, ReplayBuffer, Transition};
+use super::{
+    distillation_loss, td_huber_loss, Adam, Batch, DqnError, EpsilonGreedy, QNet, ReplayBuffer,
+    Transition,
+};
 use crate::dqn::DqnConfig;
 
 /// What one round of learning did, for SAP-Net's judgment `T_a = E_{t+1} − E_t` (eq. 7).
@@ -62,9 +65,20 @@ pub struct DqnAgent {
     measure_td: bool,
     /// Raised when the run is asked to stop: a round of many updates ends at the next.
     interrupt: Option<Arc<AtomicBool>>,
+    /// The teacher whose Q-values every update distils, if any (QDagger).
+    teacher: Option<Teacher>,
     /// Reused between updates.
     batch: Batch,
     targets: Vec<f32>,
+}
+
+/// A teacher network distilled into the learner: `L = L_TD + weight · L_distil` at
+/// `temperature` ([`distillation_loss`]).
+#[derive(Debug)]
+struct Teacher {
+    net: QNet,
+    temperature: f64,
+    weight: f64,
 }
 
 impl DqnAgent {
@@ -82,6 +96,7 @@ impl DqnAgent {
             last_loss: None,
             measure_td: false,
             interrupt: None,
+            teacher: None,
             batch: Batch::new(),
             targets: Vec::new(),
         })
@@ -99,6 +114,57 @@ impl DqnAgent {
     pub fn explore(&self, rng: &mut impl Rng) -> Option<usize> {
         let actions = self.online.architecture().action_count;
         self.explorer.explore(self.steps, actions, rng)
+    }
+
+    /// From now on every update also distils `teacher`'s Q-values at `temperature`, with
+    /// the weight [`set_distillation_weight`](Self::set_distillation_weight) sets (1 until
+    /// then).
+    pub fn distil_from(&mut self, teacher: QNet, temperature: f64) {
+        self.teacher = Some(Teacher {
+            net: teacher,
+            temperature,
+            weight: 1.0,
+        });
+    }
+
+    /// QDagger's `λ_t`: the weight of the distillation term from the next update on.
+    pub fn set_distillation_weight(&mut self, weight: f64) {
+        if let Some(teacher) = &mut self.teacher {
+            teacher.weight = weight;
+        }
+    }
+
+    /// `updates` gradient updates on minibatches of `replay` without acting (QDagger's
+    /// offline phase), the target network copied every `target_update_interval` of them;
+    /// returns the last loss. A stop ends the round early, its learning kept.
+    pub fn offline_round(
+        &mut self,
+        replay: &ReplayBuffer,
+        updates: u64,
+        rng: &mut impl Rng,
+    ) -> Result<Option<f64>, DqnError> {
+        let mut loss = None;
+        if replay.is_empty() {
+            return Ok(loss);
+        }
+        for k in 1..=updates {
+            if self
+                .interrupt
+                .as_ref()
+                .is_some_and(|f| f.load(Ordering::Relaxed))
+            {
+                break;
+            }
+            let mut batch = std::mem::take(&mut self.batch);
+            replay.sample_into(self.config.batch_size, &mut batch, rng);
+            let result = self.update(&batch);
+            self.batch = batch;
+            loss = Some(result?);
+            if k.is_multiple_of(self.config.target_update_interval) {
+                self.sync_target()?;
+            }
+        }
+        Ok(loss)
     }
 
     /// From now on, every [`UpdateReport`] carries the [`TdError`] of the transition stored
@@ -223,12 +289,25 @@ impl DqnAgent {
     fn update_with(&mut self, batch: &Batch, work: &mut UpdateWork) -> Result<f64, DqnError> {
         self.compute_td_targets(batch, &mut work.target)?;
         let isa = Isa::current();
+        // The targets are copied out: the target's buffers can take the teacher's pass.
+        let target_work = &mut work.target;
         let work = &mut work.online;
         let q = self
             .online
             .forward_with(isa, batch.obs(), batch.len(), work)?;
         let (actions, targets, delta) = (batch.actions(), &self.targets, self.config.huber_delta);
-        let (loss, grad_q) = td_huber_loss(q, actions, targets, delta)?;
+        let (mut loss, mut grad_q) = td_huber_loss(q, actions, targets, delta)?;
+        if let Some(teacher) = self.teacher.as_ref().filter(|t| t.weight > 0.0) {
+            let actions = self.online.architecture().action_count;
+            let teacher_q = teacher
+                .net
+                .forward_with(isa, batch.obs(), batch.len(), target_work)?;
+            let (distil, grad) = distillation_loss(q, teacher_q, actions, teacher.temperature);
+            loss += teacher.weight * distil;
+            for (g, d) in grad_q.iter_mut().zip(grad) {
+                *g += (teacher.weight * f64::from(d)) as f32;
+            }
+        }
         if !loss.is_finite() {
             let (step, update) = (self.steps, self.updates + 1);
             return Err(DqnError::NonFiniteLoss { step, update, loss });

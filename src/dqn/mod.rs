@@ -10,6 +10,7 @@
 mod agent;
 mod backprop;
 mod config;
+mod distill;
 mod error;
 mod exploration;
 pub mod kernels;
@@ -23,6 +24,7 @@ mod scratch;
 pub use agent::{DqnAgent, TdError, UpdateReport};
 pub use backprop::Gradients;
 pub use config::{DqnConfig, Exploration};
+pub use distill::distillation_loss;
 pub use error::DqnError;
 pub use exploration::EpsilonGreedy;
 pub use loss::{huber, td_huber_loss};

@@ -11,6 +11,7 @@ use super::definition::{MethodKind, ReuseMethod};
 use super::from_scratch::FromScratch;
 use super::gpi::GpiKnobs;
 use super::prql::PrqlKnobs;
+use super::qdagger::QDaggerKnobs;
 use super::qswitch::QSwitchKnobs;
 use super::random::{PerEpisode, PerStep};
 use super::sapnet::SapNetKnobs;
@@ -42,6 +43,9 @@ pub enum Method {
     /// The Q-switch of CUP and QMP: a new learner's critic picks, each step, whose proposed
     /// action is followed (`QSwitch()`; `QSwitch(proposal: Greedy)` the literal reading).
     QSwitch(QSwitchKnobs),
+    /// QDagger (Agarwal et al., 2022): a student distils the library's best source while it
+    /// learns, after an offline phase on that teacher's data (`QDagger()`).
+    QDagger(QDaggerKnobs),
     /// Fine-tune the library's best source by its recorded score: the selection oracle.
     BestSource,
     /// DQN from scratch with these hidden layers (the paper's baselines: `[100]`,
@@ -67,6 +71,7 @@ impl Method {
             Self::Prql(knobs) => Box::new(knobs.clone()),
             Self::Gpi(knobs) => Box::new(knobs.clone()),
             Self::QSwitch(knobs) => Box::new(knobs.clone()),
+            Self::QDagger(knobs) => Box::new(knobs.clone()),
             Self::BestSource => Box::new(Oracle),
             Self::Dqn { hidden } => Box::new(FromScratch { hidden }),
         }

@@ -17,7 +17,7 @@
 //! acts).
 //!
 //! One file per method: [`sapnet`], [`random`], [`ucb1`], [`prql`], [`best_source`],
-//! [`from_scratch`], [`gpi`], [`qswitch`], each defining its [`ReuseMethod`]. Adding one is a new file here, a variant
+//! [`from_scratch`], [`gpi`], [`qswitch`], [`qdagger`], each defining its [`ReuseMethod`]. Adding one is a new file here, a variant
 //! of [`Method`] and its arm in [`Method::definition`]; the compiler points at the rest.
 
 pub mod best_source;
@@ -28,6 +28,7 @@ pub mod gpi;
 mod method;
 pub mod parameter_schedule;
 pub mod prql;
+pub mod qdagger;
 pub mod qswitch;
 pub mod random;
 pub mod sapnet;
@@ -98,6 +99,28 @@ pub enum Learning {
     /// A learner of the method's own, a fresh DQN, learns from every step; sources never
     /// learn.
     Learner,
+}
+
+/// What a method's own learner does with the step just taken ([`Learning::Learner`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LearnerRound {
+    /// DQN's round: an update once the replay buffer holds `replay_start_size`
+    /// transitions.
+    Online,
+    /// Nothing: the step only fills the replay buffer (QDagger's teacher phase).
+    Wait,
+    /// `updates` updates on the replay buffer as it stands, then a fresh buffer for the
+    /// steps to come (QDagger's offline phase, CleanRL's new buffer for the online one).
+    Offline { updates: u64 },
+}
+
+/// A teacher among the sources whose Q-values the learner distils (QDagger).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Distillation {
+    pub teacher: usize,
+    pub temperature: f64,
+    /// The weight of the distillation term now, `λ_t`.
+    pub weight: f64,
 }
 
 /// How an episode ended, for selectors that judge per episode.
@@ -200,6 +223,17 @@ pub trait Selector: Send + fmt::Debug {
                 .unwrap_or_else(|| argmax_f32(values.learner)),
             followed: None,
         }
+    }
+
+    /// What the learner does with the step just taken (after [`act`](Self::act)'s step).
+    fn learner_round(&mut self) -> LearnerRound {
+        LearnerRound::Online
+    }
+
+    /// The teacher the learner distils, and the term's weight now; `None` for a method
+    /// that distils nothing.
+    fn distillation(&self) -> Option<Distillation> {
+        None
     }
 
     /// A step acted as [`Actor::Combined`] followed this source (`None`: the learner).

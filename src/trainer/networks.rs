@@ -145,6 +145,16 @@ impl<'a> RunNetworks<'a> {
         }
     }
 
+    /// The method's learner distils source `teacher` (a copy of it) from now on.
+    pub fn distil_from(&mut self, teacher: usize, temperature: f64) -> Result<(), DqnError> {
+        let net = self.sources[teacher].net.deep_copy()?;
+        self.learner
+            .as_mut()
+            .expect("a method that distils has a learner")
+            .distil_from(net, temperature);
+        Ok(())
+    }
+
     /// The learning copy of source `source`, or the method's own learner for `None`.
     pub fn agent(&self, source: Option<usize>) -> &DqnAgent {
         match source {

@@ -18,7 +18,8 @@ use super::{CommandReceiver, Divergence, RunOutcome, TrainerError};
 use crate::dqn::{DqnError, QNet, ReplayBuffer, Transition, UpdateReport};
 use crate::env::{self, Environment};
 use crate::reuse::{
-    Actor, Combined, Deposit, EpisodeEnd, Feedback, Learning, Needs, Selector, TdError, Tested,
+    Actor, Combined, Deposit, EpisodeEnd, Feedback, LearnerRound, Learning, Needs, Selector,
+    TdError, Tested,
 };
 use crate::sapnet::SapNet;
 use crate::seeds;
@@ -175,7 +176,7 @@ impl<'a> Run<'a> {
         let learning = selector.learning();
         let needs = selector.needs();
         let n = spec.sources.len();
-        let networks = RunNetworks::new(
+        let mut networks = RunNetworks::new(
             spec,
             learning,
             needs.td_error,
@@ -183,6 +184,9 @@ impl<'a> Run<'a> {
             seeds.weights,
             commands,
         )?;
+        if let Some(distillation) = selector.distillation() {
+            networks.distil_from(distillation.teacher, distillation.temperature)?;
+        }
         let replay = ReplayBuffer::new(spec.dqn.replay_capacity, env.observation_size());
         let rng = StdRng::seed_from_u64(seeds.agent);
         let selection_rng = StdRng::seed_from_u64(seeds.selection);
@@ -328,11 +332,27 @@ impl<'a> Run<'a> {
             }
             Learning::Learner => None,
         };
-        let report = match self
-            .networks
-            .agent_mut(learner)
-            .observe(&self.replay, &mut self.rng)
-        {
+        let round = match self.learning {
+            Learning::ActingSource => LearnerRound::Online,
+            Learning::Learner => self.selector.learner_round(),
+        };
+        if let Some(distillation) = self.selector.distillation() {
+            self.networks
+                .agent_mut(None)
+                .set_distillation_weight(distillation.weight);
+        }
+        let agent = self.networks.agent_mut(learner);
+        let result = match round {
+            LearnerRound::Online => agent.observe(&self.replay, &mut self.rng),
+            LearnerRound::Wait => Ok(None),
+            LearnerRound::Offline { updates } => {
+                let offline = agent.offline_round(&self.replay, updates, &mut self.rng);
+                // The online phase learns from a buffer of its own (CleanRL's).
+                self.replay = ReplayBuffer::new(self.replay.capacity(), self.replay.obs_size());
+                offline.map(|_| None)
+            }
+        };
+        let report = match result {
             Ok(report) => report,
             Err(error) => return Err(self.diverged(learner, error)),
         };
