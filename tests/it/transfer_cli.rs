@@ -752,3 +752,77 @@ fn every_method_runs_and_the_comparison_has_a_row_for_each() {
         methods.len()
     );
 }
+
+/// Rows of a results CSV as maps from its header's names.
+fn csv_rows(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    lines
+        .map(|line| {
+            header
+                .iter()
+                .cloned()
+                .zip(line.split(',').map(String::from))
+                .collect()
+        })
+        .collect()
+}
+
+/// GPI, the Q-switch and QDagger run end to end (issue 40): each has its row and its test
+/// rule; GPI's and the Q-switch's counts of followed sources reach activations.csv, the
+/// literal switch (greedy proposals) never follows a source, and QDagger's first episodes
+/// are its teacher's.
+#[test]
+fn the_fields_baselines_run_and_say_whom_they_followed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    train_library(&library);
+    let out = tmp.path().join("out");
+    let output = sapnet(
+        &["--headless", "--config", &config("tiny_baselines.ron")],
+        &library,
+        &out,
+    );
+    assert!(output.status.success(), "{}", stderr(&output));
+    let comparison = csv_rows(&out.join("comparison.csv"));
+    let tested: Vec<(&str, &str)> = comparison
+        .iter()
+        .map(|r| (r["method"].as_str(), r["tested"].as_str()))
+        .collect();
+    assert_eq!(
+        tested,
+        [
+            ("gpi[8]", "combined"),
+            ("qswitch[8]", "learner"),
+            ("qswitch[8]-greedy", "learner"),
+            ("qdagger[8]", "learner"),
+            ("dqn[8]", "learner"),
+        ]
+    );
+    let activations = csv_rows(&out.join("activations.csv"));
+    let followed = |method: &str| -> u64 {
+        activations
+            .iter()
+            .filter(|r| r["method"] == method)
+            .flat_map(|r| {
+                r.iter()
+                    .filter(|(k, _)| k.starts_with("selected_"))
+                    .map(|(_, v)| v.parse::<u64>().unwrap())
+                    .collect::<Vec<_>>()
+            })
+            .sum()
+    };
+    // GPI starts with an untrained learner beside trained sources: theirs win at first.
+    assert!(followed("gpi[8]") > 0);
+    assert_eq!(followed("qswitch[8]-greedy"), 0);
+    // QDagger's teacher acts its 60 steps first: the first episode names it.
+    let episodes = csv_rows(&out.join("episodes.csv"));
+    let first = episodes
+        .iter()
+        .find(|r| r["method"] == "qdagger[8]" && r["run"] == "0" && r["episode"] == "1")
+        .unwrap();
+    assert!(first["policy"].starts_with("source-"), "{first:?}");
+    let tests = csv_rows(&out.join("tests.csv"));
+    assert_eq!(tests.iter().filter(|r| r["method"] == "gpi[8]").count(), 4);
+}
