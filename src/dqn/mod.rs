@@ -8,6 +8,7 @@
 //! train from one shared buffer, so [`DqnAgent::observe`] borrows it.
 
 mod agent;
+mod attention;
 mod backprop;
 mod config;
 mod distill;
@@ -22,6 +23,7 @@ mod replay;
 mod scratch;
 
 pub use agent::{DqnAgent, TdError, UpdateReport};
+pub use attention::AttentionLearner;
 pub use backprop::Gradients;
 pub use config::{DqnConfig, Exploration};
 pub use distill::distillation_loss;

@@ -22,6 +22,12 @@ pub trait ReuseMethod {
         None
     }
 
+    /// The hidden layers of an attention network over the sources and its learner, if it
+    /// has one (A2T's).
+    fn attention_hidden(&self) -> Option<&[usize]> {
+        None
+    }
+
     /// The ranges of its knobs that serde cannot check; `field` is where it sits in the
     /// config (`protocol.methods[2]`).
     fn validate(&self, _field: &str) -> Result<(), String> {

@@ -186,8 +186,8 @@ impl Selector for Gpi {
         }
     }
 
-    fn on_followed(&mut self, followed: Option<usize>) {
-        match followed {
+    fn on_combined(&mut self, _: &StateValues<'_>, choice: Combined) {
+        match choice.followed {
             Some(i) => self.wins[i] += 1,
             None => self.learner_wins += 1,
         }
@@ -273,6 +273,7 @@ mod tests {
             learner: &[1.0, 2.0],
             sources: &sources,
             explored,
+            attention: None,
         };
         assert_eq!(
             gpi.combine(&values(Some(1))),
@@ -282,7 +283,13 @@ mod tests {
             }
         );
         for followed in [Some(0), Some(0), Some(1), None] {
-            gpi.on_followed(followed);
+            gpi.on_combined(
+                &values(None),
+                Combined {
+                    action: 0,
+                    followed,
+                },
+            );
         }
         let view = gpi.view();
         assert_eq!(view.scores, [2.0, 1.0]);

@@ -6,6 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::a2t::A2tKnobs;
 use super::best_source::Oracle;
 use super::definition::{MethodKind, ReuseMethod};
 use super::from_scratch::FromScratch;
@@ -46,6 +47,9 @@ pub enum Method {
     /// QDagger (Agarwal et al., 2022): a student distils the library's best source while it
     /// learns, after an offline phase on that teacher's data (`QDagger()`).
     QDagger(QDaggerKnobs),
+    /// A2T (Rajendran et al., 2017): a base network and a state-dependent softmax attention
+    /// over the sources and the base, acting on their mixture of Q-values (`A2t()`).
+    A2t(A2tKnobs),
     /// Fine-tune the library's best source by its recorded score: the selection oracle.
     BestSource,
     /// DQN from scratch with these hidden layers (the paper's baselines: `[100]`,
@@ -72,6 +76,7 @@ impl Method {
             Self::Gpi(knobs) => Box::new(knobs.clone()),
             Self::QSwitch(knobs) => Box::new(knobs.clone()),
             Self::QDagger(knobs) => Box::new(knobs.clone()),
+            Self::A2t(knobs) => Box::new(knobs.clone()),
             Self::BestSource => Box::new(Oracle),
             Self::Dqn { hidden } => Box::new(FromScratch { hidden }),
         }
@@ -84,6 +89,11 @@ impl Method {
     /// The method's name in results: `sapnet`, `ucb1`, `dqn[100,100]`…
     pub fn label(&self) -> String {
         self.definition().label()
+    }
+
+    /// The hidden layers of the method's attention network, if it has one.
+    pub fn attention_hidden(&self) -> Option<Vec<usize>> {
+        self.definition().attention_hidden().map(<[usize]>::to_vec)
     }
 
     /// The hidden layers of the method's own learner, if it has one.

@@ -17,9 +17,10 @@
 //! acts).
 //!
 //! One file per method: [`sapnet`], [`random`], [`ucb1`], [`prql`], [`best_source`],
-//! [`from_scratch`], [`gpi`], [`qswitch`], [`qdagger`], each defining its [`ReuseMethod`]. Adding one is a new file here, a variant
+//! [`from_scratch`], [`gpi`], [`qswitch`], [`qdagger`], [`a2t`], each defining its [`ReuseMethod`]. Adding one is a new file here, a variant
 //! of [`Method`] and its arm in [`Method::definition`]; the compiler points at the rest.
 
+pub mod a2t;
 pub mod best_source;
 mod definition;
 pub mod exclusion;
@@ -79,6 +80,9 @@ pub struct StateValues<'a> {
     /// The random action of the learner's ε-greedy exploration, when its coin fell on
     /// exploring at this step; `None` on a greedy step (and always when testing).
     pub explored: Option<usize>,
+    /// The attention's weights of the state, the sources' then the learner's, for a
+    /// method with an attention network (A2T).
+    pub attention: Option<&'a [f32]>,
 }
 
 /// The action of an [`Actor::Combined`] step, and whose policy it followed.
@@ -236,8 +240,8 @@ pub trait Selector: Send + fmt::Debug {
         None
     }
 
-    /// A step acted as [`Actor::Combined`] followed this source (`None`: the learner).
-    fn on_followed(&mut self, _followed: Option<usize>) {}
+    /// A step was acted as [`Actor::Combined`]: `choice` made from `values`.
+    fn on_combined(&mut self, _values: &StateValues<'_>, _choice: Combined) {}
 
     /// What the run must measure for this selector.
     fn needs(&self) -> Needs {

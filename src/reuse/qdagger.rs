@@ -245,7 +245,7 @@ impl Selector for QDagger {
         }
     }
 
-    fn on_followed(&mut self, _followed: Option<usize>) {
+    fn on_combined(&mut self, _: &StateValues<'_>, _: Combined) {
         self.teacher_steps_acted += 1;
     }
 
@@ -371,6 +371,7 @@ mod tests {
             learner: &[0.0, 0.0],
             sources: &sources,
             explored,
+            attention: None,
         };
         assert_eq!(q.combine(&values(None)).action, 1);
         assert_eq!(q.combine(&values(Some(0))).action, 0);

@@ -173,8 +173,8 @@ impl Selector for QSwitch {
         }
     }
 
-    fn on_followed(&mut self, followed: Option<usize>) {
-        match followed {
+    fn on_combined(&mut self, _: &StateValues<'_>, choice: Combined) {
+        match choice.followed {
             Some(i) => self.followed[i] += 1,
             None => self.learner_followed += 1,
         }
@@ -231,6 +231,7 @@ mod tests {
                 learner: &learner,
                 sources: &sources(),
                 explored: None,
+                attention: None,
             });
             assert_eq!(chosen.action, argmax_f32(&learner));
             assert_eq!(chosen.followed, None);
@@ -244,6 +245,7 @@ mod tests {
             learner: &learner,
             sources: &sources(),
             explored: Some(0),
+            attention: None,
         };
         // Behaviour proposals: the random a0 loses to source 1's a2 under Q_L.
         let behaviour = QSwitch::new(2, Proposal::Behaviour);

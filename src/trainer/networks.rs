@@ -6,7 +6,7 @@ use rand::SeedableRng;
 
 use super::spec::{RunSpec, SourcePolicy};
 use super::CommandReceiver;
-use crate::dqn::{Architecture, DqnAgent, DqnError, QNet};
+use crate::dqn::{Architecture, AttentionLearner, DqnAgent, DqnError, QNet, ReplayBuffer};
 use crate::env::Environment;
 use crate::reuse::{Actor, Combined, Learning, Selector, StateValues};
 
@@ -14,6 +14,8 @@ pub(super) struct RunNetworks<'a> {
     sources: &'a [SourcePolicy],
     agents: Vec<DqnAgent>,
     learner: Option<DqnAgent>,
+    /// The attention over the sources and the learner, for a method that has one (A2T).
+    attention: Option<AttentionLearner>,
     /// The Q-values a combining method chooses from, kept between steps.
     values: ValueBuffers,
 }
@@ -23,16 +25,22 @@ pub(super) struct RunNetworks<'a> {
 pub(super) struct ValueBuffers {
     learner: Vec<f32>,
     sources: Vec<Vec<f32>>,
+    attention: Vec<f32>,
 }
 
 impl ValueBuffers {
     /// The choice `selector` makes from `learner`'s and the (frozen) `sources`' Q-values of
-    /// `obs`, with `explored` the learner's exploring action, if its coin fell on one.
+    /// `obs` (and `attention`'s weights, if the method has one), with `explored` the
+    /// learner's exploring action, if its coin fell on one; `selector` hears it when
+    /// `acting`.
+    #[allow(clippy::too_many_arguments)]
     pub fn combine(
         &mut self,
-        selector: &dyn Selector,
+        selector: &mut dyn Selector,
+        acting: bool,
         learner: &QNet,
         sources: &[SourcePolicy],
+        attention: Option<&AttentionLearner>,
         obs: &[f32],
         explored: Option<usize>,
     ) -> Result<Combined, DqnError> {
@@ -41,11 +49,20 @@ impl ValueBuffers {
         for (values, source) in self.sources.iter_mut().zip(sources) {
             *values = source.net.q_values(obs)?;
         }
-        Ok(selector.combine(&StateValues {
+        if let Some(attention) = attention {
+            self.attention = attention.weights(obs)?;
+        }
+        let values = StateValues {
             learner: &self.learner,
             sources: &self.sources,
             explored,
-        }))
+            attention: attention.map(|_| self.attention.as_slice()),
+        };
+        let choice = selector.combine(&values);
+        if acting {
+            selector.on_combined(&values, choice);
+        }
+        Ok(choice)
     }
 }
 
@@ -88,10 +105,27 @@ impl<'a> RunNetworks<'a> {
             }
             None => None,
         };
+        let attention = match spec.reuse.attention_hidden() {
+            Some(hidden) => {
+                let seed = crate::seeds::derive(weights, &[crate::seeds::Part::Name("attention")]);
+                let mut attention = AttentionLearner::new(
+                    env.observation_size(),
+                    &hidden,
+                    spec.sources.len(),
+                    spec.dqn.init,
+                    &spec.dqn,
+                    &mut StdRng::seed_from_u64(seed),
+                )?;
+                attention.interrupt_rounds_with(commands.stop_flag());
+                Some(attention)
+            }
+            None => None,
+        };
         Ok(Self {
             sources: &spec.sources,
             agents,
             learner,
+            attention,
             values: ValueBuffers::default(),
         })
     }
@@ -101,7 +135,7 @@ impl<'a> RunNetworks<'a> {
     pub fn act(
         &mut self,
         actor: Actor,
-        selector: &dyn Selector,
+        selector: &mut dyn Selector,
         obs: &[f32],
         rng: &mut StdRng,
     ) -> Result<Combined, DqnError> {
@@ -120,8 +154,9 @@ impl<'a> RunNetworks<'a> {
                     .expect("a method that combines has a learner");
                 let explored = learner.explore(rng);
                 let net = learner.online();
+                let attention = self.attention.as_ref();
                 self.values
-                    .combine(selector, net, self.sources, obs, explored)
+                    .combine(selector, true, net, self.sources, attention, obs, explored)
             }
         }
     }
@@ -153,6 +188,26 @@ impl<'a> RunNetworks<'a> {
             .expect("a method that distils has a learner")
             .distil_from(net, temperature);
         Ok(())
+    }
+
+    /// The attention's round on the step just stored in `replay` (a method with one).
+    pub fn observe_attention(
+        &mut self,
+        replay: &ReplayBuffer,
+        rng: &mut StdRng,
+    ) -> Result<(), DqnError> {
+        let (Some(attention), Some(learner)) = (self.attention.as_mut(), self.learner.as_ref())
+        else {
+            return Ok(());
+        };
+        let sources: Vec<&QNet> = self.sources.iter().map(|s| &s.net).collect();
+        attention.observe(replay, rng, &sources, (learner.online(), learner.target()))?;
+        Ok(())
+    }
+
+    /// The attention network, for a method that has one.
+    pub fn attention(&self) -> Option<&AttentionLearner> {
+        self.attention.as_ref()
     }
 
     /// The learning copy of source `source`, or the method's own learner for `None`.
@@ -189,7 +244,8 @@ impl<'a> RunNetworks<'a> {
     }
 
     pub fn updates(&self) -> u64 {
-        let own = self.learner.as_ref().map_or(0, DqnAgent::updates);
+        let own = self.learner.as_ref().map_or(0, DqnAgent::updates)
+            + self.attention.as_ref().map_or(0, AttentionLearner::updates);
         self.agents.iter().map(DqnAgent::updates).sum::<u64>() + own
     }
 }

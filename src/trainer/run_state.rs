@@ -257,10 +257,7 @@ impl<'a> Run<'a> {
         };
         let Combined { action, followed } =
             self.networks
-                .act(actor, self.selector.as_ref(), &self.obs, &mut self.rng)?;
-        if actor == Actor::Combined {
-            self.selector.on_followed(followed);
-        }
+                .act(actor, self.selector.as_mut(), &self.obs, &mut self.rng)?;
         // V_i(s_t) of the acting source as it acts, before its update.
         let value = match actor.source() {
             Some(i) if self.needs.values && !in_warm_up => {
@@ -343,7 +340,13 @@ impl<'a> Run<'a> {
         }
         let agent = self.networks.agent_mut(learner);
         let result = match round {
-            LearnerRound::Online => agent.observe(&self.replay, &mut self.rng),
+            LearnerRound::Online => agent
+                .observe(&self.replay, &mut self.rng)
+                .and_then(|report| {
+                    self.networks
+                        .observe_attention(&self.replay, &mut self.rng)
+                        .map(|()| report)
+                }),
             LearnerRound::Wait => Ok(None),
             LearnerRound::Offline { updates } => {
                 let offline = agent.offline_round(&self.replay, updates, &mut self.rng);
@@ -465,9 +468,18 @@ impl<'a> Run<'a> {
             record.test_returns = if spec.reuse.kind().tested == Tested::Combined {
                 // The learner with the library, as the method acts greedily.
                 let mut values = ValueBuffers::default();
-                let selector = self.selector.as_ref();
+                let selector = self.selector.as_mut();
+                let attention = self.networks.attention();
                 let greedy = |obs: &[f32]| {
-                    let choice = values.combine(selector, &net, &spec.sources, obs, None)?;
+                    let choice = values.combine(
+                        selector,
+                        false,
+                        &net,
+                        &spec.sources,
+                        attention,
+                        obs,
+                        None,
+                    )?;
                     Ok(choice.action)
                 };
                 test_policy(greedy, test_env.as_mut(), episodes, seed)?

@@ -769,10 +769,11 @@ fn csv_rows(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
         .collect()
 }
 
-/// GPI, the Q-switch and QDagger run end to end (issue 40): each has its row and its test
-/// rule; GPI's and the Q-switch's counts of followed sources reach activations.csv, the
-/// literal switch (greedy proposals) never follows a source, and QDagger's first episodes
-/// are its teacher's.
+/// GPI, the Q-switch, QDagger and A2T run end to end (issue 40): each has its row and its
+/// test rule; GPI's and the Q-switch's counts of followed sources reach activations.csv,
+/// the literal switch (greedy proposals) never follows a source, QDagger's first episodes
+/// are its teacher's, and A2T's attention weights are its probabilities (each in (0, 1),
+/// the sources' summing below 1: the base holds the rest).
 #[test]
 fn the_fields_baselines_run_and_say_whom_they_followed() {
     let tmp = tempfile::tempdir().unwrap();
@@ -797,6 +798,7 @@ fn the_fields_baselines_run_and_say_whom_they_followed() {
             ("qswitch[8]", "learner"),
             ("qswitch[8]-greedy", "learner"),
             ("qdagger[8]", "learner"),
+            ("a2t[8]", "combined"),
             ("dqn[8]", "learner"),
         ]
     );
@@ -823,6 +825,16 @@ fn the_fields_baselines_run_and_say_whom_they_followed() {
         .find(|r| r["method"] == "qdagger[8]" && r["run"] == "0" && r["episode"] == "1")
         .unwrap();
     assert!(first["policy"].starts_with("source-"), "{first:?}");
+    for row in activations.iter().filter(|r| r["method"] == "a2t[8]") {
+        let weights: Vec<f64> = row
+            .iter()
+            .filter(|(k, _)| k.starts_with("P_"))
+            .map(|(_, v)| v.parse().unwrap())
+            .collect();
+        assert_eq!(weights.len(), 3);
+        assert!(weights.iter().all(|&w| w > 0.0 && w < 1.0), "{weights:?}");
+        assert!(weights.iter().sum::<f64>() < 1.0, "{weights:?}");
+    }
     let tests = csv_rows(&out.join("tests.csv"));
     assert_eq!(tests.iter().filter(|r| r["method"] == "gpi[8]").count(), 4);
 }
