@@ -605,7 +605,7 @@ fn plot_refuses_a_folder_another_process_writes() {
     refused(
         &output,
         &[
-            "in use by another sapnet process",
+            "is being written by the sapnet process",
             &format!("PID {}", child.id()),
         ],
     );
