@@ -53,6 +53,7 @@ pub fn run(cli: Cli) -> Result<()> {
             );
             print_stdout(&report.table())
         }
+        Some(Command::Open(args)) => tui::workbench::run(&args.dir),
         Some(Command::Plot(args)) => {
             let summary = results::replot(&args.dir)?;
             eprintln!(
@@ -108,6 +109,7 @@ fn refuse_unread_flags(cli: &Cli, command: &Command) -> Result<()> {
             None => "sources",
         },
         Command::Plot(_) => "plot",
+        Command::Open(_) => "open",
         Command::Pool(_) => "pool",
         Command::Compare(_) => "compare",
         Command::Sweep(args) => match args.command {

@@ -200,6 +200,12 @@ pub const SUBCOMMANDS: &[SubcommandFlags] = &[
         library: None,
     },
     SubcommandFlags {
+        name: "open",
+        reads: &[],
+        config: None,
+        library: None,
+    },
+    SubcommandFlags {
         name: "compare",
         reads: &[],
         config: None,
@@ -414,6 +420,10 @@ pub enum Command {
     /// the run records in runs/): for a run stopped before its plots, a killed one, or a
     /// folder of an older version. Prints the comparison.
     Plot(PlotArgs),
+    /// Open a results folder in the terminal UI, read only: finished, stopped, or live and
+    /// being written by another process (`sapnet --headless --out DIR` running). Views:
+    /// Runs (r) and Comparison (c); `?` lists the keys. Nothing in the folder changes.
+    Open(OpenArgs),
     /// One comparison of finished protocols on different tasks (e.g. the variants of
     /// CartPole and of MountainCar): each method's scores normalised by each task's range
     /// of returns and resampled within each task; written to --out with its plots.
@@ -484,6 +494,13 @@ pub enum SweepCommand {
 #[derive(Debug, Args)]
 pub struct PlotArgs {
     /// The results directory (a headless run's --out).
+    #[arg(value_name = "DIR")]
+    pub dir: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct OpenArgs {
+    /// The results directory (a headless run's --out), finished or still being written.
     #[arg(value_name = "DIR")]
     pub dir: PathBuf,
 }

@@ -104,6 +104,90 @@ impl FolderLock {
     }
 }
 
+/// The process holding a folder's lock, as seen from outside without taking the lock.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Holder {
+    /// The holder's PID, as the kernel reports it.
+    pub pid: u32,
+    /// The line the holder wrote in the lock file (`running as PID 1234 on host since
+    /// 10:02:07 UTC (the protocol)`), empty if it wrote none yet.
+    pub says: String,
+}
+
+impl Holder {
+    /// `HH:MM` of when the holder took the lock, as its line says it (`10:02`).
+    pub fn since(&self) -> Option<&str> {
+        let (_, after) = self.says.split_once(" since ")?;
+        after
+            .get(..5)
+            .filter(|hm| hm.as_bytes().get(2) == Some(&b':'))
+    }
+
+    /// `PID 1234 since 10:02 UTC`, or just the PID while its line is not written yet.
+    pub fn describe(&self) -> String {
+        match self.since() {
+            Some(since) => format!("PID {} since {since} UTC", self.pid),
+            None => format!("PID {}", self.pid),
+        }
+    }
+}
+
+/// Who holds `dir`'s lock now, if anyone, found without taking it — not even for an
+/// instant, since a protocol starting in that instant would be refused. Linux lists every
+/// held `flock` in `/proc/locks` by device and inode; the lock file's are compared with
+/// those. A folder without a lock file, or whose lock file no process holds (its holder
+/// died), is not held.
+pub fn holder(dir: &Path) -> Result<Option<Holder>> {
+    use std::os::unix::fs::MetadataExt;
+    let path = dir.join(LOCK_FILE);
+    // Opened as the lock is, never through a planted link, and never created.
+    let file = match OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK)
+        .open(&path)
+    {
+        Ok(file) => file,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
+    };
+    let metadata = file
+        .metadata()
+        .with_context(|| format!("reading {}", path.display()))?;
+    if !metadata.is_file() {
+        bail!(
+            "{}: not a regular file, where the folder's lock belongs",
+            path.display()
+        );
+    }
+    let locks = std::fs::read_to_string("/proc/locks")
+        .context("reading /proc/locks (which process writes a folder is read there, on Linux)")?;
+    let (major, minor) = (libc::major(metadata.dev()), libc::minor(metadata.dev()));
+    let Some(pid) = flock_holder(&locks, major, minor, metadata.ino()) else {
+        return Ok(None);
+    };
+    let mut says = String::new();
+    // The line is a few dozen bytes; a lock file grown past this was not written by sapnet.
+    let _ = (&file).take(1024).read_to_string(&mut says);
+    Ok(Some(Holder {
+        pid,
+        says: says.trim().to_string(),
+    }))
+}
+
+/// The PID holding a `flock` on the file `major:minor:inode` among `/proc/locks`' lines
+/// (`1: FLOCK  ADVISORY  WRITE 11557 fe:00:10010626 0 EOF`: the device in hex, the inode
+/// in decimal). A line `->` marks a waiter, not a holder.
+fn flock_holder(locks: &str, major: u32, minor: u32, inode: u64) -> Option<u32> {
+    let file = format!("{major:02x}:{minor:02x}:{inode}");
+    locks.lines().find_map(|line| {
+        let fields: Vec<&str> = line.split_whitespace().collect();
+        match fields.as_slice() {
+            [_, "FLOCK", _, _, pid, at, ..] if *at == file => pid.parse().ok(),
+            _ => None,
+        }
+    })
+}
+
 /// `HH:MM:SS UTC` of a Unix time (the day is rarely in doubt for a live process).
 fn clock(secs: u64) -> String {
     let day = secs % 86_400;
@@ -134,5 +218,43 @@ mod tests {
         drop(first);
         FolderLock::acquire(tmp.path(), "the protocol").unwrap();
         assert_eq!(clock(3 * 3600 + 25 * 60 + 7), "03:25:07 UTC");
+    }
+
+    #[test]
+    fn the_holder_is_found_without_taking_the_lock_and_gone_when_released() {
+        let tmp = tempfile::tempdir().unwrap();
+        assert_eq!(holder(tmp.path()).unwrap(), None, "no lock file");
+        let lock = FolderLock::acquire(tmp.path(), "the protocol").unwrap();
+        let found = holder(tmp.path()).unwrap().expect("held");
+        assert_eq!(found.pid, std::process::id());
+        assert!(found.says.contains("(the protocol)"), "{}", found.says);
+        assert_eq!(found.since().map(str::len), Some(5));
+        // Looking took nothing: the holder keeps it, a second lock is still refused.
+        assert!(FolderLock::acquire(tmp.path(), "the protocol").is_err());
+        drop(lock);
+        assert_eq!(
+            holder(tmp.path()).unwrap(),
+            None,
+            "a file left by a released lock"
+        );
+    }
+
+    #[test]
+    fn proc_locks_lines_are_read_by_device_and_inode() {
+        let locks = "1: FLOCK  ADVISORY  WRITE 11557 fe:00:10010626 0 EOF\n\
+                     2: POSIX  ADVISORY  WRITE 42 fe:00:77 0 EOF\n\
+                     2: -> FLOCK  ADVISORY  WRITE 99 fe:00:10010626 0 EOF\n";
+        assert_eq!(flock_holder(locks, 0xfe, 0, 10010626), Some(11557));
+        assert_eq!(
+            flock_holder(locks, 0xfe, 0, 77),
+            None,
+            "a POSIX lock is not ours"
+        );
+        assert_eq!(flock_holder(locks, 0xfe, 1, 10010626), None);
+        let holder = Holder {
+            pid: 1234,
+            says: "running as PID 1234 on h since 10:02:07 UTC (the protocol)".into(),
+        };
+        assert_eq!(holder.describe(), "PID 1234 since 10:02 UTC");
     }
 }

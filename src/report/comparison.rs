@@ -191,7 +191,8 @@ pub(super) fn library_ranks(library: &[LibraryEntry]) -> Vec<usize> {
         .collect()
 }
 
-pub(super) fn most_used(steps: &[u64]) -> Option<usize> {
+/// The source that acted most steps (the first listed, on a tie), if any acted.
+pub fn most_used(steps: &[u64]) -> Option<usize> {
     let most = *steps.iter().max()?;
     (most > 0).then(|| steps.iter().position(|&s| s == most).unwrap_or(0))
 }
@@ -326,7 +327,7 @@ fn share_tasks(rows: &[MethodComparison]) -> Vec<String> {
 }
 
 /// An interval as the table shows it: `123.4 [100.2, 140.0]`, with `digits` decimals.
-fn interval(e: &Estimate, digits: usize) -> String {
+pub fn interval(e: &Estimate, digits: usize) -> String {
     format!(
         "{:.digits$} [{:.digits$}, {:.digits$}]",
         e.point, e.lo, e.hi
@@ -335,10 +336,7 @@ fn interval(e: &Estimate, digits: usize) -> String {
 
 /// The comparison as a plain-text table, for stdout: IQMs with their 95% intervals.
 pub fn table(rows: &[MethodComparison], units: Units, test_score: TestScore) -> String {
-    let digits = match units {
-        Units::Returns => 1,
-        Units::Normalised => 3,
-    };
+    let digits = units.digits();
     let mut header = vec!["method".to_string(), "runs".to_string()];
     if let Some(first) = rows.first() {
         for t in &first.thresholds {

@@ -270,7 +270,7 @@ pub fn verdicts(rows: &[Improvement], score: &str) -> String {
 }
 
 /// A p-value as a reader scans it: three decimals, or its order when smaller.
-fn p_value(p: f64) -> String {
+pub fn p_value(p: f64) -> String {
     if p >= 0.001 {
         format!("{p:.3}")
     } else {

@@ -78,6 +78,15 @@ impl Units {
             Units::Normalised => "normalised",
         }
     }
+
+    /// Decimals a table shows of an aggregate in these units: returns to a tenth,
+    /// normalised scores (and optimality gaps, always normalised) to a thousandth.
+    pub fn digits(self) -> usize {
+        match self {
+            Units::Returns => 1,
+            Units::Normalised => 3,
+        }
+    }
 }
 
 /// What a report's `test` columns measure.

@@ -44,7 +44,8 @@ fn finished_dir(out: &Path, name: &str) -> PathBuf {
     out.join(RUNS).join(name)
 }
 
-fn partial_dir(out: &Path, name: &str) -> PathBuf {
+/// Where a run's record is written while it trains.
+pub(super) fn partial_dir(out: &Path, name: &str) -> PathBuf {
     out.join(RUNS).join(format!(".{name}.partial"))
 }
 

@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-use anyhow::Result;
+use anyhow::{bail, Result};
 
 use super::assemble::{assemble, Ending};
 use super::summary::{read_header, Status, Summary};
@@ -19,7 +19,12 @@ use super::summary::{read_header, Status, Summary};
 /// (`summary.json` still `running`) is marked `interrupted`.
 pub fn replot(dir: &Path) -> Result<Summary> {
     read_header(dir)?;
-    // A folder whose protocol still runs is that process's to write: refused, naming it.
+    // A folder whose protocol still runs is that process's to write: refused, naming it,
+    // before anything is taken or written there. The lock taken next closes the gap of a
+    // protocol starting in between.
+    if let Some(holder) = crate::folder_lock::holder(dir)? {
+        bail!("{}", refused_while_written(dir, &holder));
+    }
     let _lock = crate::folder_lock::FolderLock::acquire(dir, "sapnet plot")?;
     let header = read_header(dir)?;
     if !header.listed_runs.is_empty()
@@ -56,4 +61,21 @@ pub fn replot(dir: &Path) -> Result<Summary> {
         );
     }
     Ok(summary)
+}
+
+/// Why `sapnet plot` leaves a folder another process writes: who writes it, and how to
+/// read it meanwhile.
+fn refused_while_written(dir: &Path, holder: &crate::folder_lock::Holder) -> String {
+    format!(
+        "{dir} is being written by the sapnet process {who}{says}: `sapnet plot` would \
+         rewrite its report under it, so it changes nothing there; watch it with `sapnet \
+         open {dir}`, and plot it once that process has ended",
+        dir = dir.display(),
+        who = holder.describe(),
+        says = if holder.says.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", holder.says)
+        },
+    )
 }

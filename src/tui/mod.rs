@@ -15,6 +15,7 @@
 //!   with [`graph_view`] and share [`screen`] (the smallest terminal, the keys' overlay);
 //!   the dashboard's view draws teach mode on the live graph with `teach_view`, never the
 //!   reverse.
+//! - [`workbench`]: `sapnet open DIR`, a results folder (live or not) in views.
 //! - [`graph_layout`]: the graph's geometry, which the state (moving the cursor) and the
 //!   views share. The state modules import no view.
 
@@ -28,6 +29,7 @@ pub mod row_window;
 pub mod screen;
 pub mod teach_view;
 pub mod theme;
+pub mod workbench;
 
 use std::sync::mpsc;
 use std::time::{Duration, Instant};

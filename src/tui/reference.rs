@@ -6,7 +6,9 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
+use crate::report::plots;
 use crate::results;
+use crate::results::folder_state::{FolderReader, RunStatus};
 use crate::seeds::{self, Part};
 use crate::stats::{aggregate, bootstrap, Scores};
 
@@ -76,28 +78,57 @@ impl Band {
     }
 }
 
-/// The bands of a finished protocol's methods (`--compare DIR`), from its episodes.csv;
-/// refused when that protocol trained on another task than `task`, the dashboard's (its
-/// returns would be drawn on the wrong scale).
+/// The bands of a protocol's methods (`--compare DIR`) over its finished runs; refused
+/// when that protocol trained on another task than `task`, the dashboard's (its returns
+/// would be drawn on the wrong scale). A folder with run records — finished, stopped, or
+/// live and being written by another process — is read from them, as `sapnet open` reads
+/// it (never written, its lock never taken); a folder shipped with its top-level files
+/// only, from its episodes.csv.
 pub fn bands_of_folder(dir: &Path, task: &str) -> Result<Vec<Band>> {
-    let data = results::read_plot_data(dir).with_context(|| {
+    let expected = || {
         format!(
             "--compare {}: expected the output folder of a `sapnet --headless` run",
             dir.display()
         )
-    })?;
+    };
+    let live = crate::folder_lock::holder(dir)
+        .with_context(expected)?
+        .is_some();
+    if !live && !results::records::any(dir).with_context(expected)? {
+        let data = results::read_plot_data(dir).with_context(expected)?;
+        refuse_other_task(dir, &data.task, task)?;
+        return Ok(data
+            .curves
+            .iter()
+            .map(|c| Band::from_runs(&c.label, &c.returns, data.window))
+            .collect());
+    }
+    let folder = FolderReader::new(dir).read().with_context(expected)?;
+    refuse_other_task(dir, &plots::task_title(&folder.config.env), task)?;
+    let window = folder.config.protocol.moving_average;
+    let mut bands = Vec::new();
+    for method in crate::trainer::MethodId::all(&folder.config.protocol.methods) {
+        let runs: Vec<Vec<f64>> = folder
+            .runs
+            .iter()
+            .filter(|r| r.method == method && r.status == RunStatus::Done)
+            .map(|r| r.returns.clone())
+            .collect();
+        if !runs.is_empty() {
+            bands.push(Band::from_runs(method.label(), &runs, window));
+        }
+    }
+    Ok(bands)
+}
+
+fn refuse_other_task(dir: &Path, theirs: &str, task: &str) -> Result<()> {
     anyhow::ensure!(
-        data.task == task,
-        "--compare {}: its results are on {}, the dashboard trains on {task}: compare with a \
-         protocol on the same task",
+        theirs == task,
+        "--compare {}: its results are on {theirs}, the dashboard trains on {task}: compare \
+         with a protocol on the same task",
         dir.display(),
-        data.task
     );
-    Ok(data
-        .curves
-        .iter()
-        .map(|c| Band::from_runs(&c.label, &c.returns, data.window))
-        .collect())
+    Ok(())
 }
 
 #[cfg(test)]

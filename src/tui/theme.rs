@@ -4,6 +4,8 @@
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::symbols::Marker;
 
+use crate::reuse::MethodKind;
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Theme {
     pub color: bool,
@@ -85,6 +87,20 @@ impl Theme {
         }
     }
 
+    /// A method's colour: its family's hue (`MethodKind::hue`, as the plots draw it),
+    /// the `member`-th method of a family a shade lighter or darker so that variants
+    /// read apart; a family without saturation (the DQN baselines) in greys.
+    pub fn method(self, kind: MethodKind, member: usize) -> Style {
+        const SHADES: [f64; 3] = [0.55, 0.40, 0.70];
+        let lightness = SHADES[member % SHADES.len()];
+        let (r, g, b) = hsl(
+            f64::from(kind.hue),
+            f64::from(kind.saturation) / 100.0,
+            lightness,
+        );
+        self.fg(Color::Rgb(r, g, b))
+    }
+
     /// A node's colour by its share `level` (0 to 1) of the highest activation: cold blue
     /// to hot red.
     pub fn heat(self, level: f64) -> Style {
@@ -106,11 +122,46 @@ impl Theme {
     }
 }
 
+/// HSL (hue in degrees, saturation and lightness in [0, 1]) as 8-bit RGB.
+fn hsl(hue: f64, saturation: f64, lightness: f64) -> (u8, u8, u8) {
+    let chroma = (1.0 - (2.0 * lightness - 1.0).abs()) * saturation;
+    let sector = (hue.rem_euclid(360.0)) / 60.0;
+    let x = chroma * (1.0 - (sector % 2.0 - 1.0).abs());
+    let (r, g, b) = match sector as u32 {
+        0 => (chroma, x, 0.0),
+        1 => (x, chroma, 0.0),
+        2 => (0.0, chroma, x),
+        3 => (0.0, x, chroma),
+        4 => (x, 0.0, chroma),
+        _ => (chroma, 0.0, x),
+    };
+    let m = lightness - chroma / 2.0;
+    let byte = |v: f64| ((v + m) * 255.0).round().clamp(0.0, 255.0) as u8;
+    (byte(r), byte(g), byte(b))
+}
+
 /// A node's symbol by its share of the highest activation, for reading without colour.
 pub fn heat_symbol(level: f64) -> &'static str {
     match level {
         l if l >= 0.75 => "●",
         l if l >= 0.25 => "◐",
         _ => "○",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::hsl;
+
+    #[test]
+    fn hsl_by_hand() {
+        assert_eq!(hsl(0.0, 1.0, 0.5), (255, 0, 0));
+        assert_eq!(hsl(120.0, 1.0, 0.5), (0, 255, 0));
+        assert_eq!(hsl(240.0, 1.0, 0.25), (0, 0, 128));
+        assert_eq!(
+            hsl(200.0, 0.0, 0.4),
+            (102, 102, 102),
+            "no saturation: a grey"
+        );
     }
 }

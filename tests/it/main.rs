@@ -48,3 +48,4 @@ mod tui_snapshots;
 mod tui_state;
 mod tui_tmux;
 mod variants_cli;
+mod workbench;

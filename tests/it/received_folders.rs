@@ -594,7 +594,8 @@ fn plot_refuses_a_folder_another_process_writes() {
         .spawn()
         .unwrap();
     let started = Instant::now();
-    while !out.join("runs").exists() {
+    // summary.json is written just after runs/ is made: wait for it, not for runs/.
+    while !out.join("summary.json").exists() {
         assert!(started.elapsed() < Duration::from_secs(60), "never started");
         std::thread::sleep(Duration::from_millis(20));
     }
@@ -605,7 +606,7 @@ fn plot_refuses_a_folder_another_process_writes() {
     refused(
         &output,
         &[
-            "in use by another sapnet process",
+            "is being written by the sapnet process",
             &format!("PID {}", child.id()),
         ],
     );

@@ -55,18 +55,23 @@ pub(super) fn draw(
     };
     let mut datasets = Vec::new();
     // The bands first, so the live curves draw over them: the mean a dim line, its 95%
-    // interval's ends as dim dots.
+    // interval's ends as dim dots, each method's in its family's hue (as the plots draw
+    // it), so that two methods' bands read apart.
     for (band, [low, mean, high]) in bands.iter().zip(&band_points) {
-        let i = runs
+        let kind = runs
             .iter()
-            .position(|r| r.method.label() == band.label)
-            .unwrap_or(0);
+            .find(|r| r.method.label() == band.label)
+            .map(|r| r.method.kind);
+        let style = match kind {
+            Some(kind) => theme.method(kind, 0).add_modifier(Modifier::DIM),
+            None => theme.dim(),
+        };
         for edge in [low, high] {
             datasets.push(
                 Dataset::default()
                     .marker(Marker::Braille)
                     .graph_type(GraphType::Scatter)
-                    .style(theme.dim())
+                    .style(style)
                     .data(edge),
             );
         }
@@ -74,7 +79,7 @@ pub(super) fn draw(
             Dataset::default()
                 .marker(Marker::Braille)
                 .graph_type(GraphType::Line)
-                .style(theme.series(i).add_modifier(Modifier::DIM))
+                .style(style)
                 .data(mean),
         );
     }

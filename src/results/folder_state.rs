@@ -1,0 +1,398 @@
+//! A results folder as it stands, read and never written, for `sapnet open`: finished,
+//! stopped, or live and being written by another process. What each planned run has done
+//! comes from the per-run files — a finished run's record in `runs/<run>/`, a running
+//! run's `runs/.<run>.partial/episodes.csv` — since the top-level files are only put
+//! together when the protocol ends. The comparison of the finished runs is the one
+//! [`super::assemble`] writes into `comparison.csv` and `improvement.csv`: the same
+//! [`Report::of`] over the same records.
+//!
+//! Nothing here takes the folder's lock or creates a file: the writer is found in
+//! `/proc/locks` ([`folder_lock::holder`]), and every file is read as a file of a folder
+//! from elsewhere ([`crate::safe_io`]: regular files only, no link followed).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use serde::Deserialize;
+
+use super::records::{self, run_name, RunFolder};
+use super::summary::{read_header, Status};
+use crate::config::Config;
+use crate::folder_lock::{self, Holder};
+use crate::report::{LibraryEntry, Report, RunSummary, TaskRuns};
+use crate::safe_io::{self, Links};
+use crate::trainer::MethodId;
+
+/// Where one planned run stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunStatus {
+    /// Not started yet; the protocol's process is alive and will get to it.
+    Queued,
+    /// Training now: its partial record grows.
+    Running,
+    /// Finished: its record is in `runs/`.
+    Done,
+    /// Stopped before its end (by the user, a signal, or a killed process); `--resume`
+    /// runs it again.
+    Stopped,
+    /// Its protocol failed while it trained (`summary.json`'s `error` says why).
+    Failed,
+    /// Never started, and no live process will start it: `--resume` would.
+    NotRun,
+}
+
+impl RunStatus {
+    /// As the Runs view says it.
+    pub fn name(self) -> &'static str {
+        match self {
+            RunStatus::Queued => "queued",
+            RunStatus::Running => "running",
+            RunStatus::Done => "done",
+            RunStatus::Stopped => "stopped",
+            RunStatus::Failed => "failed",
+            RunStatus::NotRun => "not run",
+        }
+    }
+}
+
+/// One planned run of the protocol, as its files show it.
+#[derive(Debug, Clone)]
+pub struct RunProgress {
+    pub method: MethodId,
+    pub run: u32,
+    pub status: RunStatus,
+    /// Training returns so far, episode 1 first.
+    pub returns: Vec<f64>,
+    /// The episodes the protocol plans per run.
+    pub planned: u32,
+    /// The source it handed over (a finished run's chosen one), else the one that acted
+    /// in most of its episodes so far; `None` for a method that reuses no library.
+    pub source: Option<String>,
+    /// Seconds it has trained (a running run: as of its last episode).
+    pub wall_s: Option<f64>,
+}
+
+impl RunProgress {
+    pub fn episodes(&self) -> usize {
+        self.returns.len()
+    }
+
+    /// Seconds until its planned episodes are done, at its pace so far (a running run
+    /// only).
+    pub fn eta_s(&self) -> Option<f64> {
+        let done = self.episodes();
+        let wall = self.wall_s?;
+        (self.status == RunStatus::Running && done > 0)
+            .then(|| wall / done as f64 * (self.planned as f64 - done as f64).max(0.0))
+    }
+}
+
+/// A results folder as read at one moment.
+#[derive(Debug)]
+pub struct FolderState {
+    pub dir: PathBuf,
+    /// `summary.json`'s status (absent in folders older than the field).
+    pub status: Option<Status>,
+    /// The live process writing the folder, if any.
+    pub writer: Option<Holder>,
+    /// Why the protocol failed, if it did.
+    pub error: Option<String>,
+    pub config: Config,
+    pub library: Vec<LibraryEntry>,
+    /// Every planned run, by method as the protocol lists them, then run.
+    pub runs: Vec<RunProgress>,
+    /// The finished (and stopped) runs' records and training returns: what the report
+    /// is computed from.
+    finished: Vec<RunSummary>,
+    rewards: BTreeMap<(MethodId, u32), Vec<f64>>,
+}
+
+impl FolderState {
+    /// The task as results label it (`cartpole`).
+    pub fn task(&self) -> String {
+        self.config.env.label()
+    }
+
+    /// Runs finished to their end (stopped ones are not in the comparison).
+    pub fn finished_runs(&self) -> usize {
+        self.runs
+            .iter()
+            .filter(|r| r.status == RunStatus::Done)
+            .count()
+    }
+
+    /// What identifies the finished runs: the report changes only when this does.
+    pub fn finished_key(&self) -> BTreeSet<(String, u32)> {
+        self.finished
+            .iter()
+            .filter(|r| !r.record.stopped)
+            .map(|r| (r.record.method.label().to_string(), r.record.run))
+            .collect()
+    }
+
+    /// The comparison of the finished runs, computed as `comparison.csv` and
+    /// `improvement.csv` are ([`super::assemble`]): on a finished folder, their numbers.
+    pub fn report(&self) -> Report {
+        let task = self.task();
+        Report::of(&[TaskRuns {
+            task: &task,
+            config: &self.config,
+            library: &self.library,
+            runs: &self.finished,
+            rewards: &self.rewards,
+        }])
+    }
+}
+
+/// Reads a folder again and again (`sapnet open` refreshes), reading each finished run's
+/// returns once: a record in `runs/` never changes while its folder is there.
+pub struct FolderReader {
+    dir: PathBuf,
+    finished_returns: BTreeMap<(String, u32), Vec<f64>>,
+}
+
+impl FolderReader {
+    pub fn new(dir: &Path) -> Self {
+        Self {
+            dir: dir.to_path_buf(),
+            finished_returns: BTreeMap::new(),
+        }
+    }
+
+    /// The folder as it stands now.
+    pub fn read(&mut self) -> Result<FolderState> {
+        let dir = &self.dir.clone();
+        let header = read_header(dir)?;
+        super::require_records(dir, &header)?;
+        let writer = folder_lock::holder(dir)?;
+        let config = header.config;
+        let library = header.library.unwrap_or_default();
+        let names: Vec<&str> = library.iter().map(|e| e.name.as_str()).collect();
+        let folders = records::read(dir, &config)?;
+        let live = writer.is_some();
+        let failed = header.status == Some(Status::Failed);
+        let mut runs = Vec::new();
+        let mut rewards = BTreeMap::new();
+        for method in MethodId::all(&config.protocol.methods) {
+            for run in 0..config.protocol.runs {
+                let record = folders
+                    .iter()
+                    .find(|f| f.summary.record.method == method && f.summary.record.run == run);
+                let progress = match record {
+                    Some(folder) => {
+                        let returns = self.finished_returns(folder)?;
+                        rewards.insert((method.clone(), run), returns.clone());
+                        finished_run(folder, returns, &names, config.protocol.episodes)
+                    }
+                    None => {
+                        let partial = records::partial_dir(dir, &run_name(method.label(), run));
+                        let (status, episodes) = match read_partial(&partial)? {
+                            Some(episodes) if live => (RunStatus::Running, episodes),
+                            Some(episodes) if failed => (RunStatus::Failed, episodes),
+                            Some(episodes) => (RunStatus::Stopped, episodes),
+                            None if live => (RunStatus::Queued, PartialEpisodes::default()),
+                            None => (RunStatus::NotRun, PartialEpisodes::default()),
+                        };
+                        RunProgress {
+                            method: method.clone(),
+                            run,
+                            status,
+                            source: episodes.most_acting(),
+                            wall_s: episodes.wall_s,
+                            returns: episodes.returns,
+                            planned: config.protocol.episodes,
+                        }
+                    }
+                };
+                runs.push(progress);
+            }
+        }
+        Ok(FolderState {
+            dir: dir.to_path_buf(),
+            status: header.status,
+            writer,
+            error: header.error,
+            config,
+            library,
+            runs,
+            finished: folders.into_iter().map(|f| f.summary).collect(),
+            rewards,
+        })
+    }
+
+    fn finished_returns(&mut self, folder: &RunFolder) -> Result<Vec<f64>> {
+        let record = &folder.summary.record;
+        let key = (record.method.label().to_string(), record.run);
+        if let Some(returns) = self.finished_returns.get(&key) {
+            return Ok(returns.clone());
+        }
+        let returns = super::assemble::rewards(std::slice::from_ref(folder))?
+            .into_values()
+            .next()
+            .unwrap_or_default();
+        self.finished_returns.insert(key, returns.clone());
+        Ok(returns)
+    }
+}
+
+fn finished_run(
+    folder: &RunFolder,
+    returns: Vec<f64>,
+    names: &[&str],
+    planned: u32,
+) -> RunProgress {
+    let record = &folder.summary.record;
+    let source = match &record.chosen {
+        Some(chosen) => Some(chosen.name.clone()),
+        None => crate::report::comparison::most_used(&record.source_steps)
+            .and_then(|i| names.get(i))
+            .map(|n| n.to_string()),
+    };
+    RunProgress {
+        method: record.method.clone(),
+        run: record.run,
+        status: if record.stopped {
+            RunStatus::Stopped
+        } else {
+            RunStatus::Done
+        },
+        returns,
+        planned,
+        source,
+        wall_s: Some(record.wall_s),
+    }
+}
+
+/// What a run's partial `episodes.csv` says so far.
+#[derive(Debug, Default)]
+struct PartialEpisodes {
+    returns: Vec<f64>,
+    /// Per episode, the source that acted most in it (empty in the warm-up, or for a
+    /// method without a library).
+    policies: Vec<Option<String>>,
+    wall_s: Option<f64>,
+}
+
+impl PartialEpisodes {
+    /// The source that acted most in the most episodes (the first named, on a tie).
+    fn most_acting(&self) -> Option<String> {
+        let mut counts: Vec<(&str, usize)> = Vec::new();
+        for name in self.policies.iter().flatten() {
+            match counts.iter_mut().find(|(n, _)| n == name) {
+                Some((_, count)) => *count += 1,
+                None => counts.push((name, 1)),
+            }
+        }
+        let most = counts.iter().map(|&(_, c)| c).max()?;
+        counts
+            .iter()
+            .find(|&&(_, c)| c == most)
+            .map(|(n, _)| n.to_string())
+    }
+}
+
+#[derive(Deserialize)]
+struct PartialRow {
+    reward: f64,
+    policy: Option<String>,
+    wall_s: f64,
+}
+
+/// The episodes of a run in progress, from `runs/.<run>.partial/episodes.csv`; `None`
+/// when the run has no partial record (not started, or renamed into place since the
+/// folder was listed). The writer appends row by row: a last line not ended yet is
+/// not read.
+fn read_partial(partial: &Path) -> Result<Option<PartialEpisodes>> {
+    if std::fs::symlink_metadata(partial).is_err() {
+        return Ok(None);
+    }
+    let path = partial.join("episodes.csv");
+    let bytes = match safe_io::read(&path, Links::Refuse, safe_io::MAX_CSV_BYTES) {
+        Ok(bytes) => bytes,
+        // Created but not yet written, or renamed into place between the two looks.
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Ok(Some(PartialEpisodes::default()))
+        }
+        Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
+    };
+    let whole = bytes
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |end| end + 1);
+    let mut reader = csv::Reader::from_reader(&bytes[..whole]);
+    let mut episodes = PartialEpisodes::default();
+    for (i, row) in reader.deserialize::<PartialRow>().enumerate() {
+        let row = row.with_context(|| {
+            format!(
+                "{}: row {}: expected the columns {}",
+                path.display(),
+                i + 2,
+                super::files::EPISODES_HEADER.join(", ")
+            )
+        })?;
+        episodes.returns.push(row.reward);
+        episodes.policies.push(row.policy.filter(|p| !p.is_empty()));
+        episodes.wall_s = Some(row.wall_s);
+    }
+    Ok(Some(episodes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_partial_record_is_read_up_to_its_last_whole_line() {
+        let tmp = tempfile::tempdir().unwrap();
+        let partial = tmp.path().join(".dqn-16-run0.partial");
+        std::fs::create_dir(&partial).unwrap();
+        std::fs::write(
+            partial.join("episodes.csv"),
+            "run,method,episode,reward,steps,loss,statistic_loss,epsilon,policy,wall_s\n\
+             0,sapnet,1,12.0,12,,0.0,0.03,,0.5\n\
+             0,sapnet,2,20.0,20,0.1,0.01,0.03,source-3,1.0\n\
+             0,sapnet,3,31.0,31,0.1,0.01,0.03,source-1,1.5\n\
+             0,sapnet,4,40.0,40,0.1,0.01,0.03,source-3,2.0\n\
+             0,sapnet,5,4",
+        )
+        .unwrap();
+        let episodes = read_partial(&partial).unwrap().unwrap();
+        assert_eq!(
+            episodes.returns,
+            [12.0, 20.0, 31.0, 40.0],
+            "the cut row waits"
+        );
+        assert_eq!(episodes.most_acting().as_deref(), Some("source-3"));
+        assert_eq!(episodes.wall_s, Some(2.0));
+        assert!(read_partial(&tmp.path().join("absent")).unwrap().is_none());
+        // Four episodes in 2 s, 6 more planned: 3 s.
+        let progress = RunProgress {
+            method: MethodId::new(0, &crate::reuse::Method::the_papers()),
+            run: 0,
+            status: RunStatus::Running,
+            returns: episodes.returns,
+            planned: 10,
+            source: None,
+            wall_s: episodes.wall_s,
+        };
+        assert_eq!(progress.eta_s(), Some(3.0));
+    }
+
+    #[test]
+    fn a_bad_row_is_refused_naming_the_file_its_row_and_the_columns() {
+        let tmp = tempfile::tempdir().unwrap();
+        std::fs::write(
+            tmp.path().join("episodes.csv"),
+            "run,method,episode,reward,steps,loss,statistic_loss,epsilon,policy,wall_s\n\
+             0,sapnet,1,many,12,,0.0,0.03,,0.5\n",
+        )
+        .unwrap();
+        let err = format!("{:#}", read_partial(tmp.path()).unwrap_err());
+        assert!(
+            err.contains("episodes.csv: row 2: expected the columns run, method"),
+            "{err}"
+        );
+        assert!(err.contains("reward"), "{err}");
+    }
+}

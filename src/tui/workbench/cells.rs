@@ -1,0 +1,54 @@
+//! What the workbench's views share: a cell of a fixed width, a panel's inside, each
+//! method's colour.
+
+use ratatui::layout::Rect;
+use ratatui::style::Style;
+
+use crate::results::folder_state::FolderState;
+use crate::tui::theme::Theme;
+
+/// `text` cut or padded to exactly `width` columns (a cut ends in `…`).
+pub fn fit(text: &str, width: usize) -> String {
+    let count = text.chars().count();
+    if count <= width {
+        format!("{text:<width$}")
+    } else if width == 0 {
+        String::new()
+    } else {
+        let cut: String = text.chars().take(width - 1).collect();
+        format!("{cut}…")
+    }
+}
+
+/// The style of each method of the protocol, in its order: its family's hue, members
+/// of a family in turn a shade apart ([`Theme::method`]).
+pub fn method_styles(folder: &FolderState, theme: Theme) -> Vec<Style> {
+    let kinds: Vec<_> = folder
+        .config
+        .protocol
+        .methods
+        .iter()
+        .map(|m| m.kind())
+        .collect();
+    kinds
+        .iter()
+        .enumerate()
+        .map(|(i, kind)| {
+            let member = kinds[..i]
+                .iter()
+                .filter(|k| k.family == kind.family)
+                .count();
+            theme.method(*kind, member)
+        })
+        .collect()
+}
+
+/// A rectangle's inside, below a one-line title row and within its borders.
+pub fn inner(area: Rect) -> Rect {
+    Rect {
+        x: area.x + 1,
+        y: area.y + 1,
+        width: area.width.saturating_sub(2),
+        height: area.height.saturating_sub(2),
+    }
+}

@@ -1,0 +1,233 @@
+//! The Runs view: every planned run of the protocol, methods × runs, one line each — its
+//! status, episodes done of those planned, a sparkline of its moving average (MA10) on
+//! one scale for all (so lines compare at a glance), the latest MA10, the time
+//! left at its pace, and the source it handed over or used most.
+
+use ratatui::layout::Rect;
+use ratatui::style::Style;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Paragraph};
+use ratatui::Frame;
+
+use super::cells::{fit, inner, method_styles};
+use super::state::Workbench;
+use crate::report::moving_average;
+use crate::results::folder_state::{RunProgress, RunStatus};
+use crate::tui::row_window::RowWindow;
+use crate::tui::theme::Theme;
+
+/// The sparkline's levels, lowest first.
+const LEVELS: [char; 8] = ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'];
+
+pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) {
+    let folder = &workbench.folder;
+    let title = Line::from(vec![
+        Span::styled(" Runs ", theme.title()),
+        Span::raw(format!("{} ", counts(&folder.runs))),
+    ]);
+    frame.render_widget(Block::bordered().title(title), area);
+    let inside = inner(area);
+    if inside.height < 2 {
+        return;
+    }
+    let window = folder.config.protocol.moving_average;
+    let averages: Vec<Vec<f64>> = folder
+        .runs
+        .iter()
+        .map(|r| moving_average(&r.returns, window))
+        .collect();
+    // One scale for every line, the lowest MA10 of the folder to its highest, so that
+    // lines compare and a curve's shape shows even far below the task's best return.
+    let range = averages
+        .iter()
+        .flatten()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &a| {
+            (lo.min(a), hi.max(a))
+        });
+    let method_width = folder
+        .runs
+        .iter()
+        .map(|r| r.method.label().chars().count())
+        .max()
+        .unwrap_or(6)
+        .clamp(6, 22);
+    let source_width = folder
+        .runs
+        .iter()
+        .filter_map(|r| r.source.as_ref().map(|s| s.chars().count()))
+        .max()
+        .unwrap_or(1)
+        .clamp(6, 12);
+    let episodes_width = format!("{0}/{0}", folder.config.protocol.episodes)
+        .len()
+        .max(8);
+    // method, run, status, episodes, [sparkline], MA10, ETA, source, with a space between.
+    let fixed = method_width + 4 + 8 + episodes_width + 8 + 7 + source_width + 7;
+    let spark_width = usize::from(inside.width).saturating_sub(fixed).max(4);
+    let header = format!(
+        "{} {} {} {} {} {} {} {}",
+        fit("method", method_width),
+        fit("run", 4),
+        fit("status", 8),
+        fit("episodes", episodes_width),
+        fit(
+            &if range.0 <= range.1 {
+                format!("MA{window}, {:.1} to {:.1}", range.0, range.1)
+            } else {
+                format!("MA{window}")
+            },
+            spark_width
+        ),
+        fit(&format!("MA{window}"), 8),
+        fit("ETA", 7),
+        fit("source", source_width),
+    );
+    let mut lines = vec![Line::styled(header, theme.dim())];
+    // A line under the rows says what they hide, when they do not all fit.
+    let mut room = usize::from(inside.height) - 1;
+    if folder.runs.len() > room {
+        room = room.saturating_sub(1);
+    }
+    let rows = RowWindow::new(folder.runs.len(), room, [workbench.run_cursor]);
+    let styles = method_styles(folder, theme);
+    for i in rows.rows() {
+        let run = &folder.runs[i];
+        let first_of_method = i == 0 || folder.runs[i - 1].method != run.method;
+        let method = if first_of_method {
+            run.method.label()
+        } else {
+            ""
+        };
+        let averages = &averages[i];
+        let latest = averages
+            .last()
+            .map_or_else(|| "-".to_string(), |a| format!("{a:.1}"));
+        let eta = run.eta_s().map_or_else(|| "-".to_string(), duration);
+        let picked = i == workbench.run_cursor;
+        let row_style = |style: Style| {
+            if picked {
+                style.patch(theme.cursor())
+            } else {
+                style
+            }
+        };
+        let method_style = styles.get(run.method.index).copied().unwrap_or_default();
+        lines.push(Line::from(vec![
+            Span::styled(fit(method, method_width), row_style(method_style)),
+            Span::styled(
+                format!(" {} ", fit(&run.run.to_string(), 4)),
+                row_style(Style::new()),
+            ),
+            Span::styled(
+                fit(run.status.name(), 8),
+                row_style(status_style(run.status, theme)),
+            ),
+            Span::styled(
+                format!(
+                    " {} {} {} {} {}",
+                    fit(
+                        &format!("{}/{}", run.episodes(), run.planned),
+                        episodes_width
+                    ),
+                    fit(&sparkline(averages, range, spark_width), spark_width),
+                    fit(&latest, 8),
+                    fit(&eta, 7),
+                    fit(run.source.as_deref().unwrap_or("-"), source_width),
+                ),
+                row_style(Style::new()),
+            ),
+        ]));
+    }
+    if rows.hidden_above() + rows.hidden_below() > 0 {
+        lines.push(Line::styled(
+            format!(
+                "▲ {} more · ▼ {} more (↑↓ to move)",
+                rows.hidden_above(),
+                rows.hidden_below()
+            ),
+            theme.dim(),
+        ));
+    }
+    frame.render_widget(Paragraph::new(lines), inside);
+}
+
+/// `done 3 · running 2 · queued 6` (only the statuses some run has).
+fn counts(runs: &[RunProgress]) -> String {
+    let statuses = [
+        RunStatus::Done,
+        RunStatus::Running,
+        RunStatus::Queued,
+        RunStatus::Stopped,
+        RunStatus::Failed,
+        RunStatus::NotRun,
+    ];
+    let parts: Vec<String> = statuses
+        .iter()
+        .filter_map(|&s| {
+            let n = runs.iter().filter(|r| r.status == s).count();
+            (n > 0).then(|| format!("{} {n}", s.name()))
+        })
+        .collect();
+    format!("· {} runs: {}", runs.len(), parts.join(" · "))
+}
+
+fn status_style(status: RunStatus, theme: Theme) -> Style {
+    match status {
+        RunStatus::Running => theme.active(),
+        RunStatus::Failed | RunStatus::Stopped => theme.stopped(),
+        RunStatus::Queued | RunStatus::NotRun => theme.dim(),
+        RunStatus::Done => Style::new(),
+    }
+}
+
+/// The values as at most `width` block characters on the scale `low..high`, the last
+/// value of each of `width` equal stretches of the run (a long run's latest shape).
+pub fn sparkline(values: &[f64], (low, high): (f64, f64), width: usize) -> String {
+    if values.is_empty() || width == 0 {
+        return String::new();
+    }
+    let shown = values.len().min(width);
+    (1..=shown)
+        .map(|k| {
+            let v = values[k * values.len() / shown - 1];
+            let level = if high > low {
+                ((v - low) / (high - low)).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            LEVELS[(level * (LEVELS.len() - 1) as f64).round() as usize]
+        })
+        .collect()
+}
+
+/// `45s`, `3m05s`, `2h10m`.
+fn duration(seconds: f64) -> String {
+    let s = seconds.round() as u64;
+    match s {
+        0..60 => format!("{s}s"),
+        60..3600 => format!("{}m{:02}s", s / 60, s % 60),
+        _ => format!("{}h{:02}m", s / 3600, s % 3600 / 60),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_sparkline_keeps_the_last_value_of_each_stretch_on_the_tasks_scale() {
+        // 0..500 in eight levels: 0 → ▁, 250 → ▅ (3.5 rounds up), 500 → █.
+        assert_eq!(sparkline(&[0.0, 250.0, 500.0], (0.0, 500.0), 10), "▁▅█");
+        // Four values in two columns: the 2nd and the 4th.
+        assert_eq!(sparkline(&[0.0, 500.0, 0.0, 0.0], (0.0, 500.0), 2), "█▁");
+        assert_eq!(sparkline(&[-300.0], (-200.0, 0.0), 3), "▁", "clamped");
+        assert_eq!(sparkline(&[], (0.0, 1.0), 3), "");
+    }
+
+    #[test]
+    fn durations_read_at_a_glance() {
+        assert_eq!(duration(44.6), "45s");
+        assert_eq!(duration(185.0), "3m05s");
+        assert_eq!(duration(7800.0), "2h10m");
+    }
+}
