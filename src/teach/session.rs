@@ -7,8 +7,12 @@
 //! [`Teach::advance`], so a walk of millions of calls leaves the screen and the keys
 //! responsive.
 
+use std::path::PathBuf;
+
+use super::edit::GraphEdit;
 use super::knobs::{refusal, walk_end, EditReport, Knob};
 use super::labels;
+use super::lesson::TeachConfig;
 use crate::sapnet::{Call, SapNet, SpreadState, Spreader, TraceStep};
 
 /// Calls `r` makes between two frames: a few milliseconds' worth.
@@ -48,7 +52,38 @@ pub struct Teach {
     /// Something the last key did that the screen must say: an edit refused, pending
     /// calls made before a new activation.
     notice: Option<String>,
+    /// A line being typed (an edge to add, the file to save to), if any.
+    prompt: Option<Prompt>,
 }
+
+/// A line the user types in teach mode, and what Enter does with it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Prompt {
+    pub kind: PromptKind,
+    pub text: String,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PromptKind {
+    /// `E`: `I J W`, an edge of weight W between policies I and J (0-based, as
+    /// `--add-edge` takes them), added or reweighted.
+    AddEdge,
+    /// `w`: the path the lesson is written to.
+    Save,
+}
+
+impl PromptKind {
+    /// What the prompt asks, on screen.
+    pub fn question(self) -> &'static str {
+        match self {
+            PromptKind::AddEdge => "add edge I J W (0-based, as --add-edge):",
+            PromptKind::Save => "save the lesson to:",
+        }
+    }
+}
+
+/// The file `w` offers.
+pub const LESSON_FILE: &str = "lesson.ron";
 
 /// One activation being stepped.
 #[derive(Debug, Clone)]
@@ -113,6 +148,7 @@ impl Teach {
             edge: 0,
             last_edit: None,
             notice: None,
+            prompt: None,
         }
     }
 
@@ -407,6 +443,161 @@ impl Teach {
             done: walk.state.is_done(),
             deposited: &walk.deposited,
         })
+    }
+
+    /// The line being typed, if any: while there is one every key goes to it.
+    pub fn prompt(&self) -> Option<&Prompt> {
+        self.prompt.as_ref()
+    }
+
+    /// `E` or `w`: starts typing an edge to add, or the file to save to (`lesson.ron`
+    /// offered).
+    pub fn open_prompt(&mut self, kind: PromptKind) {
+        self.running = false;
+        self.notice = None;
+        let text = match kind {
+            PromptKind::AddEdge => String::new(),
+            PromptKind::Save => LESSON_FILE.to_string(),
+        };
+        self.prompt = Some(Prompt { kind, text });
+    }
+
+    /// A character typed into the prompt.
+    pub fn prompt_type(&mut self, c: char) {
+        if let Some(prompt) = &mut self.prompt {
+            prompt.text.push(c);
+        }
+    }
+
+    /// Backspace in the prompt.
+    pub fn prompt_backspace(&mut self) {
+        if let Some(prompt) = &mut self.prompt {
+            prompt.text.pop();
+        }
+    }
+
+    /// Esc in the prompt: nothing is done.
+    pub fn prompt_cancel(&mut self) {
+        self.prompt = None;
+    }
+
+    /// Enter in the prompt: adds the edge or writes the lesson; what went wrong (a value
+    /// not read, an edit the lesson or the net refuses, a file not written) is said and
+    /// changes nothing.
+    pub fn prompt_submit(&mut self) {
+        let Some(prompt) = self.prompt.take() else {
+            return;
+        };
+        match prompt.kind {
+            PromptKind::AddEdge => {
+                let values: Vec<String> =
+                    prompt.text.split_whitespace().map(str::to_string).collect();
+                match GraphEdit::parse("--add-edge", &values) {
+                    Ok(edit) => self.edit_graph(edit),
+                    Err(why) => {
+                        self.notice = Some(format!("no edge added: {why}"));
+                    }
+                }
+            }
+            PromptKind::Save => {
+                let path = PathBuf::from(prompt.text.trim());
+                self.notice = Some(match self.lesson_file().save(&path) {
+                    Ok(()) => format!(
+                        "wrote {}: `sapnet teach --config {}` opens it{}",
+                        path.display(),
+                        path.display(),
+                        self.walk
+                            .as_ref()
+                            .map(|w| format!(", --activate {} replays this walk", w.policy))
+                            .unwrap_or_default()
+                    ),
+                    Err(error) => format!("not saved: {error:#}"),
+                });
+            }
+        }
+    }
+
+    /// `x`: cuts the picked policy's selected edge (`e` selects it).
+    pub fn cut_selected_edge(&mut self) {
+        self.running = false;
+        match self.selected_edge() {
+            Some((i, j)) => self.edit_graph(GraphEdit::Cut { i, j }),
+            None => self.notice = Some(format!("{} has no edge to cut", self.names()[self.cursor])),
+        }
+    }
+
+    /// Edits the graph as `sapnet teach --add-edge`/`--cut-edge` do (the same checks, the
+    /// same refusals), then builds the net the lesson file would: a refusal changes
+    /// nothing and is said. The walk on screen restarts from the activations it started
+    /// from, as a knob's turn restarts it.
+    pub fn edit_graph(&mut self, edit: GraphEdit) {
+        self.running = false;
+        self.notice = None;
+        let mut lesson = self.lesson_file();
+        let built = lesson.apply(edit).and_then(|()| lesson.lesson());
+        let net = match built {
+            Ok(lesson) => lesson.net,
+            Err(why) => {
+                self.notice = Some(format!("{}: {why}", edit.flag()));
+                return;
+            }
+        };
+        let (policy, before) = match &self.walk {
+            Some(w) => (Some(w.policy), w.before.clone()),
+            None => (None, self.net.activations().to_vec()),
+        };
+        let (old_calls, new_calls) = (
+            walk_end(&self.net, policy, &before).2,
+            walk_end(&net, policy, &before).2,
+        );
+        self.net = net;
+        self.edge = 0;
+        self.notice = Some(match policy {
+            Some(p) => format!(
+                "{} done: {}'s walk {old_calls} → {new_calls} calls, restarted",
+                edit.flag(),
+                self.names()[p]
+            ),
+            None => format!("{} done", edit.flag()),
+        });
+        match policy {
+            Some(policy) => {
+                self.walk = Some(self.start(policy, before));
+                self.sync();
+            }
+            None => self.set_activations(before),
+        }
+    }
+
+    /// The lesson as it stands, in the format `sapnet teach --config` reads: the graph
+    /// (its edges), T_ω, 𝒜, τ and the paths as edited, the policies' names as the lesson
+    /// gave them, and as `initial` the activations the walk on screen started from (so
+    /// `--activate` of its policy replays it), or those on screen without a walk.
+    pub fn lesson_file(&self) -> TeachConfig {
+        let params = self.net.params();
+        let activations = match &self.walk {
+            Some(w) => w.before.clone(),
+            None => self.net.activations().to_vec(),
+        };
+        let names = self
+            .descriptions
+            .clone()
+            .unwrap_or_else(|| self.names.clone());
+        let default_names = names
+            .iter()
+            .enumerate()
+            .all(|(i, name)| *name == format!("π{i}"));
+        TeachConfig {
+            policies: self.net.len(),
+            names: if default_names { Vec::new() } else { names },
+            edges: self.net.graph().edges().collect(),
+            threshold: params.threshold,
+            coefficient: params.coefficient,
+            temperature: params.temperature,
+            paths: params.paths,
+            initial: activations.iter().any(|&a| a != 0.0).then_some(activations),
+            ..TeachConfig::default()
+        }
     }
 
     /// A walk activating `policy` from the activations `before` (eq. 8, the first calls

@@ -24,7 +24,16 @@ pub(super) fn paragraph(teach: &Teach, theme: Theme, compact: bool) -> Paragraph
         };
         format!("{} {symbol} {}", knob.key(), knob.value(teach.net(), edge))
     };
-    let said = if let Some(notice) = teach.notice() {
+    let said = if let Some(prompt) = teach.prompt() {
+        Some(Line::styled(
+            format!(
+                "{} {}█  (Enter, Esc cancels)",
+                prompt.kind.question(),
+                prompt.text
+            ),
+            theme.active(),
+        ))
+    } else if let Some(notice) = teach.notice() {
         Some(Line::styled(notice.to_string(), theme.stopped()))
     } else {
         teach
