@@ -171,3 +171,57 @@ fn keys_refuse_edits_as_the_flags_do_and_cuts_restart_the_walk() {
     assert!((a[0] - (1.25 + 0.156_25)).abs() < 1e-12, "{a:?}");
     assert_eq!(a[3], 0.0);
 }
+
+/// The "done when", in tmux as a teacher does it: `sapnet teach`, `E 0 3 0.3`,
+/// `w` to a file, `q`; the file then walks from π1 as `--add-edge 0 3 0.3` does.
+#[test]
+fn a_teacher_adds_an_edge_and_saves_the_lesson_in_tmux() {
+    if !crate::common::tmux::available() {
+        eprintln!("tmux is not installed: the end-to-end lesson test is skipped");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let saved = dir.path().join("class.ron");
+    let command = format!(
+        "{} teach; echo SAPNET-EXITED $?; sleep 60",
+        env!("CARGO_BIN_EXE_sapnet")
+    );
+    let session = crate::common::tmux::Session::start(120, 40, &command);
+    session.wait_for(&["the call", "pending spread calls"]);
+    session.keys("E");
+    session.wait_for(&["add edge I J W"]);
+    session.keys("0 3 0.3");
+    session.keys("Enter");
+    session.wait_for(&["--add-edge 0 3 0.3 done"]);
+    session.keys("w");
+    session.wait_for(&["save the lesson to: lesson.ron"]);
+    for _ in "lesson.ron".chars() {
+        session.keys("BSpace");
+    }
+    session.keys(saved.to_str().unwrap());
+    session.keys("Enter");
+    session.wait_for(&["wrote "]);
+    session.keys("q");
+    session.wait_for(&["SAPNET-EXITED 0"]);
+    let by_keys = sapnet(&[
+        "teach",
+        "--headless",
+        "--config",
+        saved.to_str().unwrap(),
+        "--activate",
+        "1",
+        "--json",
+    ]);
+    let by_flags = sapnet(&[
+        "teach",
+        "--add-edge",
+        "0",
+        "3",
+        "0.3",
+        "--activate",
+        "1",
+        "--headless",
+        "--json",
+    ]);
+    assert_eq!(by_keys.stdout, by_flags.stdout);
+}
