@@ -54,7 +54,20 @@ pub struct Teach {
     notice: Option<String>,
     /// A line being typed (an edge to add, the file to save to), if any.
     prompt: Option<Prompt>,
+    /// Exercise mode (`X`): before each call the student types its ΔA; the score so far.
+    exercise: Option<Score>,
 }
+
+/// An exercise's score: answers right of answers given.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Score {
+    pub right: usize,
+    pub asked: usize,
+}
+
+/// How far a typed ΔA may be from the call's and count as right: the screen gives ΔA to
+/// six decimals, a student working by hand to three or four.
+pub const ANSWER_TOLERANCE: f64 = 1e-3;
 
 /// A line the user types in teach mode, and what Enter does with it.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -70,6 +83,8 @@ pub enum PromptKind {
     AddEdge,
     /// `w`: the path the lesson is written to.
     Save,
+    /// Exercise mode: the ΔA the next call deposits, or `stop` where eq. 10 stops it.
+    Predict,
 }
 
 impl PromptKind {
@@ -78,6 +93,7 @@ impl PromptKind {
         match self {
             PromptKind::AddEdge => "add edge I J W (0-based, as --add-edge):",
             PromptKind::Save => "save the lesson to:",
+            PromptKind::Predict => "ΔA of the next call (a number, or stop)?",
         }
     }
 }
@@ -149,6 +165,7 @@ impl Teach {
             last_edit: None,
             notice: None,
             prompt: None,
+            exercise: None,
         }
     }
 
@@ -456,7 +473,7 @@ impl Teach {
         self.running = false;
         self.notice = None;
         let text = match kind {
-            PromptKind::AddEdge => String::new(),
+            PromptKind::AddEdge | PromptKind::Predict => String::new(),
             PromptKind::Save => LESSON_FILE.to_string(),
         };
         self.prompt = Some(Prompt { kind, text });
@@ -499,6 +516,7 @@ impl Teach {
                     }
                 }
             }
+            PromptKind::Predict => self.check_answer(&prompt.text),
             PromptKind::Save => {
                 let path = PathBuf::from(prompt.text.trim());
                 self.notice = Some(match self.lesson_file().save(&path) {
@@ -515,6 +533,86 @@ impl Teach {
                 });
             }
         }
+    }
+
+    /// `X`: exercise mode on (the score from 0) or off.
+    pub fn toggle_exercise(&mut self) {
+        self.exercise = match self.exercise {
+            Some(_) => None,
+            None => Some(Score::default()),
+        };
+        self.notice = Some(match self.exercise {
+            Some(_) => format!(
+                "exercise: s asks the next call's ΔA first (right within {ANSWER_TOLERANCE}); \
+                 X ends it"
+            ),
+            None => "exercise ended".to_string(),
+        });
+    }
+
+    /// The exercise's score, in exercise mode.
+    pub fn score(&self) -> Option<Score> {
+        self.exercise
+    }
+
+    /// `s`: in exercise mode, asks the next call's ΔA before making it; else makes it.
+    pub fn step_or_ask(&mut self) {
+        let next = self.walk.as_ref().and_then(|w| w.state.pending().last());
+        if self.exercise.is_some() && next.is_some() {
+            self.open_prompt(PromptKind::Predict);
+        } else {
+            self.step();
+        }
+    }
+
+    /// Checks `answer` against the next call (eq. 10: ΔA = η/(h×Ω) where Ω < T_ω, else
+    /// the call stops), says right or the working, counts it, then makes the call.
+    fn check_answer(&mut self, answer: &str) {
+        let Some(call) = self
+            .walk
+            .as_ref()
+            .and_then(|w| w.state.pending().last().copied())
+        else {
+            return;
+        };
+        let threshold = self.net.params().threshold;
+        let stops = call.omega >= threshold;
+        let delta = call.eta / (call.h as f64 * call.omega);
+        let answer = answer.trim();
+        let said_stop = ["stop", "stops", "stopped"].contains(&answer.to_lowercase().as_str());
+        let right = match (stops, said_stop, answer.parse::<f64>()) {
+            (true, true, _) => true,
+            (false, false, Ok(x)) => (x - delta).abs() <= ANSWER_TOLERANCE,
+            _ => false,
+        };
+        let names = self.names();
+        let working = if stops {
+            format!(
+                "eq. 10: Ω < T_ω is {:.4} < {threshold}, false: the call stops, ΔA = 0",
+                call.omega
+            )
+        } else {
+            format!(
+                "eq. 10: Ω < T_ω is {:.4} < {threshold}, true: ΔA[{}] = η/(h×Ω) = \
+                 {:.6}/({}×{:.4}) = {delta:.6}",
+                call.omega, names[call.to], call.eta, call.h, call.omega
+            )
+        };
+        let score = self.exercise.get_or_insert_with(Score::default);
+        score.asked += 1;
+        if right {
+            score.right += 1;
+        }
+        let score = *score;
+        let verdict = if right {
+            format!("right ({working})")
+        } else if answer.is_empty() {
+            format!("no answer: {working}")
+        } else {
+            format!("not {answer}: {working}")
+        };
+        self.step();
+        self.notice = Some(format!("{verdict} · score {}/{}", score.right, score.asked));
     }
 
     /// `x`: cuts the picked policy's selected edge (`e` selects it).
@@ -839,5 +937,49 @@ mod tests {
         teach.step();
         assert!(!teach.is_running());
         assert_eq!(teach.net().activations(), whole.activations());
+    }
+
+    /// Fig. 2 from π1 by hand: the first call reaches π0 at h = 1, Ω = 0.4 with
+    /// η = 𝒜/k = 1/3, so ΔA = (1/3)/(1×0.4) = 0.833333; the second goes back to π1 at
+    /// h = 2, Ω = 0.8 with η = (1/3)/2 = 1/6, ΔA = (1/6)/(2×0.8) = 0.104167; the third
+    /// returns to π0 at Ω = 1.2 ≥ T_ω = 1 and stops.
+    #[test]
+    fn an_exercise_checks_each_typed_delta_and_keeps_the_score() {
+        let mut teach = fig2();
+        teach.move_cursor(1);
+        teach.activate();
+        teach.toggle_exercise();
+        let answer = |teach: &mut Teach, text: &str| {
+            teach.step_or_ask();
+            assert_eq!(teach.prompt().map(|p| p.kind), Some(PromptKind::Predict));
+            text.chars().for_each(|c| teach.prompt_type(c));
+            teach.prompt_submit();
+            teach.notice().unwrap().to_string()
+        };
+        let said = answer(&mut teach, "0.8333");
+        assert!(said.starts_with("right"), "{said}");
+        assert!(said.ends_with("score 1/1"), "{said}");
+        assert_eq!(teach.walk().unwrap().trace.len(), 1, "the call is made");
+
+        let said = answer(&mut teach, "0.2");
+        assert!(said.starts_with("not 0.2: "), "{said}");
+        assert!(
+            said.contains("ΔA[π1] = η/(h×Ω) = 0.166667/(2×0.8000) = 0.104167"),
+            "{said}"
+        );
+        assert!(said.ends_with("score 1/2"), "{said}");
+
+        let said = answer(&mut teach, "stop");
+        assert!(said.starts_with("right"), "{said}");
+        assert!(said.contains("1.2000 < 1, false: the call stops"), "{said}");
+        assert_eq!(teach.score(), Some(Score { right: 2, asked: 3 }));
+
+        // A number where the call stops is wrong.
+        let said = answer(&mut teach, "0");
+        assert!(said.starts_with("not 0: "), "{said}");
+        teach.toggle_exercise();
+        assert_eq!(teach.score(), None);
+        teach.step_or_ask();
+        assert!(teach.prompt().is_none(), "out of exercise mode s steps");
     }
 }

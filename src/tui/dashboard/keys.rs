@@ -234,9 +234,8 @@ pub fn apply_teach_key(teach: &mut Teach, key: KeyEvent) -> bool {
             teach.move_cursor(1)
         }
         KeyCode::Char('a') => teach.activate(),
-        KeyCode::Char('s') => {
-            teach.step();
-        }
+        KeyCode::Char('s') => teach.step_or_ask(),
+        KeyCode::Char('X') => teach.toggle_exercise(),
         KeyCode::Char('r') => teach.run(),
         KeyCode::Char('u') => teach.undo(),
         KeyCode::Char('c') => teach.reset(),

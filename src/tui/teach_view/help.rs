@@ -36,6 +36,10 @@ pub(crate) fn teach_help(
             "w",
             "write the lesson as it stands to a file (--config reads it)",
         ),
+        (
+            "X",
+            "exercise: s asks the next call's ΔA first and scores it",
+        ),
         ("?", "this help (any key closes it)"),
     ]);
     if on_the_dashboard {
