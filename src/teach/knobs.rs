@@ -272,7 +272,7 @@ mod tests {
 
     /// Fig. 2 by hand: from π1 (k = 3, η = 1/3) the walk deposits on π0, π2, π3 at
     /// Ω = 0.4 and goes one edge further (Ω = 0.8 < 1) but not two (Ω = 1.2). With
-    /// T_ω = 0.5 only the first edges deposit: each neighbour gets η/(h·Ω) = (1/3)/0.4.
+    /// T_ω = 0.5 only the first edges deposit: each neighbour gets η/(h×Ω) = (1/3)/0.4.
     #[test]
     fn a_lower_threshold_shortens_the_walk_as_eq_10_says() {
         let net = fig2();

@@ -7,8 +7,12 @@
 //! [`Teach::advance`], so a walk of millions of calls leaves the screen and the keys
 //! responsive.
 
+use std::path::PathBuf;
+
+use super::edit::GraphEdit;
 use super::knobs::{refusal, walk_end, EditReport, Knob};
 use super::labels;
+use super::lesson::TeachConfig;
 use crate::sapnet::{Call, SapNet, SpreadState, Spreader, TraceStep};
 
 /// Calls `r` makes between two frames: a few milliseconds' worth.
@@ -48,7 +52,54 @@ pub struct Teach {
     /// Something the last key did that the screen must say: an edit refused, pending
     /// calls made before a new activation.
     notice: Option<String>,
+    /// A line being typed (an edge to add, the file to save to), if any.
+    prompt: Option<Prompt>,
+    /// Exercise mode (`X`): before each call the student types its ΔA; the score so far.
+    exercise: Option<Score>,
 }
+
+/// An exercise's score: answers right of answers given.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Score {
+    pub right: usize,
+    pub asked: usize,
+}
+
+/// How far a typed ΔA may be from the call's and count as right: the screen gives ΔA to
+/// six decimals, a student working by hand to three or four.
+pub const ANSWER_TOLERANCE: f64 = 1e-3;
+
+/// A line the user types in teach mode, and what Enter does with it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Prompt {
+    pub kind: PromptKind,
+    pub text: String,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PromptKind {
+    /// `E`: `I J W`, an edge of weight W between policies I and J (0-based, as
+    /// `--add-edge` takes them), added or reweighted.
+    AddEdge,
+    /// `w`: the path the lesson is written to.
+    Save,
+    /// Exercise mode: the ΔA the next call deposits, or `stop` where eq. 10 stops it.
+    Predict,
+}
+
+impl PromptKind {
+    /// What the prompt asks, on screen.
+    pub fn question(self) -> &'static str {
+        match self {
+            PromptKind::AddEdge => "add edge I J W (0-based, as --add-edge):",
+            PromptKind::Save => "save the lesson to:",
+            PromptKind::Predict => "ΔA of the next call (a number, or stop)?",
+        }
+    }
+}
+
+/// The file `w` offers.
+pub const LESSON_FILE: &str = "lesson.ron";
 
 /// One activation being stepped.
 #[derive(Debug, Clone)]
@@ -113,6 +164,8 @@ impl Teach {
             edge: 0,
             last_edit: None,
             notice: None,
+            prompt: None,
+            exercise: None,
         }
     }
 
@@ -409,6 +462,242 @@ impl Teach {
         })
     }
 
+    /// The line being typed, if any: while there is one every key goes to it.
+    pub fn prompt(&self) -> Option<&Prompt> {
+        self.prompt.as_ref()
+    }
+
+    /// `E` or `w`: starts typing an edge to add, or the file to save to (`lesson.ron`
+    /// offered).
+    pub fn open_prompt(&mut self, kind: PromptKind) {
+        self.running = false;
+        self.notice = None;
+        let text = match kind {
+            PromptKind::AddEdge | PromptKind::Predict => String::new(),
+            PromptKind::Save => LESSON_FILE.to_string(),
+        };
+        self.prompt = Some(Prompt { kind, text });
+    }
+
+    /// A character typed into the prompt.
+    pub fn prompt_type(&mut self, c: char) {
+        if let Some(prompt) = &mut self.prompt {
+            prompt.text.push(c);
+        }
+    }
+
+    /// Backspace in the prompt.
+    pub fn prompt_backspace(&mut self) {
+        if let Some(prompt) = &mut self.prompt {
+            prompt.text.pop();
+        }
+    }
+
+    /// Esc in the prompt: nothing is done.
+    pub fn prompt_cancel(&mut self) {
+        self.prompt = None;
+    }
+
+    /// Enter in the prompt: adds the edge or writes the lesson; what went wrong (a value
+    /// not read, an edit the lesson or the net refuses, a file not written) is said and
+    /// changes nothing.
+    pub fn prompt_submit(&mut self) {
+        let Some(prompt) = self.prompt.take() else {
+            return;
+        };
+        match prompt.kind {
+            PromptKind::AddEdge => {
+                let values: Vec<String> =
+                    prompt.text.split_whitespace().map(str::to_string).collect();
+                match GraphEdit::parse("--add-edge", &values) {
+                    Ok(edit) => self.edit_graph(edit),
+                    Err(why) => {
+                        self.notice = Some(format!("no edge added: {why}"));
+                    }
+                }
+            }
+            PromptKind::Predict => self.check_answer(&prompt.text),
+            PromptKind::Save => {
+                let path = PathBuf::from(prompt.text.trim());
+                self.notice = Some(match self.lesson_file().save(&path) {
+                    Ok(()) => format!(
+                        "wrote {}: `sapnet teach --config {}` opens it{}",
+                        path.display(),
+                        path.display(),
+                        self.walk
+                            .as_ref()
+                            .map(|w| format!(", --activate {} replays this walk", w.policy))
+                            .unwrap_or_default()
+                    ),
+                    Err(error) => format!("not saved: {error:#}"),
+                });
+            }
+        }
+    }
+
+    /// `X`: exercise mode on (the score from 0) or off.
+    pub fn toggle_exercise(&mut self) {
+        self.exercise = match self.exercise {
+            Some(_) => None,
+            None => Some(Score::default()),
+        };
+        self.notice = Some(match self.exercise {
+            Some(_) => format!(
+                "exercise: s asks the next call's ΔA first (right within {ANSWER_TOLERANCE}); \
+                 X ends it"
+            ),
+            None => "exercise ended".to_string(),
+        });
+    }
+
+    /// The exercise's score, in exercise mode.
+    pub fn score(&self) -> Option<Score> {
+        self.exercise
+    }
+
+    /// `s`: in exercise mode, asks the next call's ΔA before making it; else makes it.
+    pub fn step_or_ask(&mut self) {
+        let next = self.walk.as_ref().and_then(|w| w.state.pending().last());
+        if self.exercise.is_some() && next.is_some() {
+            self.open_prompt(PromptKind::Predict);
+        } else {
+            self.step();
+        }
+    }
+
+    /// Checks `answer` against the next call (eq. 10: ΔA = η/(h×Ω) where Ω < T_ω, else
+    /// the call stops), says right or the working, counts it, then makes the call.
+    fn check_answer(&mut self, answer: &str) {
+        let Some(call) = self
+            .walk
+            .as_ref()
+            .and_then(|w| w.state.pending().last().copied())
+        else {
+            return;
+        };
+        let threshold = self.net.params().threshold;
+        let stops = call.omega >= threshold;
+        let delta = call.eta / (call.h as f64 * call.omega);
+        let answer = answer.trim();
+        let said_stop = ["stop", "stops", "stopped"].contains(&answer.to_lowercase().as_str());
+        let right = match (stops, said_stop, answer.parse::<f64>()) {
+            (true, true, _) => true,
+            (false, false, Ok(x)) => (x - delta).abs() <= ANSWER_TOLERANCE,
+            _ => false,
+        };
+        let names = self.names();
+        let working = if stops {
+            format!(
+                "eq. 10: Ω < T_ω is {:.4} < {threshold}, false: the call stops, ΔA = 0",
+                call.omega
+            )
+        } else {
+            format!(
+                "eq. 10: Ω < T_ω is {:.4} < {threshold}, true: ΔA[{}] = η/(h×Ω) = \
+                 {:.6}/({}×{:.4}) = {delta:.6}",
+                call.omega, names[call.to], call.eta, call.h, call.omega
+            )
+        };
+        let score = self.exercise.get_or_insert_with(Score::default);
+        score.asked += 1;
+        if right {
+            score.right += 1;
+        }
+        let score = *score;
+        let verdict = if right {
+            format!("right ({working})")
+        } else if answer.is_empty() {
+            format!("no answer: {working}")
+        } else {
+            format!("not {answer}: {working}")
+        };
+        self.step();
+        self.notice = Some(format!("{verdict} · score {}/{}", score.right, score.asked));
+    }
+
+    /// `x`: cuts the picked policy's selected edge (`e` selects it).
+    pub fn cut_selected_edge(&mut self) {
+        self.running = false;
+        match self.selected_edge() {
+            Some((i, j)) => self.edit_graph(GraphEdit::Cut { i, j }),
+            None => self.notice = Some(format!("{} has no edge to cut", self.names()[self.cursor])),
+        }
+    }
+
+    /// Edits the graph as `sapnet teach --add-edge`/`--cut-edge` do (the same checks, the
+    /// same refusals), then builds the net the lesson file would: a refusal changes
+    /// nothing and is said. The walk on screen restarts from the activations it started
+    /// from, as a knob's turn restarts it.
+    pub fn edit_graph(&mut self, edit: GraphEdit) {
+        self.running = false;
+        self.notice = None;
+        let mut lesson = self.lesson_file();
+        let built = lesson.apply(edit).and_then(|()| lesson.lesson());
+        let net = match built {
+            Ok(lesson) => lesson.net,
+            Err(why) => {
+                self.notice = Some(format!("{}: {why}", edit.flag()));
+                return;
+            }
+        };
+        let (policy, before) = match &self.walk {
+            Some(w) => (Some(w.policy), w.before.clone()),
+            None => (None, self.net.activations().to_vec()),
+        };
+        let (old_calls, new_calls) = (
+            walk_end(&self.net, policy, &before).2,
+            walk_end(&net, policy, &before).2,
+        );
+        self.net = net;
+        self.edge = 0;
+        self.notice = Some(match policy {
+            Some(p) => format!(
+                "{} done: {}'s walk {old_calls} → {new_calls} calls, restarted",
+                edit.flag(),
+                self.names()[p]
+            ),
+            None => format!("{} done", edit.flag()),
+        });
+        match policy {
+            Some(policy) => {
+                self.walk = Some(self.start(policy, before));
+                self.sync();
+            }
+            None => self.set_activations(before),
+        }
+    }
+
+    /// The lesson as it stands, in the format `sapnet teach --config` reads: the graph
+    /// (its edges), T_ω, 𝒜, τ and the paths as edited, the policies' names as the lesson
+    /// gave them, and as `initial` the activations the walk on screen started from (so
+    /// `--activate` of its policy replays it), or those on screen without a walk.
+    pub fn lesson_file(&self) -> TeachConfig {
+        let params = self.net.params();
+        let activations = match &self.walk {
+            Some(w) => w.before.clone(),
+            None => self.net.activations().to_vec(),
+        };
+        let names = self
+            .descriptions
+            .clone()
+            .unwrap_or_else(|| self.names.clone());
+        let default_names = names
+            .iter()
+            .enumerate()
+            .all(|(i, name)| *name == format!("π{i}"));
+        TeachConfig {
+            policies: self.net.len(),
+            names: if default_names { Vec::new() } else { names },
+            edges: self.net.graph().edges().collect(),
+            threshold: params.threshold,
+            coefficient: params.coefficient,
+            temperature: params.temperature,
+            paths: params.paths,
+            initial: activations.iter().any(|&a| a != 0.0).then_some(activations),
+            ..TeachConfig::default()
+        }
+    }
+
     /// A walk activating `policy` from the activations `before` (eq. 8, the first calls
     /// queued).
     fn start(&self, policy: usize, before: Vec<f64>) -> Walk {
@@ -648,5 +937,49 @@ mod tests {
         teach.step();
         assert!(!teach.is_running());
         assert_eq!(teach.net().activations(), whole.activations());
+    }
+
+    /// Fig. 2 from π1 by hand: the first call reaches π0 at h = 1, Ω = 0.4 with
+    /// η = 𝒜/k = 1/3, so ΔA = (1/3)/(1×0.4) = 0.833333; the second goes back to π1 at
+    /// h = 2, Ω = 0.8 with η = (1/3)/2 = 1/6, ΔA = (1/6)/(2×0.8) = 0.104167; the third
+    /// returns to π0 at Ω = 1.2 ≥ T_ω = 1 and stops.
+    #[test]
+    fn an_exercise_checks_each_typed_delta_and_keeps_the_score() {
+        let mut teach = fig2();
+        teach.move_cursor(1);
+        teach.activate();
+        teach.toggle_exercise();
+        let answer = |teach: &mut Teach, text: &str| {
+            teach.step_or_ask();
+            assert_eq!(teach.prompt().map(|p| p.kind), Some(PromptKind::Predict));
+            text.chars().for_each(|c| teach.prompt_type(c));
+            teach.prompt_submit();
+            teach.notice().unwrap().to_string()
+        };
+        let said = answer(&mut teach, "0.8333");
+        assert!(said.starts_with("right"), "{said}");
+        assert!(said.ends_with("score 1/1"), "{said}");
+        assert_eq!(teach.walk().unwrap().trace.len(), 1, "the call is made");
+
+        let said = answer(&mut teach, "0.2");
+        assert!(said.starts_with("not 0.2: "), "{said}");
+        assert!(
+            said.contains("ΔA[π1] = η/(h×Ω) = 0.166667/(2×0.8000) = 0.104167"),
+            "{said}"
+        );
+        assert!(said.ends_with("score 1/2"), "{said}");
+
+        let said = answer(&mut teach, "stop");
+        assert!(said.starts_with("right"), "{said}");
+        assert!(said.contains("1.2000 < 1, false: the call stops"), "{said}");
+        assert_eq!(teach.score(), Some(Score { right: 2, asked: 3 }));
+
+        // A number where the call stops is wrong.
+        let said = answer(&mut teach, "0");
+        assert!(said.starts_with("not 0: "), "{said}");
+        teach.toggle_exercise();
+        assert_eq!(teach.score(), None);
+        teach.step_or_ask();
+        assert!(teach.prompt().is_none(), "out of exercise mode s steps");
     }
 }

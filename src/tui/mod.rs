@@ -265,6 +265,11 @@ pub fn run_teach(mut teach: Teach) -> Result<()> {
         if key.kind != KeyEventKind::Press {
             continue;
         }
+        // A line being typed (`w`, `E`) takes q and Esc too.
+        if teach.prompt().is_some() && !is_ctrl_c(key) {
+            apply_teach_key(&mut teach, key);
+            continue;
+        }
         if is_quit(key) {
             return Ok(());
         }
@@ -281,9 +286,11 @@ pub fn run_teach(mut teach: Teach) -> Result<()> {
 }
 
 fn is_quit(key: term::KeyEvent) -> bool {
-    key.code == term::KeyCode::Char('q')
-        || (key.code == term::KeyCode::Char('c')
-            && key.modifiers.contains(term::KeyModifiers::CONTROL))
+    key.code == term::KeyCode::Char('q') || is_ctrl_c(key)
+}
+
+fn is_ctrl_c(key: term::KeyEvent) -> bool {
+    key.code == term::KeyCode::Char('c') && key.modifiers.contains(term::KeyModifiers::CONTROL)
 }
 
 #[cfg(test)]

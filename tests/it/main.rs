@@ -38,6 +38,8 @@ mod signals_cli;
 mod sources_cli;
 mod sweep_cli;
 mod teach_cli;
+mod teach_lesson;
+mod teach_screen;
 mod tensorboard_cli;
 mod tensorboard_files;
 mod trainer_failure;

@@ -565,7 +565,8 @@ fn the_policy_table_scrolls_to_the_picked_row_at_the_smallest_size() {
 }
 
 /// Teach mode on the live graph at 80×24: the activations table has room for four of ten
-/// rows; it shows the picked and activated source-9, and the trace's names fit.
+/// rows; it shows the picked and activated source-9 and source-0, which its first call
+/// deposited on (issue 39: the rows nearest by index hid it), and the trace's names fit.
 #[test]
 fn live_teach_keeps_the_picked_policy_in_view_at_the_smallest_size() {
     let mut d = dashboard();
@@ -577,8 +578,9 @@ fn live_teach_keeps_the_picked_policy_in_view_at_the_smallest_size() {
     let terminal = draw_dashboard(&d, (80, 24));
     let lines = screen_lines(&terminal);
     let text = lines.join("\n");
-    assert!(text.contains("source-9 "), "{text}");
-    assert!(text.contains("▲ 6 more"), "{text}");
+    assert!(text.contains("│source-9 "), "{text}");
+    assert!(text.contains("│source-0 "), "{text}");
+    assert!(text.contains("6 of 10 not shown"), "{text}");
     // The trace row of the call made: from source-9 to its first neighbour, by label.
     let trace: String = lines
         .iter()
@@ -590,15 +592,15 @@ fn live_teach_keeps_the_picked_policy_in_view_at_the_smallest_size() {
     assert!(!trace.contains("sour"), "{trace}");
     assert!(trace.contains("│1    9    "), "{trace}");
     insta::assert_snapshot!("live_teach_source_9_80x24", terminal.backend());
-    // A click on the row that reads source-7 picks it.
-    let (column, row) = cell_of(&terminal, "source-7 ", 37).expect("source-7's row");
+    // A click on the row that reads source-0 picks it.
+    let (column, row) = cell_of(&terminal, "source-0 ", 37).expect("source-0's row");
     sapnet::tui::click(
         &mut d,
         ratatui::layout::Rect::new(0, 0, 80, 24),
         column,
         row,
     );
-    assert_eq!(d.teach.as_ref().unwrap().cursor(), 7);
+    assert_eq!(d.teach.as_ref().unwrap().cursor(), 0);
 }
 
 /// Table II's lesson names its policies by their layers: `1×100`, `2×100`, `3×100` and

@@ -3,6 +3,7 @@
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
 use crate::teach::knobs::Knob;
+use crate::teach::session::PromptKind;
 use crate::teach::Teach;
 use crate::trainer::Command;
 
@@ -43,7 +44,8 @@ impl Dashboard {
     pub fn on_key(&mut self, key: KeyEvent) -> Action {
         let ctrl_c =
             key.code == KeyCode::Char('c') && key.modifiers.contains(KeyModifiers::CONTROL);
-        if ctrl_c || key.code == KeyCode::Char('q') {
+        let typing = self.teach.as_ref().is_some_and(|t| t.prompt().is_some());
+        if ctrl_c || (key.code == KeyCode::Char('q') && !typing) {
             return Action::Quit;
         }
         self.notice = None;
@@ -204,7 +206,21 @@ impl Dashboard {
 /// Applies a teach-mode key (arrows, `a`, `s`, `r`, `u`, `c`, `p`, and the edits `1`…`5`,
 /// `+`, `−`, `e`); `false` if it is not one.
 pub fn apply_teach_key(teach: &mut Teach, key: KeyEvent) -> bool {
+    // A line being typed takes every key until Enter or Esc.
+    if teach.prompt().is_some() {
+        match key.code {
+            KeyCode::Enter => teach.prompt_submit(),
+            KeyCode::Esc => teach.prompt_cancel(),
+            KeyCode::Backspace => teach.prompt_backspace(),
+            KeyCode::Char(c) => teach.prompt_type(c),
+            _ => {}
+        }
+        return true;
+    }
     match key.code {
+        KeyCode::Char('w') => teach.open_prompt(PromptKind::Save),
+        KeyCode::Char('E') => teach.open_prompt(PromptKind::AddEdge),
+        KeyCode::Char('x') => teach.cut_selected_edge(),
         KeyCode::Char(c) if Knob::from_key(c).is_some() => {
             teach.choose_knob(Knob::from_key(c).expect("checked"));
         }
@@ -218,9 +234,8 @@ pub fn apply_teach_key(teach: &mut Teach, key: KeyEvent) -> bool {
             teach.move_cursor(1)
         }
         KeyCode::Char('a') => teach.activate(),
-        KeyCode::Char('s') => {
-            teach.step();
-        }
+        KeyCode::Char('s') => teach.step_or_ask(),
+        KeyCode::Char('X') => teach.toggle_exercise(),
         KeyCode::Char('r') => teach.run(),
         KeyCode::Char('u') => teach.undo(),
         KeyCode::Char('c') => teach.reset(),

@@ -1,21 +1,126 @@
 //! The call panel: the `spread` call about to be made, with eq. 10's test and the
 //! arithmetic of eq. 9–10, beside the one just made.
+//!
+//! Products are written `×` and nothing else is: `·` would read as one too (`A += 1 · k`
+//! read "A += 1·k").
 
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Paragraph, Wrap};
 
+use crate::sapnet::{Call, TraceStep};
 use crate::teach::Teach;
 use crate::tui::theme::Theme;
 
-/// The call about to be made, with eq. 10's test, beside the one just made.
-pub(super) fn paragraph(teach: &Teach, theme: Theme) -> Paragraph<'static> {
+/// The call about to be made, with eq. 10's test, beside the one just made (where the
+/// panel of `width` columns is wide enough: on a narrow one the trace's last row says it).
+pub(super) fn paragraph(teach: &Teach, theme: Theme, width: u16) -> Paragraph<'static> {
     let walk = teach.walk();
+    let state = walk.as_ref().map(|w| WalkState {
+        policy: w.policy,
+        made: w.trace.last().copied(),
+        next: w.pending.last().copied(),
+        calls_made: w.trace.len(),
+        calls_pending: w.pending.len(),
+    });
+    framed(lines(teach, state, theme, says_made(width)), theme)
+}
+
+/// Whether a call panel of `width` columns, its border included, says the call just made.
+fn says_made(width: u16) -> bool {
+    width >= 50
+}
+
+/// Rows the panel needs at `width` (its border included) for the tallest text any call of
+/// this lesson can give: the call made and the next one each depositing or stopped,
+/// between the longest-named policies, with three-digit counts (a longer walk may take a
+/// row more). The panel keeps this height whatever the call on screen, so that the graph
+/// above it does not change height (and its nodes do not jump) from step to step.
+pub(super) fn tallest_rows(teach: &Teach, width: u16) -> u16 {
     let names = teach.names();
-    let next = walk.as_ref().and_then(|w| w.pending.last().copied());
+    let mut by_length: Vec<usize> = (0..names.len()).collect();
+    by_length.sort_by_key(|&i| std::cmp::Reverse(names[i].chars().count()));
+    let (longest, next_longest) = match by_length[..] {
+        [a, b, ..] => (a, b),
+        [a] => (a, a),
+        [] => return 2,
+    };
+    let call = Call {
+        from: next_longest,
+        to: longest,
+        h: 9,
+        omega: 0.987_654,
+        eta: 0.123_456,
+    };
+    let made = TraceStep {
+        from: call.from,
+        to: call.to,
+        h: call.h,
+        omega: call.omega,
+        eta: call.eta,
+        delta: 0.123_456,
+        stopped: false,
+    };
+    let threshold = teach.net().params().threshold;
+    // Below any threshold the net accepts, so the test passes and every line is written;
+    // or at it, so the test fails and says so at length.
+    let passing = Call {
+        omega: threshold / 2.0,
+        ..call
+    };
+    let stopping = Call {
+        omega: threshold,
+        ..call
+    };
+    let stopped = TraceStep {
+        stopped: true,
+        delta: 0.0,
+        ..made
+    };
+    let rows = |p: &Paragraph| p.line_count(width.saturating_sub(2));
+    let mut tallest = rows(&paragraph(teach, Theme::plain(), width));
+    for made in [made, stopped] {
+        for next in [passing, stopping] {
+            let state = WalkState {
+                policy: longest,
+                made: Some(made),
+                next: Some(next),
+                calls_made: 999,
+                calls_pending: 999,
+            };
+            let text = lines(teach, Some(state), Theme::plain(), says_made(width));
+            tallest = tallest.max(rows(&framed(text, Theme::plain())));
+        }
+    }
+    u16::try_from(tallest).unwrap_or(u16::MAX)
+}
+
+/// What the panel writes of a walk.
+#[derive(Debug, Clone, Copy)]
+struct WalkState {
+    policy: usize,
+    made: Option<TraceStep>,
+    next: Option<Call>,
+    calls_made: usize,
+    calls_pending: usize,
+}
+
+fn framed(lines: Vec<Line<'static>>, theme: Theme) -> Paragraph<'static> {
+    Paragraph::new(lines)
+        .wrap(Wrap { trim: false })
+        .block(Block::bordered().title(Span::styled(" the call ", theme.title())))
+}
+
+fn lines(
+    teach: &Teach,
+    walk: Option<WalkState>,
+    theme: Theme,
+    says_made: bool,
+) -> Vec<Line<'static>> {
+    let names = teach.names();
     let params = teach.net().params();
     let threshold = params.threshold;
     let mut lines = Vec::new();
-    if let Some(made) = walk.as_ref().and_then(|w| w.trace.last()) {
+    if let Some(made) = walk.and_then(|w| w.made).filter(|_| says_made) {
         let outcome = if made.stopped {
             "stopped (Ω ≥ T_ω)".to_string()
         } else {
@@ -29,11 +134,17 @@ pub(super) fn paragraph(teach: &Teach, theme: Theme) -> Paragraph<'static> {
             theme.dim(),
         ));
     }
-    match (&walk, next) {
-        (None, _) => lines.push(Line::from(
+    match walk {
+        None => lines.push(Line::from(
             "Pick a policy with ↑↓ and press a to activate it: A[i] += 𝒜 (eq. 8).",
         )),
-        (Some(w), Some(call)) => {
+        Some(WalkState {
+            next: Some(call),
+            policy,
+            calls_made,
+            calls_pending,
+            ..
+        }) => {
             lines.push(Line::from(format!(
                 "next (Alg. 2): spread({}, h {}, Ω {:.4}, η {:.6}) from {}",
                 names[call.to], call.h, call.omega, call.eta, names[call.from]
@@ -52,7 +163,7 @@ pub(super) fn paragraph(teach: &Teach, theme: Theme) -> Paragraph<'static> {
             ]));
             if passes {
                 lines.push(Line::from(format!(
-                    "eq. 10: ΔA[{}] = η/(h·Ω) = {:.6}/({}·{:.4}) = {:.6}",
+                    "eq. 10: ΔA[{}] = η/(h×Ω) = {:.6}/({}×{:.4}) = {:.6}",
                     names[call.to],
                     call.eta,
                     call.h,
@@ -68,23 +179,19 @@ pub(super) fn paragraph(teach: &Teach, theme: Theme) -> Paragraph<'static> {
             }
             lines.push(Line::styled(
                 format!(
-                    "eq. 8: A[{}] += {} · k = {} · calls {} made, {} pending",
-                    names[w.policy],
+                    "eq. 8: A[{}] += 𝒜 = {}; k = {}; calls {calls_made} made, \
+                     {calls_pending} pending",
+                    names[policy],
                     params.coefficient,
-                    teach.net().graph().degree(w.policy),
-                    w.trace.len(),
-                    w.pending.len()
+                    teach.net().graph().degree(policy),
                 ),
                 theme.dim(),
             ));
         }
-        (Some(w), None) => lines.push(Line::from(format!(
+        Some(w) => lines.push(Line::from(format!(
             "spreading from {} is done: {} calls. a activates again, u undoes, c resets.",
-            names[w.policy],
-            w.trace.len()
+            names[w.policy], w.calls_made
         ))),
     }
-    Paragraph::new(lines)
-        .wrap(Wrap { trim: false })
-        .block(Block::bordered().title(Span::styled(" the call ", theme.title())))
+    lines
 }

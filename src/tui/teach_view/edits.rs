@@ -11,16 +11,46 @@ use crate::teach::Teach;
 use crate::tui::theme::Theme;
 
 /// The knobs (`1`…`5`, the chosen one marked), and the last edit's effect or the notice.
-pub(super) fn paragraph(teach: &Teach, theme: Theme) -> Paragraph<'static> {
+/// `compact` (a short screen): with an effect or a notice to say, the chosen knob moves to
+/// the title and the line of all five gives way to it, so that the trace below keeps its
+/// rows.
+pub(super) fn paragraph(teach: &Teach, theme: Theme, compact: bool) -> Paragraph<'static> {
     let names = teach.names();
     let edge = teach.selected_edge();
-    let mut knobs = Vec::new();
-    for knob in Knob::ALL {
+    let knob_text = |knob: Knob| {
         let symbol = match (knob, edge) {
             (Knob::EdgeWeight, Some((i, j))) => format!("M({},{})", names[i], names[j]),
             _ => knob.symbol().to_string(),
         };
-        let text = format!("{} {symbol} {}", knob.key(), knob.value(teach.net(), edge));
+        format!("{} {symbol} {}", knob.key(), knob.value(teach.net(), edge))
+    };
+    let said = if let Some(prompt) = teach.prompt() {
+        Some(Line::styled(
+            format!(
+                "{} {}█  (Enter, Esc cancels)",
+                prompt.kind.question(),
+                prompt.text
+            ),
+            theme.active(),
+        ))
+    } else if let Some(notice) = teach.notice() {
+        Some(Line::styled(notice.to_string(), theme.stopped()))
+    } else {
+        teach
+            .last_edit()
+            .map(|report| Line::from(edit_summary(report, names)))
+    };
+    if let (true, Some(said)) = (compact, said.clone()) {
+        return Paragraph::new(vec![said]).wrap(Wrap { trim: false }).block(
+            Block::bordered().title(Span::styled(
+                format!(" edit · {} ", knob_text(teach.knob())),
+                theme.title(),
+            )),
+        );
+    }
+    let mut knobs = Vec::new();
+    for knob in Knob::ALL {
+        let text = knob_text(knob);
         if !knobs.is_empty() {
             knobs.push(Span::raw(" · "));
         }
@@ -31,11 +61,7 @@ pub(super) fn paragraph(teach: &Teach, theme: Theme) -> Paragraph<'static> {
         });
     }
     let mut lines = vec![Line::from(knobs)];
-    if let Some(notice) = teach.notice() {
-        lines.push(Line::styled(notice.to_string(), theme.stopped()));
-    } else if let Some(report) = teach.last_edit() {
-        lines.push(Line::from(edit_summary(report, names)));
-    }
+    lines.extend(said);
     Paragraph::new(lines)
         .wrap(Wrap { trim: false })
         .block(Block::bordered().title(Span::styled(

@@ -34,11 +34,12 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         "SAP-Net · T_ω {} · 𝒜 {} · τ {}",
         params.threshold, params.coefficient, params.temperature
     );
-    graph_view::draw(
+    graph_view::draw_with_weights(
         frame,
         area,
         Block::bordered().title(Span::styled(format!(" {title} "), theme.title())),
         scene,
         theme,
+        true,
     );
 }

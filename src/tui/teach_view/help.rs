@@ -29,7 +29,17 @@ pub(crate) fn teach_help(
             "+ / −",
             "turn it a step: the walk restarts, the change is shown",
         ),
-        ("e", "the picked policy's next edge (for 5)"),
+        ("e", "the picked policy's next edge (for 5 and x)"),
+        ("E", "add an edge I J W, or reweight it (as --add-edge)"),
+        ("x", "cut the picked policy's selected edge"),
+        (
+            "w",
+            "write the lesson as it stands to a file (--config reads it)",
+        ),
+        (
+            "X",
+            "exercise: s asks the next call's ΔA first and scores it",
+        ),
         ("?", "this help (any key closes it)"),
     ]);
     if on_the_dashboard {

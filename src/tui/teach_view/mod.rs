@@ -17,9 +17,9 @@ use ratatui::widgets::Paragraph;
 use ratatui::Frame;
 
 use crate::teach::Teach;
-use crate::tui::graph_layout;
 use crate::tui::screen::{draw_help, too_small, MIN_HEIGHT, MIN_WIDTH};
 use crate::tui::theme::Theme;
+use crate::tui::{graph_layout, graph_view};
 pub(crate) use help::teach_help;
 use values::values_rows;
 
@@ -39,9 +39,9 @@ pub fn draw(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {
 
 /// Teach mode's panels, in the dashboard or on their own.
 pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
-    let call = call::paragraph(teach, theme);
-    let edits = edits::paragraph(teach, theme);
-    let panels = layout(area, teach.net().len(), &call, &edits);
+    let edits = edits::paragraph(teach, theme, compact(area));
+    let panels = layout(area, teach, &edits);
+    let call = call::paragraph(teach, theme, panels.call.width);
     graph_panel::draw(frame, panels.graph, teach, theme);
     frame.render_widget(call, panels.call);
     frame.render_widget(edits, panels.edits);
@@ -63,34 +63,37 @@ struct Panels {
 /// Teach mode's panels in `area`, for hit-testing a click (drawing lays them out from the
 /// paragraphs it draws, [`layout`]).
 fn panels(area: Rect, teach: &Teach) -> Panels {
-    let call = call::paragraph(teach, Theme::plain());
-    let edits = edits::paragraph(teach, Theme::plain());
-    layout(area, teach.net().len(), &call, &edits)
+    let edits = edits::paragraph(teach, Theme::plain(), compact(area));
+    layout(area, teach, &edits)
 }
 
-/// Teach mode's panels in `area` for a net of `n` policies: the call's and the edit's
-/// panels as tall as their wrapped text (at 80 columns both wrap to more lines than fixed
-/// heights held), the graph and the trace taking what is left.
-fn layout(area: Rect, n: usize, call: &Paragraph, edits: &Paragraph) -> Panels {
+/// Teach mode's panels in `area`: the call's panel as tall as the tallest text a call of
+/// this lesson can give at its width (so the graph above keeps its height from step to
+/// step), the edit panel as tall as its wrapped text, the trace at least
+/// [`TRACE_MIN_ROWS`] and the graph taking what is left.
+fn layout(area: Rect, teach: &Teach, edits: &Paragraph) -> Panels {
+    let n = teach.net().len();
     let [left, right] =
         Layout::horizontal([Constraint::Percentage(45), Constraint::Percentage(55)]).areas(area);
     let rows = |paragraph: &Paragraph, width: u16| {
         u16::try_from(paragraph.line_count(width.saturating_sub(2))).unwrap_or(u16::MAX)
     };
-    let call_rows = rows(call, left.width).clamp(9, left.height.saturating_sub(GRAPH_MIN_ROWS));
+    let call_rows =
+        call::tallest_rows(teach, left.width).min(left.height.saturating_sub(GRAPH_MIN_ROWS));
     let [graph, call] = Layout::vertical([
         Constraint::Min(GRAPH_MIN_ROWS),
         Constraint::Length(call_rows),
     ])
     .areas(left);
-    let short = area.height < 30;
+    let short = compact(area);
     let values_rows = (n as u16 + 3).min(right.height / 3);
-    let stack_rows = if short { 5 } else { 7 };
+    let stack_rows = if short { 4 } else { 7 };
     let edit_rows = rows(edits, right.width).clamp(
-        6,
+        EDIT_MIN_ROWS,
         right
             .height
-            .saturating_sub(values_rows + stack_rows + TRACE_MIN_ROWS),
+            .saturating_sub(values_rows + stack_rows + TRACE_MIN_ROWS)
+            .max(EDIT_MIN_ROWS),
     );
     let [values, stack, edits, trace] = Layout::vertical([
         Constraint::Length(values_rows),
@@ -109,9 +112,19 @@ fn layout(area: Rect, n: usize, call: &Paragraph, edits: &Paragraph) -> Panels {
     }
 }
 
-/// Rows the graph keeps however long the call's text, and the trace however long the edit's.
+/// A screen too short for every panel's every line: the stack and the edit panel say less.
+fn compact(area: Rect) -> bool {
+    area.height < 30
+}
+
+/// Rows the graph keeps however long the call's text.
 const GRAPH_MIN_ROWS: u16 = 8;
-const TRACE_MIN_ROWS: u16 = 3;
+/// The trace's rows at the least: four calls under its header, inside its border (at
+/// 80×24 it once showed two).
+const TRACE_MIN_ROWS: u16 = 7;
+/// The edit panel's rows at the least: the knobs' line, wrapped, and a line of what the
+/// last edit did.
+const EDIT_MIN_ROWS: u16 = 5;
 
 /// The policy under the cell `(column, row)` of teach mode's panels drawn in `area`: a node
 /// of the graph, or a row of the activations table.
@@ -120,6 +133,11 @@ pub fn policy_at(area: Rect, teach: &Teach, column: u16, row: u16) -> Option<usi
     let panels = panels(area, teach);
     let at = Position::new(column, row);
     if panels.graph.contains(at) {
+        let label =
+            graph_view::node_label_at(panels.graph, teach.names(), teach.groups(), column, row);
+        if label.is_some() {
+            return label;
+        }
         let positions = graph_layout::positions(n, teach.groups());
         return graph_layout::canvas_point(panels.graph, column, row)
             .and_then(|point| graph_layout::node_at(&positions, point, graph_layout::CLICK_REACH));

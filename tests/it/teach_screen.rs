@@ -1,0 +1,333 @@
+//! Teach mode's screen fixes (issue 39, item 6), each at 80×24 and 120×40: ratatui's
+//! TestBackend, insta snapshots in tests/it/snapshots/, colours off (`NO_COLOR`'s theme).
+
+use ratatui::backend::TestBackend;
+use ratatui::Terminal;
+use sapnet::teach::lesson::TeachConfig;
+use sapnet::teach::Teach;
+use sapnet::tui::teach_view;
+use sapnet::tui::theme::Theme;
+
+const SIZES: [(u16, u16); 2] = [(80, 24), (120, 40)];
+
+fn fig2() -> Teach {
+    let lesson = TeachConfig::load(None).unwrap();
+    Teach::new(lesson.names, lesson.net)
+}
+
+fn table2() -> Teach {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/teach_table2.ron");
+    let lesson = TeachConfig::load(Some(&path)).unwrap();
+    let groups = lesson.groups.clone().unwrap();
+    Teach::new(lesson.names, lesson.net).with_groups(groups)
+}
+
+fn draw(teach: &Teach, (w, h): (u16, u16)) -> Terminal<TestBackend> {
+    let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
+    terminal
+        .draw(|f| teach_view::draw(f, teach, false, Theme::plain()))
+        .unwrap();
+    terminal
+}
+
+/// The screen's rows as text.
+fn lines(terminal: &Terminal<TestBackend>) -> Vec<String> {
+    let buffer = terminal.backend().buffer();
+    (0..buffer.area.height)
+        .map(|y| {
+            (0..buffer.area.width)
+                .map(|x| buffer[(x, y)].symbol())
+                .collect()
+        })
+        .collect()
+}
+
+/// The text of the left-hand panels (the graph and the call), `width` columns of 45%.
+fn left(line: &str, width: u16) -> String {
+    line.chars().take(usize::from(width) * 45 / 100).collect()
+}
+
+fn right(line: &str, width: u16) -> String {
+    line.chars().skip(usize::from(width) * 45 / 100).collect()
+}
+
+/// The row of the screen where the call panel's top border is.
+fn call_panel_row(lines: &[String]) -> usize {
+    lines
+        .iter()
+        .position(|l| l.contains("┌ the call "))
+        .expect("the call panel")
+}
+
+/// Fig. 2's walk from π1 at its first call: `1/3 ÷ (1 × 0.4)`, written with `×` for the
+/// product and never `·` (which read "A += 1·k = 3" in eq. 8's line).
+#[test]
+fn products_are_written_with_a_times_sign_and_nothing_else_is() {
+    let mut teach = fig2();
+    teach.move_cursor(1);
+    teach.activate();
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = lines(&terminal);
+        // The call panel, above the status line.
+        let call: String = screen[call_panel_row(&screen)..screen.len() - 1]
+            .iter()
+            .map(|l| left(l, size.0))
+            .collect::<Vec<_>>()
+            .join("\n");
+        // The text wraps at 80 columns: compare it without the wrapping.
+        let flat: String = call
+            .lines()
+            .map(|l| l.trim_matches(|c| c == '│' || c == ' ' || c == '└' || c == '─'))
+            .collect::<Vec<_>>()
+            .join(" ");
+        assert!(flat.contains("η/(h×Ω)"), "{call}");
+        assert!(flat.contains("0.333333/(1×0.4000) = 0.833333"), "{call}");
+        assert!(flat.contains("A[π1] += 𝒜 = 1; k = 3;"), "{call}");
+        assert!(!call.contains('·'), "{call}");
+        insta::assert_snapshot!(
+            format!("teach_times_sign_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+}
+
+/// Every step of Fig. 2's walk from π1 and of Table II's from π3: the call panel starts on
+/// the same row and each node's label stays on its cell, from the first call to the
+/// walk's end (the graph once grew and shrank with the call's text).
+#[test]
+fn the_graph_keeps_its_height_and_its_nodes_from_step_to_step() {
+    for (mut teach, activated, nodes) in [(fig2(), 1, 4), (table2(), 3, 10)] {
+        teach.move_cursor(activated as isize);
+        for size in SIZES {
+            let before = lines(&draw(&teach, size));
+            let rows = call_panel_row(&before);
+            let node_cells = |screen: &[String]| -> Vec<(usize, usize)> {
+                (0..nodes)
+                    .map(|i| {
+                        let label = format!("π{i}");
+                        screen
+                            .iter()
+                            .enumerate()
+                            .find_map(|(row, l)| {
+                                let graph = left(l, size.0);
+                                let at = graph.find(&label)?;
+                                // π1 is not π10's start: the label ends there.
+                                let rest = &graph[at + label.len()..];
+                                (!rest.starts_with(|c: char| c.is_ascii_digit()))
+                                    .then(|| (row, graph[..at].chars().count()))
+                            })
+                            .unwrap_or_else(|| panic!("{label}: {}", screen.join("\n")))
+                    })
+                    .collect()
+            };
+            let first = node_cells(&before);
+            let mut teach = teach.clone();
+            teach.activate();
+            let mut steps = 0;
+            loop {
+                let screen = lines(&draw(&teach, size));
+                assert_eq!(call_panel_row(&screen), rows, "step {steps} at {size:?}");
+                assert_eq!(node_cells(&screen), first, "step {steps} at {size:?}");
+                if teach.step().is_none() {
+                    break;
+                }
+                steps += 1;
+            }
+            assert!(steps > 5, "{steps}");
+        }
+    }
+}
+
+/// At 80×24 the trace once showed two calls: it shows four, the latest last.
+#[test]
+fn the_trace_shows_four_calls_at_the_smallest_size() {
+    let mut teach = fig2();
+    teach.move_cursor(1);
+    teach.activate();
+    for _ in 0..6 {
+        teach.step();
+    }
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = lines(&terminal);
+        let header = screen
+            .iter()
+            .position(|l| right(l, size.0).contains("#    from to"))
+            .expect("the trace's header");
+        let calls: Vec<&str> = screen[header + 1..]
+            .iter()
+            .map(|l| l.as_str())
+            .take_while(|l| !right(l, size.0).contains('└'))
+            .filter(|l| {
+                right(l, size.0)
+                    .trim_start_matches('│')
+                    .starts_with(|c: char| c.is_ascii_digit())
+            })
+            .collect();
+        assert!(calls.len() >= 4, "{size:?}: {}", screen.join("\n"));
+        assert!(
+            right(calls[calls.len() - 1], size.0).starts_with("│6 "),
+            "the latest call last: {calls:?}"
+        );
+        insta::assert_snapshot!(
+            format!("teach_trace_rows_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+}
+
+/// Table II's π3 activated at 80×24, where the activations table has four rows for ten
+/// policies: the policies the walk deposits on (π4, π5, π6, its category) are in view
+/// beside π3, not π0…π2 (the rows nearest π3 by index).
+#[test]
+fn the_policies_receiving_delta_a_stay_in_the_table() {
+    let mut teach = table2();
+    teach.move_cursor(3);
+    teach.activate();
+    let deposited = |teach: &Teach| -> Vec<usize> {
+        (0..10)
+            .filter(|&i| teach.walk().unwrap().deposited[i] > 0.0 && i != 3)
+            .collect()
+    };
+    while deposited(&teach).len() < 3 {
+        teach.step().expect("the walk reaches π3's whole category");
+    }
+    assert_eq!(
+        deposited(&teach),
+        [4, 5, 6],
+        "the hand count: π3's category is π3…π6"
+    );
+    assert!(!teach.walk().unwrap().done);
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let table: Vec<String> = lines(&terminal)
+            .iter()
+            .map(|l| right(l, size.0))
+            .take_while(|l| !l.contains("pending spread calls"))
+            .collect();
+        let text = table.join("\n");
+        for i in [3, 4, 5, 6] {
+            assert!(
+                text.contains(&format!("│π{i} ")),
+                "π{i} at {size:?}:\n{text}"
+            );
+        }
+        if size == (80, 24) {
+            assert!(!text.contains("│π0 "), "{text}");
+            assert!(text.contains("6 of 10 not shown"), "{text}");
+        }
+        insta::assert_snapshot!(
+            format!("teach_receivers_in_view_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+}
+
+/// Fig. 2's two diagonals cross in the middle of the graph, where two `0.40`s once sat:
+/// all four weights are written, none on the crossing.
+#[test]
+fn edge_weights_are_written_off_the_crossing() {
+    let teach = fig2();
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = lines(&terminal);
+        let graph_rows = call_panel_row(&screen);
+        let graph: Vec<String> = screen[..graph_rows]
+            .iter()
+            .map(|l| left(l, size.0))
+            .collect();
+        let weights: usize = graph.iter().map(|l| l.matches("0.40").count()).sum();
+        assert_eq!(weights, 4, "{}", graph.join("\n"));
+        // The crossing: on the row of π3 and π1 (the horizontal diagonal), under π0's
+        // label (centred on the vertical one).
+        let crossing_column = graph
+            .iter()
+            .find_map(|l| l.find("π0").map(|at| l[..at].chars().count()))
+            .expect("π0");
+        let crossing_row = graph
+            .iter()
+            .find(|l| l.contains("π3") && l.contains("π1"))
+            .expect("the horizontal diagonal");
+        let cells: Vec<char> = crossing_row.chars().collect();
+        let around: String = cells[crossing_column - 1..=crossing_column + 1]
+            .iter()
+            .collect();
+        assert!(
+            !around.contains(|c: char| c.is_ascii_digit() || c == '.'),
+            "a weight on the crossing: {around:?}\n{}",
+            graph.join("\n")
+        );
+        insta::assert_snapshot!(
+            format!("teach_weights_off_crossing_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+}
+
+/// Table II's graph: its weights (0.95, eq. 5 with δ = −0.5, ω = 0.1) are written, and
+/// its ten nodes, three categories drawn together, each read whole at 80×24.
+#[test]
+fn table2_shows_its_weights_and_no_node_overlaps_another() {
+    let mut teach = table2();
+    teach.move_cursor(8);
+    teach.activate();
+    teach.step();
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = lines(&terminal);
+        let graph: Vec<String> = screen[..call_panel_row(&screen)]
+            .iter()
+            .map(|l| left(l, size.0))
+            .collect();
+        let text = graph.join("\n");
+        assert!(text.contains("0.95"), "{text}");
+        for i in 0..10 {
+            let label = format!("π{i}");
+            let whole = graph.iter().any(|l| {
+                l.match_indices(&label).any(|(at, _)| {
+                    let before = l[..at].chars().last();
+                    let after = l[at + label.len()..].chars().next();
+                    before.is_some_and(|c| "○●◐◔◕×".contains(c))
+                        && !after.is_some_and(|c| c.is_ascii_digit())
+                })
+            });
+            assert!(whole, "{label} at {size:?}:\n{text}");
+        }
+        insta::assert_snapshot!(
+            format!("teach_table2_graph_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+}
+
+/// A click on a node's label picks it, where the label sits off its node to keep clear
+/// of a neighbour's.
+#[test]
+fn a_click_on_a_node_label_picks_its_policy() {
+    let teach = table2();
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = lines(&terminal);
+        for i in 0..10 {
+            let label = format!("π{i}");
+            let (row, column) = screen
+                .iter()
+                .enumerate()
+                .find_map(|(row, l)| {
+                    let graph = left(l, size.0);
+                    let at = graph.find(&label)?;
+                    let rest = &graph[at + label.len()..];
+                    (!rest.starts_with(|c: char| c.is_ascii_digit()))
+                        .then(|| (row, graph[..at].chars().count()))
+                })
+                .unwrap();
+            let screen_area = ratatui::layout::Rect::new(0, 0, size.0, size.1);
+            assert_eq!(
+                teach_view::clicked(&teach, screen_area, column as u16, row as u16),
+                Some(i),
+                "{label} at {size:?}"
+            );
+        }
+    }
+}
