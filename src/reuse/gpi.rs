@@ -120,15 +120,13 @@ pub(super) fn check_learner(
 #[derive(Debug)]
 pub struct Gpi {
     /// Steps whose action took its Q-value from each source, and from the learner.
-    wins: Vec<u64>,
-    learner_wins: u64,
+    wins: FollowedCounts,
 }
 
 impl Gpi {
     pub fn new(n: usize) -> Self {
         Self {
-            wins: vec![0; n],
-            learner_wins: 0,
+            wins: FollowedCounts::new(n),
         }
     }
 }
@@ -187,16 +185,13 @@ impl Selector for Gpi {
     }
 
     fn on_combined(&mut self, _: &StateValues<'_>, choice: Combined) {
-        match choice.followed {
-            Some(i) => self.wins[i] += 1,
-            None => self.learner_wins += 1,
-        }
+        self.wins.count(choice.followed);
     }
 
     /// Scores: the steps each source's Q-value won the maximum; probabilities: their share
     /// of all steps (the learner and exploring steps hold the rest).
     fn view(&self) -> SelectorView {
-        followed_view("wins", &self.wins, self.learner_wins)
+        self.wins.view("wins")
     }
 
     fn chosen(&self) -> Option<usize> {
@@ -204,26 +199,46 @@ impl Selector for Gpi {
     }
 }
 
-/// A view of per-source counts of followed steps, for the methods that combine: the count
-/// as the score, its share of all steps as the probability.
-pub(super) fn followed_view(
-    score_name: &'static str,
-    counts: &[u64],
+/// Steps that followed each source and the learner, for the methods that combine.
+#[derive(Debug)]
+pub(super) struct FollowedCounts {
+    sources: Vec<u64>,
     learner: u64,
-) -> SelectorView {
-    let n = counts.len();
-    let total = (counts.iter().sum::<u64>() + learner) as f64;
-    let probabilities = counts
-        .iter()
-        .map(|&c| if total > 0.0 { c as f64 / total } else { 0.0 })
-        .collect();
-    SelectorView {
-        score_name,
-        scores: counts.iter().map(|&c| c as f64).collect(),
-        probabilities,
-        positive: vec![0; n],
-        negative: vec![0; n],
-        excluded: Vec::new(),
+}
+
+impl FollowedCounts {
+    pub fn new(n: usize) -> Self {
+        Self {
+            sources: vec![0; n],
+            learner: 0,
+        }
+    }
+
+    /// One step that followed `followed` (`None`: the learner).
+    pub fn count(&mut self, followed: Option<usize>) {
+        match followed {
+            Some(i) => self.sources[i] += 1,
+            None => self.learner += 1,
+        }
+    }
+
+    /// The counts as the scores, their share of all steps as the probabilities.
+    pub fn view(&self, score_name: &'static str) -> SelectorView {
+        let n = self.sources.len();
+        let total = (self.sources.iter().sum::<u64>() + self.learner) as f64;
+        let probabilities = self
+            .sources
+            .iter()
+            .map(|&c| if total > 0.0 { c as f64 / total } else { 0.0 })
+            .collect();
+        SelectorView {
+            score_name,
+            scores: self.sources.iter().map(|&c| c as f64).collect(),
+            probabilities,
+            positive: vec![0; n],
+            negative: vec![0; n],
+            excluded: Vec::new(),
+        }
     }
 }
 

@@ -30,7 +30,7 @@ use rand::rngs::StdRng;
 use serde::{Deserialize, Serialize};
 
 use super::definition::{MethodKind, ReuseMethod, Tested};
-use super::gpi::{check_learner, followed_view, learner_label};
+use super::gpi::{check_learner, learner_label, FollowedCounts};
 use super::{
     argmax_f32, Actor, Combined, Learning, Library, ReuseError, Selector, SelectorView, StateValues,
 };
@@ -117,16 +117,14 @@ impl ReuseMethod for QSwitchKnobs {
 #[derive(Debug)]
 pub struct QSwitch {
     proposal: Proposal,
-    followed: Vec<u64>,
-    learner_followed: u64,
+    followed: FollowedCounts,
 }
 
 impl QSwitch {
     pub fn new(n: usize, proposal: Proposal) -> Self {
         Self {
             proposal,
-            followed: vec![0; n],
-            learner_followed: 0,
+            followed: FollowedCounts::new(n),
         }
     }
 }
@@ -174,16 +172,13 @@ impl Selector for QSwitch {
     }
 
     fn on_combined(&mut self, _: &StateValues<'_>, choice: Combined) {
-        match choice.followed {
-            Some(i) => self.followed[i] += 1,
-            None => self.learner_followed += 1,
-        }
+        self.followed.count(choice.followed);
     }
 
     /// Scores: the steps each source's action was followed; probabilities: their share of
     /// all steps (the learner's own actions hold the rest).
     fn view(&self) -> SelectorView {
-        followed_view("followed", &self.followed, self.learner_followed)
+        self.followed.view("followed")
     }
 
     fn chosen(&self) -> Option<usize> {

@@ -4,6 +4,7 @@
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::symbols::Marker;
 
+use crate::report::plots::palette::hsl_bytes as hsl;
 use crate::reuse::MethodKind;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -120,24 +121,6 @@ impl Theme {
         let blue = (230.0 - 180.0 * level) as u8;
         Style::new().fg(Color::Rgb(red, 90, blue))
     }
-}
-
-/// HSL (hue in degrees, saturation and lightness in [0, 1]) as 8-bit RGB.
-fn hsl(hue: f64, saturation: f64, lightness: f64) -> (u8, u8, u8) {
-    let chroma = (1.0 - (2.0 * lightness - 1.0).abs()) * saturation;
-    let sector = (hue.rem_euclid(360.0)) / 60.0;
-    let x = chroma * (1.0 - (sector % 2.0 - 1.0).abs());
-    let (r, g, b) = match sector as u32 {
-        0 => (chroma, x, 0.0),
-        1 => (x, chroma, 0.0),
-        2 => (0.0, chroma, x),
-        3 => (0.0, x, chroma),
-        4 => (x, 0.0, chroma),
-        _ => (chroma, 0.0, x),
-    };
-    let m = lightness - chroma / 2.0;
-    let byte = |v: f64| ((v + m) * 255.0).round().clamp(0.0, 255.0) as u8;
-    (byte(r), byte(g), byte(b))
 }
 
 /// A node's symbol by its share of the highest activation, for reading without colour.

@@ -16,7 +16,7 @@ mod efficiency;
 mod improvement;
 mod intervals;
 mod legend;
-mod palette;
+pub mod palette;
 mod profiles;
 mod selections;
 mod sweep;

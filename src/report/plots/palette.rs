@@ -156,6 +156,13 @@ pub(super) fn emphasised(kinds: &[MethodKind], labels: &[String], scores: &[f64]
 
 /// HSL to RGB (hue in degrees, saturation and lightness in [0, 1]).
 fn hsl(hue: f64, saturation: f64, lightness: f64) -> RGBColor {
+    let (r, g, b) = hsl_bytes(hue, saturation, lightness);
+    RGBColor(r, g, b)
+}
+
+/// HSL (hue in degrees, saturation and lightness in [0, 1]) as 8-bit RGB: the plots' and
+/// the terminal's method colours alike.
+pub fn hsl_bytes(hue: f64, saturation: f64, lightness: f64) -> (u8, u8, u8) {
     let chroma = (1.0 - (2.0 * lightness - 1.0).abs()) * saturation;
     let h = hue.rem_euclid(360.0) / 60.0;
     let x = chroma * (1.0 - (h % 2.0 - 1.0).abs());
@@ -169,7 +176,7 @@ fn hsl(hue: f64, saturation: f64, lightness: f64) -> RGBColor {
     };
     let m = lightness - chroma / 2.0;
     let byte = |v: f64| ((v + m) * 255.0).round().clamp(0.0, 255.0) as u8;
-    RGBColor(byte(r), byte(g), byte(b))
+    (byte(r), byte(g), byte(b))
 }
 
 /// Matplotlib's `tab10`, then ten more far from them and from each other (five of
