@@ -47,8 +47,13 @@ pub fn draw(frame: &mut Frame, session: &Session, theme: Theme) {
     }
 }
 
-/// The area the followed run's dashboard takes in the Run view: all but the top line.
+/// The area the followed run's dashboard takes in the Run view: all but the top line; on
+/// the smallest terminal the dashboard needs, all of it (the line then takes the panels'
+/// top border).
 pub fn dashboard_area(area: Rect) -> Rect {
+    if area.height <= screen::MIN_HEIGHT {
+        return area;
+    }
     Rect::new(
         area.x,
         area.y + 1,
@@ -87,8 +92,14 @@ fn phase_words(session: &Session) -> String {
 /// it is given).
 fn draw_run(frame: &mut Frame, area: Rect, session: &Session, theme: Theme) {
     let [top, _] = Layout::vertical([Constraint::Length(1), Constraint::Fill(1)]).areas::<2>(area);
-    frame.render_widget(Paragraph::new(run_line(session, theme)), top);
     let below = dashboard_area(area);
+    draw_dashboard_in(frame, below, session, theme);
+    frame.render_widget(Clear, top);
+    frame.render_widget(Paragraph::new(run_line(session, theme)), top);
+}
+
+/// The followed run's dashboard in `below`, or why there is none.
+fn draw_dashboard_in(frame: &mut Frame, below: Rect, session: &Session, theme: Theme) {
     let Some(run) = session.followed_run() else {
         let text = match &session.followed {
             Some((method, run)) => format!(
@@ -240,7 +251,7 @@ fn draw_stop_question(frame: &mut Frame, area: Rect, then_quit: bool, theme: The
 
 fn draw_picker(frame: &mut Frame, area: Rect, picker: &Picker, theme: Theme) {
     let error_lines = picker.error.as_ref().map_or(0, |_| 4);
-    let wanted = picker.entries.len() as u16 + 5 + error_lines;
+    let wanted = picker.entries.len() as u16 + 7 + error_lines;
     let rect = centered(
         frame,
         area,
@@ -248,7 +259,7 @@ fn draw_picker(frame: &mut Frame, area: Rect, picker: &Picker, theme: Theme) {
         wanted.min(area.height.saturating_sub(2)),
     );
     let inner_width = usize::from(rect.width.saturating_sub(2));
-    let rows = usize::from(rect.height.saturating_sub(4 + error_lines));
+    let rows = usize::from(rect.height.saturating_sub(7 + error_lines));
     // The rows shown: a window that keeps the cursor in sight.
     let total = picker.entries.len() + 1;
     let first = picker.cursor.saturating_sub(rows.saturating_sub(1));
@@ -279,10 +290,18 @@ fn draw_picker(frame: &mut Frame, area: Rect, picker: &Picker, theme: Theme) {
     if let Some(error) = &picker.error {
         lines.push(Line::from(Span::styled(error.clone(), theme.stopped())));
     }
+    lines.push(Line::from(vec![
+        Span::styled("⏎", theme.title()),
+        Span::raw(" launch into a new folder · "),
+        Span::styled("↑↓", theme.title()),
+        Span::raw(" pick · "),
+        Span::styled("Esc", theme.title()),
+        Span::raw(" close"),
+    ]));
     lines.push(Line::from(Span::styled(
         format!(
-            "{} · {} lessons and grids left out · with this session's flags (--quick, \
-             --episodes, --runs, --jobs, --library) · ⏎ launch · Esc close",
+            "{}/ ({} lessons and grids left out), run with this session's --quick, \
+             --episodes, --runs, --jobs, --library",
             picker.dir.display(),
             picker.left_out
         ),
