@@ -11,6 +11,8 @@ use crate::trainer::{
 };
 
 /// What a watched protocol tells its front end.
+// An event is moved as it is: boxing it would cost an allocation per step.
+#[allow(clippy::large_enum_variant)]
 pub enum Watched {
     /// A run started on its thread: its commands steer it.
     Started {
