@@ -1,9 +1,8 @@
 //! Dispatches a parsed command line to the part of the crate that does the work.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::mpsc;
-use std::time::{SystemTime, UNIX_EPOCH};
 
 use anyhow::{Context, Result};
 
@@ -150,6 +149,19 @@ fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
         Some(path) => training_config(path)?,
         None => Config::from_ron(embedded, label)?,
     };
+    apply_flags(cli, &mut config);
+    // A Gymnasium id that does not exist (or a Python without Gymnasium) is said first,
+    // before a library or a folder is looked for under its name.
+    for (field, task) in config.tasks() {
+        env::spaces(task)
+            .with_context(|| format!("{label}: {field}", label = origin(cli, label)))?;
+    }
+    Ok(config)
+}
+
+/// The command line's `--quick`, then `--seed`, `--episodes` and `--runs`, applied to
+/// `config` (its warnings said first).
+fn apply_flags(cli: &Cli, config: &mut Config) {
     for warning in config.warnings() {
         eprintln!("warning: {warning}");
     }
@@ -166,13 +178,6 @@ fn load_config(cli: &Cli, embedded: &str, label: &str) -> Result<Config> {
         config.protocol.runs = runs;
     }
     config.run_with(&cli.run.python_settings());
-    // A Gymnasium id that does not exist (or a Python without Gymnasium) is said first,
-    // before a library or a folder is looked for under its name.
-    for (field, task) in config.tasks() {
-        env::spaces(task)
-            .with_context(|| format!("{label}: {field}", label = origin(cli, label)))?;
-    }
-    Ok(config)
 }
 
 /// The training config at `path`; a lesson given instead is said to be one, with what
@@ -297,20 +302,7 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     }
     let config = load_config(cli, assets::CARTPOLE, "embedded assets/cartpole.ron")?;
     if !cli.run.headless {
-        if cli.run.out.is_some()
-            || cli.run.force
-            || cli.run.jobs.is_some()
-            || cli.run.trace
-            || cli.run.tensorboard
-            || cli.run.add_to_library
-        {
-            anyhow::bail!(
-                "--out, --force, --jobs, --trace, --tensorboard and --add-to-library are for \
-                 --headless runs: \
-                 the dashboard writes no files (its teach mode, `t`, steps the spreading by hand)"
-            );
-        }
-        return run_dashboard(cli, &config);
+        return run_in_ui(cli, config);
     }
     if cli.run.compare.is_some() {
         anyhow::bail!(
@@ -326,7 +318,7 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     }
     let dir = match &cli.run.out {
         Some(dir) => dir.clone(),
-        None => default_out_dir(cli.run.config.as_deref()),
+        None => headless::default_out_dir(cli.run.config.as_deref()),
     };
     let output = OutputOptions {
         dir,
@@ -396,42 +388,58 @@ fn run_options(cli: &Cli) -> RunOptions {
     }
 }
 
-/// The dashboard follows one run (`--follow-run`, else run 0) of one reusing method
-/// (`--follow`, else the first SAP-Net method, else the first that reuses; `m` moves to the
-/// next), step by step, beside the same run of the first DQN baseline, episode by episode;
-/// the library is loaded (or trained, with a progress bar) before the screen switches.
-fn run_dashboard(cli: &Cli, config: &Config) -> Result<()> {
+/// The config's whole protocol in the UI: headless's runs, seeds and files into the same
+/// `--out` folder (taken here, so that a folder refused is said on the command line), with
+/// one run followed live (`--follow`, `--follow-run`, else SAP-Net's run 0). Prints what
+/// `--headless` prints once the screen has closed on a protocol that ended.
+fn run_in_ui(cli: &Cli, config: Config) -> Result<()> {
     let ids = crate::trainer::MethodId::all(&config.protocol.methods);
-    let followed = tui::follow::followed_method(&ids, cli.run.follow.as_deref())?;
+    let followed = tui::follow::followed_run(
+        &ids,
+        cli.run.follow.as_deref(),
+        cli.run.follow_run,
+        config.protocol.runs,
+    )?;
     // Read before training starts, so that a wrong folder is said at once.
     let reference = match &cli.run.compare {
         Some(dir) => tui::reference::bands_of_folder(dir, &config.env.gym_id())?,
         None => Vec::new(),
     };
-    // The followed run and the DQN baseline train side by side.
-    let plan = experiment::plan(config, &cli.run.library_root(), 2, &on_interrupt()?)
-        .map_err(|error| in_config_file(error, cli))?;
-    let (followable, baseline) =
-        tui::follow::dashboard_specs(&plan.specs, cli.run.follow_run.unwrap_or(0))?;
-    let first = followable
-        .iter()
-        .position(|s| Some(&s.method) == followed.as_ref())
-        .unwrap_or(0);
-    let task = config.env.gym_id();
-    tui::run_dashboard(
-        &task,
-        tui::DashboardRuns {
-            followable,
-            followed: first,
-            baseline,
-            reference,
+    let output = OutputOptions {
+        dir: match &cli.run.out {
+            Some(dir) => dir.clone(),
+            None => headless::default_out_dir(cli.run.config.as_deref()),
         },
-    )?;
-    eprintln!(
-        "the dashboard keeps no files: `sapnet --headless --out DIR` writes the whole \
-         protocol's results"
-    );
-    Ok(())
+        force: cli.run.force,
+    };
+    let opened = headless::OpenedOutput::open(&output)?;
+    // SIGTERM and SIGHUP stop the protocol as `q` does, the terminal restored.
+    let _signals = on_interrupt()?;
+    let load = |path: &Path| -> Result<Config> {
+        let mut config = training_config(path)?;
+        apply_flags(cli, &mut config);
+        for (field, task) in config.tasks() {
+            env::spaces(task).with_context(|| format!("{}: {field}", path.display()))?;
+        }
+        Ok(config)
+    };
+    let settings = tui::workbench::live::Settings {
+        options: run_options(cli),
+        python: cli.run.python_settings(),
+        load: &load,
+        reference,
+    };
+    let start = tui::workbench::live::Start {
+        config,
+        output,
+        opened,
+        followed,
+    };
+    match tui::workbench::live::run(start, &settings)? {
+        Some((Ok(summary), dir)) => headless::print_summary(&summary, &dir),
+        Some((Err(error), _)) => Err(error),
+        None => Ok(()),
+    }
 }
 
 fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
@@ -621,18 +629,6 @@ fn print_stdout(text: &str) -> Result<()> {
 /// stop.
 fn on_interrupt() -> Result<mpsc::Receiver<trainer::Command>> {
     crate::signals::stop_on_signals()
-}
-
-/// `out/<config stem>-<unix seconds>`: a new directory per run, so the default never
-/// collides with earlier results.
-fn default_out_dir(config: Option<&Path>) -> PathBuf {
-    let stem = config
-        .and_then(|p| p.file_stem())
-        .map_or("cartpole".into(), |s| s.to_string_lossy().into_owned());
-    let seconds = SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
-    PathBuf::from("out").join(format!("{stem}-{seconds}"))
 }
 
 #[cfg(test)]

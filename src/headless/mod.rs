@@ -34,9 +34,12 @@
 mod observer;
 mod output;
 mod summary;
+mod tap;
 mod tensorboard_runs;
 
+pub use output::default_out_dir;
 pub use summary::{print_comparison, print_summary};
+pub use tap::{Tap, Watched};
 use tensorboard_runs::TensorBoardRuns;
 pub use tensorboard_runs::TENSORBOARD_DIR;
 
@@ -49,6 +52,7 @@ use anyhow::{bail, Context, Result};
 use crate::config::Config;
 use crate::env::PythonSettings;
 use crate::experiment::{self, LibraryCopies};
+use crate::folder_lock::FolderLock;
 use crate::progress::{Progress, Unit};
 use crate::report::LibraryEntry;
 use crate::results::{self, assemble, records, Ending, Status, Summary};
@@ -56,6 +60,7 @@ use crate::trainer::Command;
 
 use observer::ResultFiles;
 use output::open_output;
+use tap::Tapped;
 
 /// Where results go and whether old ones may be replaced.
 #[derive(Debug, Clone)]
@@ -91,9 +96,49 @@ pub fn run(
     options: &RunOptions,
     commands: &Receiver<Command>,
 ) -> Result<Summary> {
-    let created = !output.dir.exists();
-    let (lock, replaced) = open_output(output)?;
-    let summary = protocol(config, &output.dir, options, None, commands);
+    let opened = OpenedOutput::open(output)?;
+    run_opened(config, output, opened, options, commands, None)
+}
+
+/// An output folder taken for a protocol: its lock held, the results `--force` replaces
+/// moved aside. Taken before a terminal UI opens, so that a folder that is refused is
+/// said on the command line.
+pub struct OpenedOutput {
+    lock: FolderLock,
+    replaced: Option<PathBuf>,
+    /// The folder did not exist before: a protocol refused before writing anything
+    /// leaves none behind.
+    created: bool,
+}
+
+impl OpenedOutput {
+    pub fn open(output: &OutputOptions) -> Result<Self> {
+        let created = !output.dir.exists();
+        let (lock, replaced) = open_output(output)?;
+        Ok(Self {
+            lock,
+            replaced,
+            created,
+        })
+    }
+}
+
+/// [`run`] into a folder already taken, with `tap` (if any) told every run's events and
+/// commands as they come: the protocol the workbench runs, the same one headless runs.
+pub fn run_opened(
+    config: &Config,
+    output: &OutputOptions,
+    opened: OpenedOutput,
+    options: &RunOptions,
+    commands: &Receiver<Command>,
+    tap: Option<&Tap>,
+) -> Result<Summary> {
+    let OpenedOutput {
+        lock,
+        replaced,
+        created,
+    } = opened;
+    let summary = protocol(config, &output.dir, options, None, commands, tap);
     if summary.is_err() && created {
         // Refused before anything was written (a library that cannot load, a config the
         // library cannot take): leave no empty folder behind. A folder holding anything is
@@ -133,6 +178,19 @@ pub fn resume(
     python: &PythonSettings,
     options: &RunOptions,
     commands: &Receiver<Command>,
+) -> Result<Summary> {
+    resume_tapped(dir, runs, added, python, options, commands, None)
+}
+
+/// [`resume`], with `tap` (if any) told every run's events and commands as they come.
+pub fn resume_tapped(
+    dir: &Path,
+    runs: Option<u32>,
+    added: Option<&AddedMethods>,
+    python: &PythonSettings,
+    options: &RunOptions,
+    commands: &Receiver<Command>,
+    tap: Option<&Tap>,
 ) -> Result<Summary> {
     if !dir.is_dir() {
         bail!(
@@ -198,6 +256,7 @@ pub fn resume(
         &options,
         Some(header.library.as_deref()),
         commands,
+        tap,
     )?;
     output::finish_replacement(dir)?;
     Ok(summary)
@@ -264,6 +323,7 @@ fn protocol(
     options: &RunOptions,
     resumed: Option<Option<&[LibraryEntry]>>,
     commands: &Receiver<Command>,
+    tap: Option<&Tap>,
 ) -> Result<Summary> {
     let mut plan = experiment::plan(config, &options.library, options.jobs, commands)?;
     let library: Option<Vec<LibraryEntry>> = plan.sources.as_ref().map(|sources| {
@@ -298,15 +358,21 @@ fn protocol(
                 .iter()
                 .any(|f| f.summary.record.method == spec.method && f.summary.record.run == spec.run)
         });
-        eprintln!(
-            "resuming {}: {} runs finished before, {} to run",
-            out.display(),
-            kept.len(),
-            plan.specs.len()
-        );
+        // A screen on the terminal says it itself.
+        if tap.is_none() {
+            eprintln!(
+                "resuming {}: {} runs finished before, {} to run",
+                out.display(),
+                kept.len(),
+                plan.specs.len()
+            );
+        }
     }
     for spec in &mut plan.specs {
         spec.stream.trace = options.trace && spec.method.kind.spreads;
+    }
+    if let Some(tap) = tap {
+        tap.stream(&mut plan.specs);
     }
 
     // On disk before the first run, so that even a killed protocol says what it was.
@@ -342,18 +408,24 @@ fn protocol(
     } else {
         None
     };
-    let mut files = ResultFiles::new(
-        out.to_path_buf(),
-        config.clone(),
-        names,
-        Progress::new(planned, unit),
-        summary,
-        copies,
-        tensorboard,
-    );
+    // Bars on stderr would be drawn over a screen on the terminal: a tapped protocol
+    // shows its progress there instead.
+    let progress = tap.is_none().then(|| Progress::new(planned, unit));
+    let mut files = Tapped {
+        files: ResultFiles::new(
+            out.to_path_buf(),
+            config.clone(),
+            names,
+            progress,
+            summary,
+            copies,
+            tensorboard,
+        ),
+        tap,
+    };
     let started = Instant::now();
     let outcome = crate::trainer::schedule(plan.specs, options.jobs, commands, &mut files);
-    files.finish_progress(matches!(outcome, Ok(false)));
+    files.files.finish_progress(matches!(outcome, Ok(false)));
     let ending = match outcome {
         Ok(false) => Ending {
             status: Status::Complete,

@@ -25,7 +25,8 @@ pub(super) struct ResultFiles {
     config: Config,
     /// The sources' names (none without a library).
     names: Vec<String>,
-    progress: Progress,
+    /// Progress on stderr; none under a screen that shows it (the workbench).
+    progress: Option<Progress>,
     /// The record of every run in progress.
     writers: BTreeMap<(MethodId, u32), RunWriter>,
     /// Runs finished so far, rewritten to `summary.json` as each ends.
@@ -42,7 +43,7 @@ impl ResultFiles {
         out: PathBuf,
         config: Config,
         names: Vec<String>,
-        progress: Progress,
+        progress: Option<Progress>,
         summary: Summary,
         copies: Option<LibraryCopies>,
         tensorboard: Option<TensorBoardRuns>,
@@ -61,7 +62,17 @@ impl ResultFiles {
 
     /// Ends the progress display; `complete` false leaves it where it stopped.
     pub(super) fn finish_progress(&mut self, complete: bool) {
-        self.progress.finish(complete);
+        if let Some(progress) = &mut self.progress {
+            progress.finish(complete);
+        }
+    }
+
+    /// A warning above the bars, or on stderr when there are none.
+    fn warn(&self, message: &str) {
+        match &self.progress {
+            Some(progress) => progress.warn(message),
+            None => eprintln!("warning: {message}"),
+        }
     }
 
     fn writer(&mut self, method: &MethodId, run: u32) -> Result<&mut RunWriter> {
@@ -88,7 +99,9 @@ impl Observer for ResultFiles {
                     .protocol
                     .max_steps
                     .unwrap_or(u64::from(planned_episodes));
-                self.progress.run_started(method.label(), run, planned);
+                if let Some(progress) = &mut self.progress {
+                    progress.run_started(method.label(), run, planned);
+                }
                 self.writer(&method, run)?;
                 if let Some(tensorboard) = &mut self.tensorboard {
                     tensorboard.run_started(&self.config, &method, run)?;
@@ -106,7 +119,9 @@ impl Observer for ResultFiles {
                 if let Some(tensorboard) = &mut self.tensorboard {
                     tensorboard.episode(&record)?;
                 }
-                self.progress.episode(&record);
+                if let Some(progress) = &mut self.progress {
+                    progress.episode(&record);
+                }
             }
             Event::Trace(record) => {
                 self.writer(&record.method, record.run)?.trace(&record)?;
@@ -119,8 +134,9 @@ impl Observer for ResultFiles {
 
     fn on_finished(&mut self, _order: usize, _spec: &RunSpec, outcome: RunOutcome) -> Result<()> {
         let record = outcome.record;
-        self.progress
-            .run_finished(record.method.label(), record.run);
+        if let Some(progress) = &mut self.progress {
+            progress.run_finished(record.method.label(), record.run);
+        }
         if let Some(tensorboard) = &mut self.tensorboard {
             tensorboard.run_finished(&record.method, record.run, record.stopped)?;
         }
@@ -137,7 +153,7 @@ impl Observer for ResultFiles {
             {
                 match copies.add(&name, &outcome.net, &info) {
                     Ok(path) => library_copy = Some(path),
-                    Err(err) => self.progress.warn(&format!(
+                    Err(err) => self.warn(&format!(
                         "the chosen policy of {} run {} could not be added to the library in \
                          {}: {err:#}; it is in {}",
                         record.method,

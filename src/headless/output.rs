@@ -4,6 +4,7 @@
 //! cleared first.
 
 use std::path::{Path, PathBuf};
+use std::time::{SystemTime, UNIX_EPOCH};
 
 use anyhow::{bail, Context, Result};
 
@@ -181,6 +182,18 @@ fn remove_results(dir: &Path) -> Result<()> {
         .with_context(|| format!("removing {}", path.display()))?;
     }
     Ok(())
+}
+
+/// `out/<config stem>-<unix seconds>`: a new directory per run, so the default never
+/// collides with earlier results.
+pub fn default_out_dir(config: Option<&Path>) -> PathBuf {
+    let stem = config
+        .and_then(|p| p.file_stem())
+        .map_or("cartpole".into(), |s| s.to_string_lossy().into_owned());
+    let seconds = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    PathBuf::from("out").join(format!("{stem}-{seconds}"))
 }
 
 #[cfg(test)]

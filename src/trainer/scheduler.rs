@@ -9,7 +9,9 @@ use std::time::Duration;
 use anyhow::{Context, Result};
 
 use crate::env::EnvError;
-use crate::trainer::{self, Command, Event, RunHandle, RunOutcome, RunSpec, TrainerError};
+use crate::trainer::{
+    self, Command, Commands, Event, RunHandle, RunOutcome, RunSpec, TrainerError,
+};
 
 /// How often the scheduler drains the runs' events and checks for a stop.
 const POLL_INTERVAL: Duration = Duration::from_millis(10);
@@ -23,6 +25,10 @@ pub trait Observer {
 
     /// A run failed; returns the error the schedule ends with.
     fn on_failed(&mut self, spec: &RunSpec, err: TrainerError) -> anyhow::Error;
+
+    /// A run started on its thread: a front end that steers one run (the workbench's
+    /// followed run: pause, step, speed) keeps its commands. Headless steers none.
+    fn on_started(&mut self, _spec: &RunSpec, _commands: &Commands) {}
 }
 
 /// A run in progress.
@@ -54,6 +60,7 @@ pub fn schedule(
             };
             let handle = trainer::spawn(spec.clone(), events_tx.clone())
                 .context("starting a trainer thread")?;
+            observer.on_started(&spec, &handle.commands);
             active.push(Active {
                 order,
                 spec,

@@ -1,13 +1,14 @@
-//! Which runs the dashboard trains: the followed method (`--follow`), run `--follow-run`
-//! of every method that reuses, and the same run of the first DQN baseline.
+//! Which run of a protocol the UI follows in its Run view: `--follow` (a method) and
+//! `--follow-run` (its run), else run 0 of the first method that spreads activation
+//! (SAP-Net), else of the first that reuses, else of the first method.
 
 use anyhow::Result;
 
-use crate::trainer::{MethodId, RunSpec, StreamOptions};
+use crate::trainer::MethodId;
 
-/// The method the dashboard follows first: `follow` (a method's label, refused if the
-/// config has none or it does not reuse the library), else the first that spreads activation
-/// (SAP-Net), else the first that reuses; `None` when no method reuses.
+/// The method followed first: `follow` (a method's label, refused if the config has none),
+/// else the first that spreads activation (SAP-Net), else the first that reuses, else the
+/// first; `None` for a protocol of no method.
 pub fn followed_method(ids: &[MethodId], follow: Option<&str>) -> Result<Option<MethodId>> {
     Ok(match follow {
         Some(label) => {
@@ -18,96 +19,81 @@ pub fn followed_method(ids: &[MethodId], follow: Option<&str>) -> Result<Option<
                     labels.join(", ")
                 );
             };
-            anyhow::ensure!(
-                id.kind.reuses,
-                "--follow {label}: the dashboard follows a method that reuses the library; \
-                 the DQN baseline runs beside it anyway"
-            );
             Some(id.clone())
         }
         None => ids
             .iter()
             .find(|m| m.kind.spreads)
             .or_else(|| ids.iter().find(|m| m.kind.reuses))
+            .or_else(|| ids.first())
             .cloned(),
     })
 }
 
-/// Run `run` (`--follow-run`, from 0 as in the results' files) of every reusing method,
-/// streaming every step, and of the first DQN baseline: what the dashboard can train.
-pub fn dashboard_specs(specs: &[RunSpec], run: u32) -> Result<(Vec<RunSpec>, Option<RunSpec>)> {
-    let runs = specs.iter().map(|s| s.run + 1).max().unwrap_or(0);
+/// The run followed first, as (method label, run): `follow_run` (from 0, as in the
+/// results' files; refused past the protocol's `runs`) of [`followed_method`].
+pub fn followed_run(
+    ids: &[MethodId],
+    follow: Option<&str>,
+    follow_run: Option<u32>,
+    runs: u32,
+) -> Result<Option<(String, u32)>> {
+    let run = follow_run.unwrap_or(0);
     anyhow::ensure!(
         run < runs,
         "--follow-run {run}: expected a run from 0 to {} (the config's {runs} runs per method, \
          numbered from 0 as in the results' files)",
         runs.saturating_sub(1)
     );
-    let followable = specs
-        .iter()
-        .filter(|s| s.run == run && s.method.kind.reuses)
-        .map(|s| {
-            let mut spec = s.clone();
-            spec.stream = StreamOptions::live();
-            spec
-        })
-        .collect();
-    let baseline = specs
-        .iter()
-        .find(|s| s.run == run && !s.method.kind.reuses)
-        .cloned();
-    Ok((followable, baseline))
+    Ok(followed_method(ids, follow)?.map(|m| (m.label().to_string(), run)))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dqn::DqnConfig;
-    use crate::env::EnvConfig;
+    use crate::reuse::Method;
 
-    /// Two runs of a reusing method and of a DQN baseline, as a plan lists them.
-    fn specs() -> Vec<RunSpec> {
-        let spec = |run, label: &str, kind| {
-            let mut s = RunSpec::scratch(
-                run,
-                label,
-                EnvConfig::CartPole(Default::default()),
-                DqnConfig::default(),
-                vec![4],
-                10,
-                1,
-                u64::from(run) + 7,
-            );
-            s.method.kind = kind;
-            s
-        };
-        (0..2)
-            .flat_map(|run| {
-                [
-                    spec(run, "sapnet", crate::reuse::sapnet::KIND),
-                    spec(run, "dqn[4]", crate::reuse::from_scratch::KIND),
-                ]
-            })
-            .collect()
+    fn ids() -> Vec<MethodId> {
+        MethodId::all(&[
+            Method::Dqn { hidden: vec![8] },
+            Method::Random,
+            Method::SapNet,
+        ])
     }
 
     #[test]
-    fn the_dashboard_trains_the_run_asked_for() {
-        let (followable, baseline) = dashboard_specs(&specs(), 1).unwrap();
-        assert_eq!(followable.len(), 1);
-        assert_eq!((followable[0].run, followable[0].seed), (1, 8));
-        assert_eq!(followable[0].stream, StreamOptions::live());
-        assert_eq!(baseline.map(|b| (b.run, b.seed)), Some((1, 8)));
-        let (first, _) = dashboard_specs(&specs(), 0).unwrap();
-        assert_eq!(first[0].run, 0);
+    fn sapnet_run_0_is_followed_unless_told_otherwise() {
+        assert_eq!(
+            followed_run(&ids(), None, None, 2).unwrap(),
+            Some(("sapnet".to_string(), 0))
+        );
+        assert_eq!(
+            followed_run(&ids(), Some("dqn[8]"), Some(1), 2).unwrap(),
+            Some(("dqn[8]".to_string(), 1))
+        );
+        // Without a reusing method, the first method is followed.
+        let baselines = MethodId::all(&[Method::Dqn { hidden: vec![8] }]);
+        assert_eq!(
+            followed_run(&baselines, None, None, 1).unwrap(),
+            Some(("dqn[8]".to_string(), 0))
+        );
     }
 
     #[test]
-    fn a_run_the_config_does_not_have_is_refused_with_the_range() {
+    fn a_run_or_method_the_config_does_not_have_is_refused() {
         for run in [2, 3] {
-            let err = dashboard_specs(&specs(), run).unwrap_err().to_string();
+            let err = followed_run(&ids(), None, Some(run), 2)
+                .unwrap_err()
+                .to_string();
             assert!(err.contains(&format!("--follow-run {run}")), "{err}");
             assert!(err.contains("from 0 to 1"), "{err}");
         }
+        let err = followed_run(&ids(), Some("ucb1"), None, 2)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("--follow ucb1: the config has no such method; its methods are dqn[8], random, sapnet"),
+            "{err}"
+        );
     }
 }

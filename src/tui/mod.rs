@@ -1,4 +1,5 @@
-//! The terminal UI: the live dashboard over the trainer's event stream, and teach mode.
+//! The terminal UI: a protocol run in the workbench (its views, and the live dashboard of
+//! the run it follows, over the trainer's event stream), and teach mode.
 //!
 //! The UI thread only reads keys, drains events and draws; training runs on the trainer's
 //! threads and never waits for the screen. Each frame drains the whole channel (never
@@ -15,7 +16,8 @@
 //!   with [`graph_view`] and share [`screen`] (the smallest terminal, the keys' overlay);
 //!   the dashboard's view draws teach mode on the live graph with `teach_view`, never the
 //!   reverse.
-//! - [`workbench`]: `sapnet open DIR`, a results folder (live or not) in views.
+//! - [`workbench`]: `sapnet` (a protocol trained and watched in views, one run followed
+//!   in the dashboard) and `sapnet open DIR` (a results folder, live or not, in views).
 //! - [`graph_layout`]: the graph's geometry, which the state (moving the cursor) and the
 //!   views share. The state modules import no view.
 
@@ -31,16 +33,14 @@ pub mod teach_view;
 pub mod theme;
 pub mod workbench;
 
-use std::sync::mpsc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::{Context, Result};
 use crossterm::event::{self as term, KeyEventKind, MouseButton, MouseEventKind};
 
 use crate::teach::session::CALLS_PER_FRAME;
 use crate::teach::Teach;
-use crate::trainer::{self, Command, RunHandle, RunSpec};
-use dashboard::{apply_teach_key, Action, Dashboard};
+use dashboard::{apply_teach_key, Dashboard};
 use theme::Theme;
 
 /// The time between frames: about 30 per second.
@@ -48,7 +48,7 @@ pub const FRAME: Duration = Duration::from_millis(33);
 
 /// Leaves the alternate screen and raw mode, and stops mouse reporting, however the UI
 /// ends; ratatui's panic hook restores the screen for panics, and the unwinding drops this.
-struct TerminalGuard;
+pub(crate) struct TerminalGuard;
 
 impl Drop for TerminalGuard {
     fn drop(&mut self) {
@@ -61,7 +61,7 @@ impl Drop for TerminalGuard {
 /// Raw mode, the alternate screen and mouse reporting (clicks pick a node or a row),
 /// with the guard that leaves them. If opening fails half-way, raw mode is undone here
 /// (nothing else was changed yet).
-fn open_terminal() -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
+pub(crate) fn open_terminal() -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
     match ratatui::try_init() {
         Ok(terminal) => {
             crate::signals::set_interactive(true);
@@ -79,149 +79,11 @@ fn open_terminal() -> Result<(ratatui::DefaultTerminal, TerminalGuard)> {
     }
 }
 
-/// A run the dashboard drives: its commands, and the thread to join at the end.
-struct LiveRun {
-    handle: RunHandle,
-    /// Whether pause, step and speed go to this run (the followed reusing run, or the only
-    /// one).
-    leads: bool,
-}
-
-/// What the dashboard trains: the run it follows step by step, chosen among one run per
-/// reusing method (`m` moves to the next), and a baseline beside it.
-pub struct DashboardRuns {
-    /// Run 1 of each method the dashboard can follow, streaming every step.
-    pub followable: Vec<RunSpec>,
-    /// The one followed first.
-    pub followed: usize,
-    /// Trained beside it, episode by episode (the first DQN baseline).
-    pub baseline: Option<RunSpec>,
-    /// A finished protocol's bands to draw under the live curves (`--compare`).
-    pub reference: Vec<reference::Band>,
-}
-
-/// Runs the dashboard until the user quits, then stops and joins the runs.
 /// A left click on a screen of `area` showing `dashboard`: the view that drew it tells
 /// what the click landed on, the dashboard acts on it.
 pub fn click(dashboard: &mut Dashboard, area: ratatui::layout::Rect, column: u16, row: u16) {
     if let Some(clicked) = dashboard_view::clicked(dashboard, area, column, row) {
         dashboard.on_click(clicked);
-    }
-}
-
-pub fn run_dashboard(task: &str, plan: DashboardRuns) -> Result<()> {
-    let theme = Theme::from_env();
-    let mut dashboard = Dashboard::new(task);
-    dashboard.reference = plan.reference.clone();
-    let (events_tx, events) = mpsc::channel();
-    let mut runs: Vec<LiveRun> = Vec::new();
-    let mut followed = plan.followed;
-    if let Some(spec) = plan.followable.get(followed) {
-        dashboard.follow(spec.method.label());
-        let handle =
-            trainer::spawn(spec.clone(), events_tx.clone()).context("starting a trainer thread")?;
-        runs.push(LiveRun {
-            handle,
-            leads: true,
-        });
-    }
-    if let Some(spec) = plan.baseline {
-        let handle =
-            trainer::spawn(spec, events_tx.clone()).context("starting a trainer thread")?;
-        let leads = runs.is_empty();
-        runs.push(LiveRun { handle, leads });
-    }
-    let (mut terminal, guard) = open_terminal()?;
-    let result = (|| -> Result<()> {
-        loop {
-            for event in events.try_iter() {
-                dashboard.on_event(event);
-            }
-            // SIGTERM or SIGHUP: leave as `q` does, the terminal restored.
-            if crate::signals::received().is_some() {
-                return Ok(());
-            }
-            dashboard.tick(Instant::now());
-            terminal
-                .draw(|frame| dashboard_view::draw_dashboard(frame, &dashboard, theme))
-                .context("drawing the dashboard")?;
-            if !term::poll(FRAME).context("reading the keyboard")? {
-                continue;
-            }
-            let key = match term::read().context("reading the keyboard")? {
-                term::Event::Key(key) => key,
-                term::Event::Mouse(mouse) => {
-                    if mouse.kind == MouseEventKind::Down(MouseButton::Left) {
-                        let size = terminal.size().context("reading the terminal's size")?;
-                        click(&mut dashboard, size.into(), mouse.column, mouse.row);
-                    }
-                    continue;
-                }
-                _ => continue, // a resize redraws on the next frame
-            };
-            if key.kind != KeyEventKind::Press {
-                continue;
-            }
-            match dashboard.on_key(key) {
-                Action::None => {}
-                Action::Quit => return Ok(()),
-                Action::Send(command) => {
-                    for run in runs.iter().filter(|r| r.leads) {
-                        let _ = run.handle.commands.send(command);
-                    }
-                }
-                Action::SendAll(command) => {
-                    for run in &runs {
-                        let _ = run.handle.commands.send(command);
-                    }
-                }
-                Action::FollowNext if plan.followable.len() > 1 => {
-                    // The run followed so far stops; it is joined with the others at the end.
-                    for run in runs.iter_mut().filter(|r| r.leads) {
-                        let _ = run.handle.commands.send(Command::Stop);
-                        run.leads = false;
-                    }
-                    followed = (followed + 1) % plan.followable.len();
-                    let spec = plan.followable[followed].clone();
-                    dashboard.follow(spec.method.label());
-                    let handle = trainer::spawn(spec, events_tx.clone())
-                        .context("starting a trainer thread")?;
-                    for command in dashboard.settings() {
-                        let _ = handle.commands.send(command);
-                    }
-                    runs.push(LiveRun {
-                        handle,
-                        leads: true,
-                    });
-                }
-                Action::FollowNext => {
-                    dashboard.notice = Some("m: only one method reuses the library here");
-                }
-            }
-        }
-    })();
-    drop(guard);
-    for run in &runs {
-        let _ = run.handle.commands.send(Command::Stop);
-    }
-    // Every failure is said; the first makes the exit status, as a headless run's would.
-    let mut failed = None;
-    for run in runs {
-        let failure = match run.handle.thread.join() {
-            Ok(Ok(_)) => continue,
-            Ok(Err(err)) => format!("a training run failed: {err}"),
-            Err(_) => "a training thread panicked".to_string(),
-        };
-        if failed.is_some() {
-            eprintln!("{failure}");
-        } else {
-            failed = Some(failure);
-        }
-    }
-    result?;
-    match failed {
-        Some(failure) => Err(anyhow::anyhow!(failure)),
-        None => Ok(()),
     }
 }
 

@@ -51,3 +51,4 @@ mod tui_state;
 mod tui_tmux;
 mod variants_cli;
 mod workbench;
+mod workbench_protocol;

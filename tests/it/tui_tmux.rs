@@ -17,10 +17,13 @@ fn a_user_pauses_steps_teaches_and_quits() {
         return;
     }
     let library = Path::new(env!("CARGO_MANIFEST_DIR")).join("saved_policies");
+    // The UI runs the whole protocol into its folder (issue 36).
+    let tmp = tempfile::tempdir().unwrap();
     let command = format!(
-        "{} --library {}; echo SAPNET-EXITED $?; sleep 60",
+        "{} --library {} --out {}; echo SAPNET-EXITED $?; sleep 60",
         env!("CARGO_BIN_EXE_sapnet"),
-        library.display()
+        library.display(),
+        tmp.path().join("out").display()
     );
     let session = Session::start(120, 40, &command);
 
@@ -48,6 +51,9 @@ fn a_user_pauses_steps_teaches_and_quits() {
     let screen = session.wait_for(&["T_ω 1 → 0.9", "restarted", "calls 0 made"]);
     assert!(screen.contains("SAP-Net · T_ω 0.9"), "{screen}");
     session.keys("q");
+    // The protocol is still training: `q` asks once.
+    session.wait_for(&["protocol running: stop it? the folder stays resumable"]);
+    session.keys("y");
     let screen = session.wait_for(&["SAPNET-EXITED 0"]);
     assert!(
         !screen.contains("SAP-Net graph"),
@@ -62,19 +68,23 @@ fn sigterm_leaves_the_dashboard_with_the_terminal_restored() {
         return;
     }
     let library = Path::new(env!("CARGO_MANIFEST_DIR")).join("saved_policies");
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
     // The seed marks this process apart from the other test's.
     let command = format!(
-        "{} --library {} --seed 4242; echo SAPNET-EXITED $?; stty -a | grep -o -- '-*icanon'; sleep 60",
+        "{} --library {} --seed 4242 --out {}; echo SAPNET-EXITED $?; stty -a | grep -o -- '-*icanon'; sleep 60",
         env!("CARGO_BIN_EXE_sapnet"),
-        library.display()
+        library.display(),
+        out.display()
     );
     let session = Session::start(120, 40, &command);
     session.wait_for(&["SAP-Net graph", "RUNNING"]);
     // Anchored, so that the pane's shell, whose command line holds the same words, lives.
     let pattern = format!(
-        "^{} --library {} --seed 4242$",
+        "^{} --library {} --seed 4242 --out {}$",
         env!("CARGO_BIN_EXE_sapnet"),
-        library.display()
+        library.display(),
+        out.display()
     );
     let killed = Command::new("pkill")
         .args(["-TERM", "-f", &pattern])
@@ -101,10 +111,12 @@ fn closing_the_terminal_ends_the_dashboard() {
         return;
     }
     let library = Path::new(env!("CARGO_MANIFEST_DIR")).join("saved_policies");
+    let tmp = tempfile::tempdir().unwrap();
     let command = format!(
-        "{} --library {} --seed 4343",
+        "{} --library {} --seed 4343 --out {}",
         env!("CARGO_BIN_EXE_sapnet"),
-        library.display()
+        library.display(),
+        tmp.path().join("out").display()
     );
     let pattern = format!("^{command}$");
     let session = Session::start(120, 40, &command);

@@ -12,11 +12,26 @@
 //! - [`state`]: what the workbench keeps and what its keys do; it draws nothing.
 //! - [`view`]: the screen around the views (the folder's line, the status bar, `?`);
 //!   [`runs_view`], [`comparison_view`]: a file per view; [`cells`]: what they share.
+//!
+//! `sapnet` without `--headless` runs a protocol in the same views, into the folder it
+//! writes (read by the same thread as a folder opened), with the dashboard of one run
+//! followed live:
+//! - [`session`]: what it keeps and what its keys ask (stop, launch, resume, follow);
+//!   [`picker`]: `L`'s configs;
+//! - [`session_view`]: drawing it (the Run view, the stop question, the picker);
+//! - [`live`]: its loop; [`protocol`]: the protocol's thread (headless's code, tapped);
+//!   [`stderr_capture`]: stderr held aside while the screen is up.
 
 pub mod cells;
 pub mod comparison_view;
+pub mod live;
+pub mod picker;
+pub mod protocol;
 pub mod runs_view;
+pub mod session;
+pub mod session_view;
 pub mod state;
+mod stderr_capture;
 pub mod view;
 
 use std::path::Path;

@@ -107,6 +107,10 @@ pub struct Workbench {
     /// The last refresh's failure, shown until a read succeeds again: the views keep the
     /// last good read.
     pub read_error: Option<String>,
+    /// The keys a protocol run in the UI adds (hook for [`super::session`]): for the
+    /// status bar, and for the overlay; the session handles them before the views do.
+    pub host_bar: Vec<(&'static str, &'static str)>,
+    pub host_overlay: Vec<(&'static str, &'static str)>,
 }
 
 impl Workbench {
@@ -122,6 +126,8 @@ impl Workbench {
             run_cursor: 0,
             method_cursor: 0,
             read_error: None,
+            host_bar: Vec::new(),
+            host_overlay: Vec::new(),
         }
     }
 
@@ -191,7 +197,7 @@ impl Workbench {
 
     /// Every key, for the overlay: the views' first, then what each view adds.
     pub fn keys(&self) -> Vec<(&'static str, &'static str)> {
-        vec![
+        let mut keys = vec![
             (
                 "r",
                 "Runs: every planned run, its status, episodes, MA10 and source",
@@ -213,19 +219,32 @@ impl Workbench {
                 "s",
                 "Comparison: the pairs of the other score (training return or test score)",
             ),
-            ("?", "every key"),
+        ];
+        keys.extend(self.host_overlay.iter().copied());
+        keys.push(("?", "every key"));
+        keys.push(if self.host_overlay.is_empty() {
             (
                 "q, Esc, Ctrl-C",
                 "quit (the folder is only read: nothing in it changes)",
-            ),
-        ]
+            )
+        } else {
+            (
+                "q, Esc, Ctrl-C",
+                "quit; while a protocol trains, asks first (stopped, its folder stays \
+                 resumable)",
+            )
+        });
+        keys
     }
 
     /// The keys the status bar lists for the view shown, after the views' own.
-    pub fn view_commands(&self) -> &'static [(&'static str, &'static str)] {
-        match self.view {
+    pub fn view_commands(&self) -> Vec<(&'static str, &'static str)> {
+        let own: &[(&str, &str)] = match self.view {
             View::Runs => &[("↑↓", "run")],
             View::Comparison => &[("↑↓", "method"), ("a", "aggregate"), ("s", "score")],
-        }
+        };
+        let mut keys = own.to_vec();
+        keys.extend(self.host_bar.iter().copied());
+        keys
     }
 }

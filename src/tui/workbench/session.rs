@@ -1,0 +1,595 @@
+//! A protocol run in the UI (`sapnet` without `--headless`): the workbench's views of the
+//! folder it writes, and the Run view of one run followed live (today's dashboard), with
+//! the keys that launch (`L`), stop (`S`, `q`) and resume (`R`) protocols. What it keeps
+//! and what its keys ask for; no thread, no drawing ([`super::session_view`] draws it,
+//! [`super::live`] runs the loop that owns the protocol's thread).
+//!
+//! Every run of the protocol gets a [`Dashboard`] of its own when it starts, fed its own
+//! events: following another run (Enter on it in the Runs view, `m` in the Run view)
+//! shows its dashboard, its curve since its start. Only the run followed from the start
+//! streams every step (the step line); the others send what headless runs send, an
+//! episode's end and the sources' state then (every step while paused or slowed).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+
+use super::picker::{Picked, Picker};
+use super::state::{View, Workbench};
+use crate::headless::Watched;
+use crate::report::Report;
+use crate::results::folder_state::{FolderState, RunStatus};
+use crate::results::Status;
+use crate::trainer::{Command, Commands, Event};
+use crate::tui::dashboard::{Action as DashboardAction, Dashboard, Mode};
+use crate::tui::reference::Band;
+
+/// The session's keys in the views' overlay (`?`).
+const HOST_KEYS: [(&str, &str); 5] = [
+    (
+        "Enter",
+        "Runs: follow the run under the cursor in the Run view (pause, step and speed act \
+         on it; the others train at full speed)",
+    ),
+    (
+        "f",
+        "the Run view: the followed run's dashboard (r and c come back here)",
+    ),
+    (
+        "L",
+        "launch a protocol: pick a config (assets/*.ron, or type a path) into a new folder",
+    ),
+    (
+        "S",
+        "stop the protocol training (asked once; the folder stays resumable)",
+    ),
+    ("R", "resume the stopped protocol of this folder"),
+];
+
+/// A run of the protocol: its method's label and its index.
+pub type RunKey = (String, u32);
+
+/// Which screen is up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Screen {
+    /// The followed run's dashboard.
+    Run,
+    /// The workbench's views of the folder (Runs, Comparison).
+    Views,
+}
+
+/// Where the session's protocol is.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Phase {
+    /// No protocol runs in this session (a folder opened, or one that ended before).
+    Idle,
+    /// Training (or loading its library first).
+    Running,
+    /// Asked to stop: the runs finish their step and the files are written.
+    Stopping,
+    /// It ended, as its `summary.json` says.
+    Ended(Status),
+    /// It could not go on: why.
+    Failed(String),
+}
+
+/// A question or a panel over the screen, which takes the keys while it is up.
+pub enum Overlay {
+    /// "protocol running: stop it?"; `then_quit`: the UI closes once it has stopped.
+    Stop { then_quit: bool },
+    /// The configs to launch.
+    Picker(Picker),
+}
+
+/// What the loop must do after a key.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Request {
+    None,
+    Quit,
+    /// Stop the protocol (the folder stays resumable); then quit if `then_quit`.
+    Stop {
+        then_quit: bool,
+    },
+    /// Start the protocol of this config into a new folder.
+    Launch(PathBuf),
+    /// Resume the stopped protocol of the folder shown.
+    Resume,
+}
+
+/// One run's dashboard and, while it trains, its commands.
+pub struct LiveRun {
+    pub dashboard: Dashboard,
+    pub commands: Option<Commands>,
+}
+
+/// The protocol run in the UI, and what the screen shows of it.
+pub struct Session {
+    /// The folder the protocol writes (or the one opened).
+    pub dir: PathBuf,
+    /// The task's name, for each run's dashboard.
+    pub task: String,
+    /// `--compare`'s bands, under every run's curves.
+    pub reference: Vec<Band>,
+    /// The workbench on the folder, once it has been read.
+    pub workbench: Option<Workbench>,
+    /// Why the folder cannot be read yet (before the protocol wrote its summary.json).
+    pub read_error: Option<String>,
+    pub screen: Screen,
+    pub phase: Phase,
+    /// The runs started in this session, each with its dashboard.
+    pub runs: BTreeMap<RunKey, LiveRun>,
+    /// The run the Run view shows, and pause, step and speed steer.
+    pub followed: Option<RunKey>,
+    /// The run that streams every step (the one followed from the start).
+    pub live: Option<RunKey>,
+    pub overlay: Option<Overlay>,
+    /// What the last key did or why it did nothing, shown until the next key.
+    pub notice: Option<String>,
+}
+
+impl Session {
+    /// A session on `dir`, following `followed` (which streams its steps) once it starts.
+    pub fn new(dir: &Path, task: &str, followed: Option<RunKey>, phase: Phase) -> Self {
+        Self {
+            dir: dir.to_path_buf(),
+            task: task.to_string(),
+            reference: Vec::new(),
+            workbench: None,
+            read_error: None,
+            screen: if followed.is_some() {
+                Screen::Run
+            } else {
+                Screen::Views
+            },
+            phase,
+            runs: BTreeMap::new(),
+            live: followed.clone(),
+            followed,
+            overlay: None,
+            notice: None,
+        }
+    }
+
+    /// The same screen on a new protocol's folder (`L`, `R`): its runs start afresh.
+    pub fn restart(&mut self, dir: &Path, task: &str, followed: Option<RunKey>) {
+        let reference = std::mem::take(&mut self.reference);
+        let screen = self.screen;
+        *self = Self::new(dir, task, followed, Phase::Running);
+        self.reference = reference;
+        self.screen = screen;
+    }
+
+    /// Whether a protocol of this session is training or stopping.
+    pub fn is_running(&self) -> bool {
+        matches!(self.phase, Phase::Running | Phase::Stopping)
+    }
+
+    /// A new read of the folder, as [`Workbench::refreshed`] takes it.
+    pub fn refreshed(&mut self, folder: FolderState, report: Option<Option<Report>>) {
+        self.read_error = None;
+        match &mut self.workbench {
+            Some(workbench) => workbench.refreshed(folder, report),
+            None => self.workbench = Some(Workbench::new(folder, report.flatten())),
+        }
+        self.sync_host_keys();
+    }
+
+    /// Gives the workbench the session's keys for its status bar and overlay, as the
+    /// phase allows them now.
+    pub fn sync_host_keys(&mut self) {
+        let bar = self.bar_keys();
+        if let Some(workbench) = &mut self.workbench {
+            workbench.host_bar = bar;
+            workbench.host_overlay = HOST_KEYS.to_vec();
+        }
+    }
+
+    /// A read that failed: before the first good one the screen says why; after it, the
+    /// workbench keeps the last good read and says it.
+    pub fn read_failed(&mut self, error: String) {
+        match &mut self.workbench {
+            Some(workbench) => workbench.read_error = Some(error),
+            None => self.read_error = Some(error),
+        }
+    }
+
+    /// The dashboard the Run view shows.
+    pub fn followed_run(&self) -> Option<&LiveRun> {
+        self.runs.get(self.followed.as_ref()?)
+    }
+
+    fn followed_run_mut(&mut self) -> Option<&mut LiveRun> {
+        self.runs.get_mut(self.followed.as_ref()?)
+    }
+
+    /// What the protocol's thread told.
+    pub fn on_watched(&mut self, watched: Watched) {
+        match watched {
+            Watched::Started {
+                method,
+                run,
+                commands,
+            } => {
+                let key = (method.label().to_string(), run);
+                self.run_entry(&key).commands = Some(commands);
+            }
+            Watched::Event(event) => {
+                let Some(key) = self.key_of(&event) else {
+                    return;
+                };
+                let ended = matches!(event, Event::RunEnded(_) | Event::RunFailed { .. });
+                let run = self.run_entry(&key);
+                run.dashboard.on_event(event);
+                if ended {
+                    run.commands = None;
+                }
+            }
+        }
+    }
+
+    /// The run an event is of; a step's is the run that streams them.
+    fn key_of(&self, event: &Event) -> Option<RunKey> {
+        let key = |method: &crate::trainer::MethodId, run: u32| (method.label().to_string(), run);
+        Some(match event {
+            Event::RunStarted { run, method, .. } | Event::RunFailed { run, method, .. } => {
+                key(method, *run)
+            }
+            Event::Step(_) => self.live.clone()?,
+            Event::Activations(snapshot) => key(&snapshot.method, snapshot.run),
+            Event::Trace(record) => key(&record.method, record.run),
+            Event::EpisodeEnded(record) => key(&record.method, record.run),
+            Event::RunEnded(record) => key(&record.method, record.run),
+        })
+    }
+
+    fn run_entry(&mut self, key: &RunKey) -> &mut LiveRun {
+        let (task, reference) = (&self.task, &self.reference);
+        self.runs.entry(key.clone()).or_insert_with(|| {
+            let mut dashboard = Dashboard::new(task.clone());
+            dashboard.reference = reference.clone();
+            dashboard.follow(&key.0);
+            LiveRun {
+                dashboard,
+                commands: None,
+            }
+        })
+    }
+
+    /// Once a frame: the followed run's speed, and teach mode's walk.
+    pub fn tick(&mut self, now: Instant) {
+        if let Some(run) = self.followed_run_mut() {
+            run.dashboard.tick(now);
+        }
+    }
+
+    /// What `key` does.
+    pub fn on_key(&mut self, key: KeyEvent) -> Request {
+        let ctrl_c =
+            key.code == KeyCode::Char('c') && key.modifiers.contains(KeyModifiers::CONTROL);
+        self.notice = None;
+        if let Some(overlay) = self.overlay.take() {
+            return self.on_overlay_key(overlay, key, ctrl_c);
+        }
+        if ctrl_c {
+            return self.quit();
+        }
+        match self.screen {
+            Screen::Run => self.on_run_key(key),
+            Screen::Views => self.on_views_key(key),
+        }
+    }
+
+    fn on_overlay_key(&mut self, overlay: Overlay, key: KeyEvent, ctrl_c: bool) -> Request {
+        match overlay {
+            Overlay::Stop { then_quit } => match key.code {
+                // Ctrl-C twice stops, as `y` does.
+                KeyCode::Char('y') | KeyCode::Enter => Request::Stop { then_quit },
+                _ if ctrl_c => Request::Stop { then_quit },
+                _ => {
+                    self.notice = Some("the protocol goes on".into());
+                    Request::None
+                }
+            },
+            Overlay::Picker(mut picker) => {
+                if ctrl_c {
+                    return Request::None;
+                }
+                match picker.on_key(key) {
+                    Picked::Nothing => {
+                        self.overlay = Some(Overlay::Picker(picker));
+                        Request::None
+                    }
+                    Picked::Closed => Request::None,
+                    Picked::Config(path) => {
+                        // Kept up until the loop says whether the config was taken.
+                        self.overlay = Some(Overlay::Picker(picker));
+                        Request::Launch(path)
+                    }
+                }
+            }
+        }
+    }
+
+    /// `q`, Esc or Ctrl-C: asks first while a protocol trains.
+    fn quit(&mut self) -> Request {
+        match self.phase {
+            Phase::Running => {
+                self.overlay = Some(Overlay::Stop { then_quit: true });
+                Request::None
+            }
+            _ => Request::Quit,
+        }
+    }
+
+    /// The keys of the protocol itself, on every screen: `L`, `S`, `R`; `None` if `key` is
+    /// none of them.
+    fn protocol_key(&mut self, key: KeyEvent) -> Option<Request> {
+        Some(match key.code {
+            KeyCode::Char('L') => {
+                if self.is_running() {
+                    self.notice = Some("a protocol is running: S stops it first".into());
+                } else {
+                    self.overlay = Some(Overlay::Picker(Picker::open()));
+                }
+                Request::None
+            }
+            KeyCode::Char('S') => {
+                if self.phase == Phase::Running {
+                    self.overlay = Some(Overlay::Stop { then_quit: false });
+                } else {
+                    self.notice = Some("no protocol is training".into());
+                }
+                Request::None
+            }
+            KeyCode::Char('R') => match self.resumable() {
+                Ok(()) => Request::Resume,
+                Err(why) => {
+                    self.notice = Some(why);
+                    Request::None
+                }
+            },
+            _ => return None,
+        })
+    }
+
+    /// Whether `R` can resume the folder shown, and if not why.
+    pub fn resumable(&self) -> Result<(), String> {
+        if self.is_running() {
+            return Err("the protocol is training: nothing to resume".into());
+        }
+        let Some(workbench) = &self.workbench else {
+            return Err("the folder holds no protocol yet".into());
+        };
+        let folder = &workbench.folder;
+        if let Some(writer) = &folder.writer {
+            return Err(format!("{} writes this folder", writer.describe()));
+        }
+        match folder.status {
+            Some(Status::Stopped | Status::Failed | Status::Running | Status::Interrupted) => {
+                Ok(())
+            }
+            None | Some(Status::Complete) => {
+                Err("this protocol is complete: nothing to resume (L launches another)".into())
+            }
+        }
+    }
+
+    fn on_run_key(&mut self, key: KeyEvent) -> Request {
+        let teaching = self
+            .followed_run()
+            .is_some_and(|r| r.dashboard.mode == Mode::Teach || r.dashboard.help);
+        if !teaching {
+            match key.code {
+                KeyCode::Char('q') | KeyCode::Esc => return self.quit(),
+                KeyCode::Char('r') => {
+                    self.show_view(View::Runs);
+                    return Request::None;
+                }
+                KeyCode::Char('c') => {
+                    self.show_view(View::Comparison);
+                    return Request::None;
+                }
+                _ => {}
+            }
+            if let Some(request) = self.protocol_key(key) {
+                return request;
+            }
+        }
+        let Some(run) = self.followed_run_mut() else {
+            self.notice = Some("no run followed yet: r lists the runs, Enter follows one".into());
+            return Request::None;
+        };
+        match run.dashboard.on_key(key) {
+            DashboardAction::None => Request::None,
+            DashboardAction::Quit => self.quit(),
+            DashboardAction::Send(command) | DashboardAction::SendAll(command) => {
+                if let Some(commands) = &run.commands {
+                    let _ = commands.send(command);
+                }
+                Request::None
+            }
+            DashboardAction::FollowNext => {
+                self.follow_next();
+                Request::None
+            }
+        }
+    }
+
+    fn show_view(&mut self, view: View) {
+        self.screen = Screen::Views;
+        if let Some(workbench) = &mut self.workbench {
+            workbench.view = view;
+        }
+    }
+
+    fn on_views_key(&mut self, key: KeyEvent) -> Request {
+        let Some(workbench) = &mut self.workbench else {
+            return match key.code {
+                KeyCode::Char('q') | KeyCode::Esc => self.quit(),
+                KeyCode::Char('f') => {
+                    self.screen = Screen::Run;
+                    Request::None
+                }
+                _ => self.protocol_key(key).unwrap_or(Request::None),
+            };
+        };
+        if workbench.help {
+            workbench.on_key(key);
+            return Request::None;
+        }
+        match key.code {
+            KeyCode::Char('q') | KeyCode::Esc => return self.quit(),
+            KeyCode::Char('f') => {
+                self.screen = Screen::Run;
+                return Request::None;
+            }
+            KeyCode::Enter if workbench.view == View::Runs => {
+                self.follow_cursor();
+                return Request::None;
+            }
+            _ => {}
+        }
+        if let Some(request) = self.protocol_key(key) {
+            return request;
+        }
+        if let Some(workbench) = &mut self.workbench {
+            workbench.on_key(key);
+        }
+        Request::None
+    }
+
+    /// Enter in the Runs view: the run under the cursor, followed in the Run view if it
+    /// trains (or trained) in this session.
+    fn follow_cursor(&mut self) {
+        let Some(workbench) = &self.workbench else {
+            return;
+        };
+        let Some(row) = workbench.folder.runs.get(workbench.run_cursor) else {
+            return;
+        };
+        let key = (row.method.label().to_string(), row.run);
+        if self.runs.contains_key(&key) {
+            self.follow(key);
+            self.screen = Screen::Run;
+            return;
+        }
+        self.notice = Some(match row.status {
+            RunStatus::Queued => format!("{} run {} has not started yet", key.0, key.1),
+            RunStatus::Done => format!(
+                "{} run {} finished before this session: its row says its figures",
+                key.0, key.1
+            ),
+            status => format!("{} run {} is {}", key.0, key.1, status.name()),
+        });
+    }
+
+    /// `m`: the next run that trains now, after the followed one.
+    fn follow_next(&mut self) {
+        let training: Vec<RunKey> = self
+            .runs
+            .iter()
+            .filter(|(_, r)| r.commands.is_some())
+            .map(|(k, _)| k.clone())
+            .collect();
+        let next = match &self.followed {
+            Some(now) => training
+                .iter()
+                .find(|k| *k > now)
+                .or(training.first())
+                .cloned(),
+            None => training.first().cloned(),
+        };
+        match next {
+            Some(key) if Some(&key) != self.followed.as_ref() => self.follow(key),
+            _ => self.notice = Some("m: no other run is training".into()),
+        }
+    }
+
+    /// Follows `key`: the run followed so far is let go at full speed (a run left paused
+    /// would hold the protocol up for ever).
+    pub fn follow(&mut self, key: RunKey) {
+        if let Some(left) = self.followed_run_mut() {
+            let board = &mut left.dashboard;
+            if board.mode != Mode::Running || board.speed != 0 {
+                board.mode = Mode::Running;
+                board.teach = None;
+                board.speed = 0;
+                if let Some(commands) = &left.commands {
+                    let _ = commands.send(Command::Throttle(Duration::ZERO));
+                    let _ = commands.send(Command::Resume);
+                }
+            }
+        }
+        self.followed = Some(key);
+    }
+
+    /// The keys the workbench's status bar adds for a protocol run here, as the phase
+    /// allows them.
+    pub fn bar_keys(&self) -> Vec<(&'static str, &'static str)> {
+        let mut keys = vec![("⏎", "follow"), ("f", "run view")];
+        match self.phase {
+            Phase::Running => keys.push(("S", "stop")),
+            Phase::Stopping => {}
+            _ => {
+                keys.push(("L", "launch"));
+                if self.resumable().is_ok() {
+                    keys.push(("R", "resume"));
+                }
+            }
+        }
+        keys
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(c: char) -> KeyEvent {
+        KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
+    }
+
+    #[test]
+    fn quitting_a_training_protocol_asks_once_and_stops_it() {
+        let mut session = Session::new(
+            Path::new("out/x"),
+            "CartPole-v1",
+            Some(("sapnet".into(), 0)),
+            Phase::Running,
+        );
+        assert_eq!(session.on_key(key('q')), Request::None);
+        assert!(matches!(
+            session.overlay,
+            Some(Overlay::Stop { then_quit: true })
+        ));
+        assert_eq!(session.on_key(key('y')), Request::Stop { then_quit: true });
+        // Answered no, the protocol goes on and nothing is asked again.
+        session.on_key(key('q'));
+        assert_eq!(session.on_key(key('n')), Request::None);
+        assert!(session.overlay.is_none());
+        // Ctrl-C asks, and a second one answers yes.
+        let ctrl_c = KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL);
+        assert_eq!(session.on_key(ctrl_c), Request::None);
+        assert_eq!(session.on_key(ctrl_c), Request::Stop { then_quit: true });
+    }
+
+    #[test]
+    fn an_ended_protocol_quits_at_once_and_launches_only_when_idle() {
+        let mut session = Session::new(Path::new("out/x"), "CartPole-v1", None, Phase::Running);
+        assert_eq!(session.on_key(key('L')), Request::None);
+        assert!(session.overlay.is_none());
+        assert_eq!(
+            session.notice.as_deref(),
+            Some("a protocol is running: S stops it first")
+        );
+        session.phase = Phase::Ended(Status::Complete);
+        assert_eq!(session.on_key(key('q')), Request::Quit);
+        assert_eq!(session.on_key(key('R')), Request::None);
+        assert_eq!(
+            session.notice.as_deref(),
+            Some("the folder holds no protocol yet")
+        );
+    }
+}
