@@ -14,16 +14,19 @@ pub enum View {
     Runs,
     /// The methods side by side: aggregates with intervals, whiskers, pairs.
     Comparison,
+    /// Each method's learning curve over its runs, with its band ([`super::curves`]).
+    Curves,
 }
 
 impl View {
-    pub const ALL: [View; 2] = [View::Runs, View::Comparison];
+    pub const ALL: [View; 3] = [View::Runs, View::Comparison, View::Curves];
 
     /// The key that shows it, and its name in the status bar.
     pub fn key(self) -> (char, &'static str) {
         match self {
             View::Runs => ('r', "runs"),
             View::Comparison => ('c', "comparison"),
+            View::Curves => ('v', "curves"),
         }
     }
 }
@@ -107,6 +110,8 @@ pub struct Workbench {
     /// The last refresh's failure, shown until a read succeeds again: the views keep the
     /// last good read.
     pub read_error: Option<String>,
+    /// The Curves view's choices.
+    pub curves: super::curves::Curves,
 }
 
 impl Workbench {
@@ -122,6 +127,7 @@ impl Workbench {
             run_cursor: 0,
             method_cursor: 0,
             read_error: None,
+            curves: super::curves::Curves::default(),
         }
     }
 
@@ -156,11 +162,15 @@ impl Workbench {
             self.help = false;
             return Action::None;
         }
+        if self.view == View::Curves && self.curves.on_key(key, &self.folder) {
+            return Action::None;
+        }
         match key.code {
             KeyCode::Esc => return Action::Quit,
             KeyCode::Char('?') => self.help = true,
             KeyCode::Char('r') => self.view = View::Runs,
             KeyCode::Char('c') => self.view = View::Comparison,
+            KeyCode::Char('v') => self.view = View::Curves,
             KeyCode::Char('a') if self.view == View::Comparison => {
                 self.aggregate = self.aggregate.next();
             }
@@ -184,6 +194,7 @@ impl Workbench {
         let (cursor, rows) = match self.view {
             View::Runs => (&mut self.run_cursor, self.folder.runs.len()),
             View::Comparison => (&mut self.method_cursor, methods),
+            View::Curves => return,
         };
         let last = rows.saturating_sub(1) as isize;
         *cursor = (*cursor as isize + by).clamp(0, last) as usize;
@@ -213,12 +224,17 @@ impl Workbench {
                 "s",
                 "Comparison: the pairs of the other score (training return or test score)",
             ),
+        ]
+        .into_iter()
+        .chain(super::curves::KEYS)
+        .chain([
             ("?", "every key"),
             (
                 "q, Esc, Ctrl-C",
                 "quit (the folder is only read: nothing in it changes)",
             ),
-        ]
+        ])
+        .collect()
     }
 
     /// The keys the status bar lists for the view shown, after the views' own.
@@ -226,6 +242,7 @@ impl Workbench {
         match self.view {
             View::Runs => &[("↑↓", "run")],
             View::Comparison => &[("↑↓", "method"), ("a", "aggregate"), ("s", "score")],
+            View::Curves => &super::curves::COMMANDS,
         }
     }
 }
