@@ -52,6 +52,10 @@ pub fn run(cli: Cli) -> Result<()> {
             );
             print_stdout(&report.table())
         }
+        // A sweep folder opens in the Sweep view, any other in the workbench's views.
+        Some(Command::Open(args)) if tui::workbench::sweep::is_sweep(&args.dir) => {
+            tui::workbench::sweep::run(&args.dir)
+        }
         Some(Command::Open(args)) => tui::workbench::run(&args.dir),
         Some(Command::Plot(args)) => {
             let summary = results::replot(&args.dir)?;

@@ -500,7 +500,9 @@ pub struct PlotArgs {
 
 #[derive(Debug, Args)]
 pub struct OpenArgs {
-    /// The results directory (a headless run's --out), finished or still being written.
+    /// The results directory (a headless run's --out), finished or still being written; a
+    /// folder shipped with its top-level files (summary.json, episodes.csv); or a sweep
+    /// folder (sapnet sweep plan's --out).
     #[arg(value_name = "DIR")]
     pub dir: PathBuf,
 }

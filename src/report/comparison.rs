@@ -16,7 +16,7 @@ use serde::Serialize;
 
 use super::runs::LibraryEntry;
 use super::{MethodRuns, TestScore, Units};
-use crate::reuse::MethodKind;
+use crate::reuse::{lock_in, MethodKind};
 use crate::seeds::{self, Part};
 use crate::stats::{aggregate, bootstrap, proportion, Estimate, Scores};
 
@@ -139,9 +139,17 @@ fn measures(m: &MethodRuns, units: Units) -> MethodComparison {
         source_shares: m.source_shares.clone(),
         task_shares: m.task_shares.clone(),
         ranks: m.ranks.clone(),
-        lock_in_median: median(&m.lock_in_steps),
-        locked_runs: m.lock_in_steps.len(),
-        lock_in_measured: m.kind.picks_by_probability,
+        // A step recorded for a method lock-in means nothing for (the oracle's probability
+        // of 1 passes 0.99 at its first step) is not a lock-in.
+        lock_in_median: lock_in::measured(m.kind)
+            .then(|| median(&m.lock_in_steps))
+            .flatten(),
+        locked_runs: if lock_in::measured(m.kind) {
+            m.lock_in_steps.len()
+        } else {
+            0
+        },
+        lock_in_measured: lock_in::measured(m.kind),
     }
 }
 
@@ -294,8 +302,13 @@ pub fn csv_records(rows: &[MethodComparison], units: Units) -> (Vec<String>, Vec
             cell(row.training.map(|a| a.mean.point)),
             cell(row.test_std),
             ranks.join(" "),
+            // Empty, as the table's `-`, for a method lock-in means nothing for.
             cell(row.lock_in_median),
-            row.locked_runs.to_string(),
+            if row.lock_in_measured {
+                row.locked_runs.to_string()
+            } else {
+                String::new()
+            },
             shares.join(" "),
         ]);
         for task in &tasks {
@@ -374,11 +387,12 @@ pub fn table(rows: &[MethodComparison], units: Units, test_score: TestScore) -> 
         } else {
             ranks.join(" ")
         });
-        line.push(match row.lock_in_median {
-            Some(s) => format!("{s:.0} ({}/{})", row.locked_runs, row.runs),
-            None if !row.lock_in_measured => "-".into(),
-            None => format!("never (0/{})", row.runs),
-        });
+        line.push(lock_in::over_runs(
+            row.lock_in_measured,
+            row.lock_in_median,
+            row.locked_runs,
+            row.runs,
+        ));
         if !tasks.is_empty() {
             let shares: Vec<String> = row
                 .task_shares

@@ -164,7 +164,9 @@ impl FolderReader {
     pub fn read(&mut self) -> Result<FolderState> {
         let dir = &self.dir.clone();
         let header = read_header(dir)?;
-        super::require_records(dir, &header)?;
+        if !header.listed_runs.is_empty() && !records::any(dir)? {
+            return shipped(dir, header);
+        }
         let writer = folder_lock::holder(dir)?;
         let config = header.config;
         let library = header.library.unwrap_or_default();
@@ -183,7 +185,7 @@ impl FolderReader {
                     Some(folder) => {
                         let returns = self.finished_returns(folder)?;
                         rewards.insert((method.clone(), run), returns.clone());
-                        finished_run(folder, returns, &names, config.protocol.episodes)
+                        finished_run(&folder.summary, returns, &names, config.protocol.episodes)
                     }
                     None => {
                         let partial = records::partial_dir(dir, &run_name(method.label(), run));
@@ -236,13 +238,64 @@ impl FolderReader {
     }
 }
 
+/// A folder shipped with its top-level files only (`docs/`'s: no run records), read from
+/// `summary.json` and `episodes.csv` as `sapnet plot` reads it ([`super::shipped::runs`]):
+/// a finished protocol, every run it lists done (or stopped), the others not run.
+fn shipped(dir: &Path, header: super::SummaryHeader) -> Result<FolderState> {
+    let shipped = super::shipped::runs(dir, &header)?;
+    let writer = folder_lock::holder(dir)?;
+    let config = header.config;
+    let library = header.library.unwrap_or_default();
+    let names: Vec<&str> = library.iter().map(|e| e.name.as_str()).collect();
+    let mut runs = Vec::new();
+    for method in MethodId::all(&config.protocol.methods) {
+        for run in 0..config.protocol.runs {
+            let listed = shipped
+                .runs
+                .iter()
+                .find(|r| r.record.method == method && r.record.run == run);
+            runs.push(match listed {
+                Some(summary) => {
+                    let returns = shipped
+                        .rewards
+                        .get(&(method.clone(), run))
+                        .cloned()
+                        .unwrap_or_default();
+                    finished_run(summary, returns, &names, config.protocol.episodes)
+                }
+                None => RunProgress {
+                    method: method.clone(),
+                    run,
+                    status: RunStatus::NotRun,
+                    returns: Vec::new(),
+                    planned: config.protocol.episodes,
+                    source: None,
+                    wall_s: None,
+                },
+            });
+        }
+    }
+    let status = header.status;
+    Ok(FolderState {
+        dir: dir.to_path_buf(),
+        status,
+        writer,
+        error: header.error,
+        config,
+        library,
+        runs,
+        finished: shipped.runs,
+        rewards: shipped.rewards,
+    })
+}
+
 fn finished_run(
-    folder: &RunFolder,
+    summary: &RunSummary,
     returns: Vec<f64>,
     names: &[&str],
     planned: u32,
 ) -> RunProgress {
-    let record = &folder.summary.record;
+    let record = &summary.record;
     let source = match &record.chosen {
         Some(chosen) => Some(chosen.name.clone()),
         None => crate::report::comparison::most_used(&record.source_steps)

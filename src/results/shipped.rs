@@ -4,7 +4,7 @@
 //! training returns from `episodes.csv`, its tests from `tests.csv` — so that a report
 //! shipped by an older version can be read by today's rules. The data files are read, never
 //! written; `activations.csv`, if it did not ship, leaves the figures drawn from it as they
-//! were.
+//! were. `sapnet open` reads the same runs ([`runs`]) and writes nothing.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -30,8 +30,10 @@ pub fn can_replot(dir: &Path) -> bool {
     std::fs::symlink_metadata(dir.join("episodes.csv")).is_ok_and(|m| m.is_file())
 }
 
-/// Makes `dir`'s report, plots and `summary.json` again from its top-level files.
-pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
+/// Every run `dir`'s `summary.json` lists, with its training returns from `episodes.csv`:
+/// what its report is made of. Refused for a protocol that did not finish, and, naming
+/// what is missing, for a folder whose episodes shipped compressed only.
+pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
     if !matches!(header.status, None | Some(Status::Complete)) {
         bail!(
             "{}: a protocol that did not finish (summary.json: status {:?}) and has no run \
@@ -41,13 +43,30 @@ pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
             header.status
         );
     }
+    if !can_replot(dir) {
+        bail!(
+            "{}: summary.json lists {} runs, the folder holds none of their records \
+             (runs/<run>/run.json) and no episodes.csv, whose training returns the report is \
+             made of{}",
+            dir.display(),
+            header.listed_runs.len(),
+            if dir.join("episodes.csv.xz").exists() {
+                format!(
+                    " (it ships compressed: decompress it first, xz -dk {}, or in a copy of \
+                     the folder)",
+                    dir.join("episodes.csv.xz").display()
+                )
+            } else {
+                String::new()
+            }
+        );
+    }
     let path = dir.join("summary.json");
     let text = safe_io::read_text(&path, Links::Refuse, MAX_SUMMARY_BYTES)
         .with_context(|| format!("reading {}", path.display()))?;
     let listed: ListedRuns =
         serde_json::from_str(&text).with_context(|| format!("reading {}", path.display()))?;
-    let config = header.config;
-    let methods = MethodId::all(&config.protocol.methods);
+    let methods = MethodId::all(&header.config.protocol.methods);
     let mut runs = Vec::new();
     for run in listed.runs {
         let Some(method) = methods.iter().find(|m| m.label() == run.record.method) else {
@@ -61,6 +80,20 @@ pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
         runs.push(run.with_method(method.clone()));
     }
     let rewards = rewards(&dir.join("episodes.csv"), &methods)?;
+    Ok(ShippedRuns { runs, rewards })
+}
+
+/// A shipped folder's runs and their training returns.
+pub struct ShippedRuns {
+    pub runs: Vec<RunSummary>,
+    pub rewards: BTreeMap<(MethodId, u32), Vec<f64>>,
+}
+
+/// Makes `dir`'s report, plots and `summary.json` again from its top-level files.
+pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
+    let ShippedRuns { runs, rewards } = runs(dir, &header)?;
+    let config = header.config;
+    let path = dir.join("summary.json");
     let library = header.library.unwrap_or_default();
     let task = config.env.label();
     let report = Report::of(&[TaskRuns {

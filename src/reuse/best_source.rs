@@ -75,14 +75,15 @@ impl Selector for BestSource {
 /// The oracle in `protocol.methods` (`BestSource`), in the palette's orange.
 pub struct Oracle;
 
-/// What the oracle is: its one source has probability 1 from the start.
+/// What the oracle is: its one source has probability 1 from the start, given, not
+/// learned: no lock-in to measure ([`super::lock_in`]).
 pub const KIND: MethodKind = MethodKind {
     family: "BestSource",
     hue: 30,
     saturation: 80,
     reuses: true,
     tested: Tested::BestRecorded,
-    picks_by_probability: true,
+    picks_by_probability: false,
     spreads: false,
 };
 

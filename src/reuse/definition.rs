@@ -57,8 +57,10 @@ pub struct MethodKind {
     pub reuses: bool,
     /// What its runs hand over to be tested greedily.
     pub tested: Tested,
-    /// Whether it picks sources with probabilities, so that lock-in (one source above
-    /// 0.99) is measured; a rule (UCB1's index, a draw per episode) has none.
+    /// Whether its probabilities of picking a source are learned during the run, so that
+    /// lock-in (one source above 0.99) means something ([`super::lock_in`]); a rule
+    /// (UCB1's index, a draw per episode) or fixed odds (random's 1/N, the oracle's 1)
+    /// have none.
     pub picks_by_probability: bool,
     /// Whether it spreads activation over SAP-Net's graph: its runs trace their walks and
     /// teach mode can step them.

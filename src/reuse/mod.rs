@@ -26,6 +26,7 @@ mod definition;
 pub mod exclusion;
 pub mod from_scratch;
 pub mod gpi;
+pub mod lock_in;
 mod method;
 pub mod parameter_schedule;
 pub mod prql;

@@ -97,15 +97,15 @@ const KIND: MethodKind = MethodKind {
     saturation: 65,
     reuses: true,
     tested: Tested::DrawnAtStart,
-    picks_by_probability: true,
+    // Its odds are 1/N, fixed: no lock-in to measure ([`super::lock_in`]).
+    picks_by_probability: false,
     spreads: false,
 };
 
 /// `Random`: a random source every step.
 pub struct PerStep;
 
-/// `RandomPerEpisode`: a random source every episode; its draw is a rule, not a
-/// probability that could lock in.
+/// `RandomPerEpisode`: a random source every episode.
 pub struct PerEpisode;
 
 impl ReuseMethod for PerStep {
@@ -134,7 +134,6 @@ impl ReuseMethod for PerEpisode {
     fn kind(&self) -> MethodKind {
         MethodKind {
             family: "RandomPerEpisode",
-            picks_by_probability: false,
             ..KIND
         }
     }

@@ -114,48 +114,10 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
     // Per axis (the pooled rows of `*` aside), each value's comparison: `sweep.png`.
     let mut plotted: Vec<SweepAxis> = Vec::new();
     let mut task_titles: Vec<String> = Vec::new();
-    let mut groups: Vec<(String, String, Vec<&Results>)> = Vec::new();
-    for (a, axis) in axes.iter().enumerate() {
-        let mut values: Vec<&String> = Vec::new();
-        for (cell, _) in &done {
-            if !values.contains(&&cell.axes[a].1) {
-                values.push(&cell.axes[a].1);
-            }
-        }
-        for value in values {
-            let group: Vec<&Results> = done
-                .iter()
-                .filter(|(cell, _)| &cell.axes[a].1 == value)
-                .map(|(_, r)| r)
-                .collect();
-            groups.push((axis.clone(), value.clone(), group));
-        }
-    }
-    let all: Vec<&Results> = done.iter().map(|(_, r)| r).collect();
-    if by_task(&all).len() > 1 {
-        groups.push((ACROSS_TASKS.into(), "every cell".into(), all));
-    }
+    let done_refs: Vec<(&super::CellEntry, &Results)> = done.iter().map(|(c, r)| (*c, r)).collect();
+    let groups = groups(&axes, &done_refs);
     for (axis, value, group) in &groups {
-        let strata: Vec<(String, Results)> = by_task(group)
-            .into_iter()
-            .map(|(task, cells)| (task, pool(&cells)))
-            .collect();
-        let tasks: Vec<TaskRuns> = strata
-            .iter()
-            .map(|(task, pooled)| TaskRuns {
-                task,
-                config: &pooled.config,
-                library: pooled.library.as_deref().unwrap_or_default(),
-                runs: &pooled.runs,
-                rewards: &pooled.rewards,
-            })
-            .collect();
-        let mut report = Report::of(&tasks);
-        report.subject = Some(if axis == ACROSS_TASKS {
-            value.clone()
-        } else {
-            format!("{axis} = {value}")
-        });
+        let (report, strata) = value_report(axis, value, group);
         for title in &report.task_titles {
             if !task_titles.contains(title) {
                 task_titles.push(title.clone());
@@ -229,6 +191,67 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
         missing,
         tables,
     })
+}
+
+/// The finished cells grouped as the merge reports them: per axis, each value's cells (in
+/// the order first met), then, for a sweep over several tasks, every cell under
+/// [`ACROSS_TASKS`]. The workbench's Sweep view groups them the same way.
+pub fn groups<'a>(
+    axes: &[String],
+    done: &[(&super::CellEntry, &'a Results)],
+) -> Vec<(String, String, Vec<&'a Results>)> {
+    let mut groups: Vec<(String, String, Vec<&Results>)> = Vec::new();
+    for (a, axis) in axes.iter().enumerate() {
+        let mut values: Vec<&String> = Vec::new();
+        for (cell, _) in done {
+            if !values.contains(&&cell.axes[a].1) {
+                values.push(&cell.axes[a].1);
+            }
+        }
+        for value in values {
+            let group: Vec<&Results> = done
+                .iter()
+                .filter(|(cell, _)| &cell.axes[a].1 == value)
+                .map(|(_, r)| *r)
+                .collect();
+            groups.push((axis.clone(), value.clone(), group));
+        }
+    }
+    let all: Vec<&Results> = done.iter().map(|(_, r)| *r).collect();
+    if by_task(&all).len() > 1 {
+        groups.push((ACROSS_TASKS.into(), "every cell".into(), all));
+    }
+    groups
+}
+
+/// The report of one axis value's cells, their runs pooled per task (stratified by task
+/// over several), as `merged/comparison.csv` holds it; with the pooled runs per task.
+pub fn value_report(
+    axis: &str,
+    value: &str,
+    group: &[&Results],
+) -> (Report, Vec<(String, Results)>) {
+    let strata: Vec<(String, Results)> = by_task(group)
+        .into_iter()
+        .map(|(task, cells)| (task, pool(&cells)))
+        .collect();
+    let tasks: Vec<TaskRuns> = strata
+        .iter()
+        .map(|(task, pooled)| TaskRuns {
+            task,
+            config: &pooled.config,
+            library: pooled.library.as_deref().unwrap_or_default(),
+            runs: &pooled.runs,
+            rewards: &pooled.rewards,
+        })
+        .collect();
+    let mut report = Report::of(&tasks);
+    report.subject = Some(if axis == ACROSS_TASKS {
+        value.to_string()
+    } else {
+        format!("{axis} = {value}")
+    });
+    (report, strata)
 }
 
 /// The axis of the rows pooled over every cell of a sweep that spans several tasks.

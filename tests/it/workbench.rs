@@ -39,8 +39,13 @@ fn stderr(output: &Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()
 }
 
+/// A key as the tests spell it: `\n` is Enter.
 fn key(c: char) -> KeyEvent {
-    KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)
+    let code = match c {
+        '\n' => KeyCode::Enter,
+        c => KeyCode::Char(c),
+    };
+    KeyEvent::new(code, KeyModifiers::NONE)
 }
 
 /// A finished protocol of tests/configs/two_baselines.ron in `out`.
@@ -303,6 +308,9 @@ fn the_views_at_both_sizes() {
             ("runs", ""),
             ("comparison", "c"),
             ("comparison_test", "cjs"),
+            ("curves", "v"),
+            ("curves_zoomed_mean", "v+m"),
+            ("curves_one_run", "vj\n]"),
             ("help", "?"),
         ] {
             let terminal = screen(&steady(workbench(&out, keys)), size);
@@ -328,7 +336,11 @@ fn the_views_at_both_sizes() {
     let _lock = FolderLock::acquire(&live, "the protocol").unwrap();
     for size in SIZES {
         let (w, h) = size;
-        for (name, keys) in [("live_runs", ""), ("live_comparison", "c")] {
+        for (name, keys) in [
+            ("live_runs", ""),
+            ("live_comparison", "c"),
+            ("live_curves", "v"),
+        ] {
             let mut workbench = steady(workbench(&live, keys));
             assert_eq!(
                 workbench.folder.writer.as_ref().map(|w| w.pid),
@@ -393,5 +405,546 @@ fn open_refuses_a_bad_file_naming_it_before_the_screen_opens() {
         "reward",
     ] {
         assert!(said.contains(names), "{names:?} in {said}");
+    }
+}
+
+/// `sample_efficiency.csv`'s rows of `method` and `statistic`, as (episode, runs, value,
+/// lo, hi), the numbers as the file writes them.
+fn efficiency_rows(
+    out: &Path,
+    method: &str,
+    statistic: &str,
+) -> Vec<(String, String, [String; 3])> {
+    let mut reader = csv::Reader::from_path(out.join("sample_efficiency.csv")).unwrap();
+    reader
+        .records()
+        .map(Result::unwrap)
+        .filter(|r| &r[0] == method && &r[3] == statistic)
+        .map(|r| {
+            (
+                r[1].to_string(),
+                r[2].to_string(),
+                [r[4].to_string(), r[5].to_string(), r[6].to_string()],
+            )
+        })
+        .collect()
+}
+
+/// Item 2, Curves: each method's curve is `sample_efficiency.csv`'s, point for point (the
+/// same episodes, runs, values and interval ends, as the file writes them), for the IQM
+/// and the mean; the legend shows each one's value where the view ends, to a tenth, and
+/// after a zoom the value at the zoomed range's last point.
+#[test]
+fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    finished_folder(&out);
+    let mut workbench = workbench(&out, "v");
+    let labels = ["dqn[16]", "dqn[8]"];
+    for (index, label) in labels.iter().enumerate() {
+        let points = workbench.curves.curve(&workbench.folder, index);
+        for (statistic, of) in [
+            (
+                "iqm",
+                (|p: &sapnet::report::sample_efficiency::EfficiencyPoint| p.iqm) as fn(&_) -> _,
+            ),
+            ("mean", |p| p.mean),
+        ] {
+            let rows = efficiency_rows(&out, label, statistic);
+            // Episodes 10 to 30 of MA10: 21 points.
+            assert_eq!(rows.len(), 21, "{label} {statistic}");
+            let drawn: Vec<(String, String, [String; 3])> = points
+                .iter()
+                .map(|p| {
+                    let e = of(p);
+                    (
+                        p.episode.to_string(),
+                        p.runs.to_string(),
+                        [e.point, e.lo, e.hi].map(|x| format!("{x:?}")),
+                    )
+                })
+                .collect();
+            assert_eq!(drawn, rows, "{label} {statistic}");
+        }
+    }
+    let legend_value = |workbench: &Workbench, label: &str| -> String {
+        let drawn = text(&screen(workbench, (120, 40)));
+        let line = drawn
+            .lines()
+            .find(|l| l.contains(&format!(" {label} ")) && (l.contains("■ ") || l.contains("□ ")))
+            .unwrap_or_else(|| panic!("{label} in the legend of\n{drawn}"))
+            .to_string();
+        let at = line.find(&format!("{label} ")).unwrap() + label.len();
+        line[at..].trim().trim_end_matches('│').trim().to_string()
+    };
+    let tenth = |row: &(String, String, [String; 3])| {
+        let [v, lo, hi] = row.2.clone().map(|x| x.parse::<f64>().unwrap());
+        format!("{v:.1} [{lo:.1}, {hi:.1}]")
+    };
+    for (statistic, keys) in [("iqm", ""), ("mean", "m")] {
+        for k in keys.chars() {
+            workbench.on_key(key(k));
+        }
+        for label in labels {
+            let rows = efficiency_rows(&out, label, statistic);
+            assert_eq!(legend_value(&workbench, label), tenth(rows.last().unwrap()));
+        }
+    }
+    // Zoomed in once: half of episodes 1 to 30 around their middle, 15.5 ± 7.25, is
+    // narrower than twenty, so 15.5 ± 10, in whole episodes 6 to 26: the last point
+    // shown is episode 26's.
+    workbench.on_key(key('m'));
+    workbench.on_key(key('+'));
+    let (from, to) = workbench.curves.range(&workbench.folder);
+    assert_eq!((from, to), (6.0, 26.0));
+    let drawn = text(&screen(&workbench, (120, 40)));
+    assert!(drawn.contains("episodes 6–26 of 30"), "{drawn}");
+    assert!(drawn.contains("IQM [95% CI] at ep 26"), "{drawn}");
+    for label in labels {
+        let rows = efficiency_rows(&out, label, "iqm");
+        let row = rows.iter().find(|r| r.0 == "26").unwrap();
+        assert_eq!(legend_value(&workbench, label), tenth(row));
+    }
+    // Space hides the picked method (the first): its legend box empties.
+    workbench.on_key(key(' '));
+    assert!(workbench.curves.hidden.contains(&0));
+    let drawn = text(&screen(&workbench, (120, 40)));
+    assert!(drawn.contains("□ ● dqn[16]"), "{drawn}");
+    assert!(drawn.contains("■ ▲ dqn[8]"), "{drawn}");
+}
+
+/// Each method's line is drawn in the plots' colour of that method
+/// (`report::plots::palette`), and without colour each carries a marker of its own.
+#[test]
+fn the_curves_are_drawn_in_each_methods_colour_or_marker() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    finished_folder(&out);
+    let workbench = workbench(&out, "v");
+    let kinds: Vec<_> = workbench
+        .folder
+        .config
+        .protocol
+        .methods
+        .iter()
+        .map(|m| m.kind())
+        .collect();
+    let colours = sapnet::report::plots::palette::method_colours(&kinds);
+    assert_ne!(colours[0], colours[1], "two DQN sizes read apart");
+    let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
+    terminal
+        .draw(|f| view::draw(f, &workbench, Theme { color: true }))
+        .unwrap();
+    let buffer = terminal.backend().buffer();
+    for (r, g, b) in colours {
+        let colour = ratatui::style::Color::Rgb(r, g, b);
+        // Braille cells of the curve (not only the legend's swatch).
+        let cells = buffer
+            .content()
+            .iter()
+            .filter(|c| {
+                c.fg == colour
+                    && ('\u{2801}'..='\u{28ff}').contains(&c.symbol().chars().next().unwrap_or(' '))
+            })
+            .count();
+        assert!(cells > 10, "{cells} braille cells of {colour:?}");
+    }
+    let plain = text(&screen(&workbench, (120, 40)));
+    for (marker, label) in [("●", "dqn[16]"), ("▲", "dqn[8]")] {
+        assert!(plain.contains(&format!("{marker} {label}")), "{plain}");
+        assert!(
+            plain.matches(marker).count() > 2,
+            "markers along {label}'s line in\n{plain}"
+        );
+    }
+}
+
+/// Item 5, one truth: for a finished tiny folder of every kind of method, the Comparison
+/// view's intervals are exactly the stdout table's cells (IQM of the training return and
+/// of the test score), which are comparison.csv's numbers to a tenth; and lock-in is one
+/// figure said one way: the table's cell is [`lock_in::over_runs`] of comparison.csv's
+/// columns, a number for SAP-Net and PRQ-learning, `-` (an empty `locked_runs`) for every
+/// other method.
+#[test]
+fn the_comparison_view_and_lock_in_equal_the_table_and_comparison_csv() {
+    use sapnet::reuse::lock_in;
+    let tmp = tempfile::tempdir().unwrap();
+    let library = tmp.path().join("lib");
+    let sources = sapnet()
+        .args(["sources", "--config"])
+        .arg(configs("tiny_sources.ron"))
+        .arg("--library")
+        .arg(&library)
+        .output()
+        .unwrap();
+    assert!(sources.status.success(), "{}", stderr(&sources));
+    let out = tmp.path().join("out");
+    let run = sapnet()
+        .args(["--headless", "--jobs", "2", "--config"])
+        .arg(configs("tiny_reuse.ron"))
+        .arg("--library")
+        .arg(&library)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", stderr(&run));
+    let stdout = String::from_utf8_lossy(&run.stdout).into_owned();
+    // The table: cells two spaces or more apart.
+    let mut lines = stdout.lines().skip_while(|l| !l.starts_with("method "));
+    let header: Vec<String> = split_cells(lines.next().expect("the table"));
+    let table: Vec<Vec<String>> = lines
+        .take_while(|l| !l.trim().is_empty())
+        .map(split_cells)
+        .collect();
+    let at = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let mut reader = csv::Reader::from_path(out.join("comparison.csv")).unwrap();
+    let csv_header = reader.headers().unwrap().clone();
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    assert_eq!(rows.len(), 9);
+    assert_eq!(table.len(), rows.len(), "{stdout}");
+    let column = |row: &csv::StringRecord, name: &str| -> String {
+        row[csv_header.iter().position(|h| h == name).unwrap()].to_string()
+    };
+    let workbench = workbench(&out, "c");
+    let drawn = text(&screen(&workbench, (120, 40)));
+    let mut measured = Vec::new();
+    for (line, row) in table.iter().zip(&rows) {
+        let method = &row[0];
+        assert_eq!(&line[0], method);
+        // The table's cells are comparison.csv's numbers to a tenth.
+        for (cell, score) in [
+            ("return IQM [95% CI]", "return"),
+            ("test IQM [95% CI]", "test"),
+        ] {
+            let [v, lo, hi] = ["", "_lo", "_hi"].map(|end| {
+                column(row, &format!("{score}_iqm{end}"))
+                    .parse::<f64>()
+                    .unwrap()
+            });
+            assert_eq!(
+                line[at(cell)],
+                format!("{v:.1} [{lo:.1}, {hi:.1}]"),
+                "{method}"
+            );
+        }
+        // The view's row shows those two cells, and no other interval.
+        let shown = drawn
+            .lines()
+            .find(|l| l.starts_with(&format!("│{method} ")))
+            .unwrap_or_else(|| panic!("{method} in\n{drawn}"));
+        let intervals: Vec<String> = intervals_in(shown);
+        assert_eq!(
+            intervals,
+            [
+                line[at("return IQM [95% CI]")].clone(),
+                line[at("test IQM [95% CI]")].clone()
+            ],
+            "{method}: {shown}"
+        );
+        // Lock-in: the table's cell from the CSV's two columns by the one definition.
+        let runs: usize = column(row, "runs").parse().unwrap();
+        let median = column(row, "lock_in_median_step");
+        let locked = column(row, "locked_runs");
+        let is_measured = !locked.is_empty();
+        let said = lock_in::over_runs(
+            is_measured,
+            median.parse().ok(),
+            locked.parse().unwrap_or(0),
+            runs,
+        );
+        assert_eq!(line[at("lock-in step")], said, "{method}");
+        if is_measured {
+            measured.push(method.to_string());
+        }
+    }
+    assert_eq!(
+        measured,
+        [
+            "sapnet",
+            "sapnet[episode,decay0.99]",
+            "sapnet[k5,linear5to1]",
+            "prql[8]"
+        ],
+        "lock-in means something for the learned selections only"
+    );
+}
+
+/// The cells of a line of the stdout table.
+fn split_cells(line: &str) -> Vec<String> {
+    line.split("  ")
+        .map(str::trim)
+        .filter(|c| !c.is_empty())
+        .map(String::from)
+        .collect()
+}
+
+/// Every `12.3 [4.5, 6.7]` in a line, in order.
+fn intervals_in(line: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    let mut rest = line;
+    while let Some(open) = rest.find(" [") {
+        let start = rest[..open]
+            .rfind(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-'))
+            .map_or(0, |i| i + 1);
+        let Some(close) = rest[open..].find(']') else {
+            break;
+        };
+        let candidate = &rest[start..open + close + 1];
+        if start < open {
+            found.push(candidate.to_string());
+        }
+        rest = &rest[open + close + 1..];
+    }
+    found
+}
+
+/// Where `needle` is drawn on `terminal`'s screen: its (column, row).
+fn drawn_at(terminal: &Terminal<TestBackend>, needle: &str) -> (u16, u16) {
+    let buffer = terminal.backend().buffer();
+    let width = usize::from(buffer.area.width);
+    let rows: Vec<String> = buffer
+        .content()
+        .chunks(width)
+        .map(|row| row.iter().map(|c| c.symbol()).collect())
+        .collect();
+    for (y, row) in rows.iter().enumerate() {
+        if let Some(byte) = row.find(needle) {
+            let x = row[..byte].chars().count();
+            return (x as u16, y as u16);
+        }
+    }
+    panic!("{needle:?} not drawn in\n{}", rows.join("\n"));
+}
+
+/// Item 8, the mouse: a click on a view's name in the status bar shows it, on a run's
+/// line picks the run, on a method's row of the Comparison picks the method, and on a
+/// method in the Curves view's legend picks it and hides it (a second click shows it).
+#[test]
+fn a_click_picks_a_view_a_run_a_method_and_a_legend_entry() {
+    use crossterm::event::{MouseButton, MouseEvent, MouseEventKind};
+    use sapnet::tui::workbench::mouse::on_mouse;
+    use sapnet::tui::workbench::state::View;
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    finished_folder(&out);
+    let mut workbench = workbench(&out, "");
+    let size = ratatui::layout::Rect::new(0, 0, 120, 40);
+    let click = |workbench: &mut Workbench, (column, row): (u16, u16)| {
+        let event = MouseEvent {
+            kind: MouseEventKind::Down(MouseButton::Left),
+            column,
+            row,
+            modifiers: KeyModifiers::NONE,
+        };
+        assert!(
+            on_mouse(workbench, event, size),
+            "a click at {column}, {row}"
+        );
+    };
+    // Runs: the first run of dqn[8] is the fourth (index 3).
+    let at = drawn_at(&screen(&workbench, (120, 40)), "dqn[8]  0");
+    click(&mut workbench, at);
+    assert_eq!(workbench.run_cursor, 3);
+    let at = drawn_at(&screen(&workbench, (120, 40)), "v curves");
+    click(&mut workbench, at);
+    assert_eq!(workbench.view, View::Curves);
+    let at = drawn_at(&screen(&workbench, (120, 40)), "■ ▲ dqn[8]");
+    click(&mut workbench, at);
+    assert_eq!(workbench.curves.cursor, 1);
+    assert!(workbench.curves.hidden.contains(&1));
+    assert!(text(&screen(&workbench, (120, 40))).contains("□ ▲ dqn[8]"));
+    click(&mut workbench, at);
+    assert!(workbench.curves.hidden.is_empty());
+    let at = drawn_at(&screen(&workbench, (120, 40)), "c comparison");
+    click(&mut workbench, at);
+    assert_eq!(workbench.view, View::Comparison);
+    let at = drawn_at(&screen(&workbench, (120, 40)), "│dqn[8] ");
+    click(&mut workbench, (at.0 + 1, at.1));
+    assert_eq!(workbench.method_cursor, 1);
+}
+
+/// Item 4: a folder shipped with its top-level files only (no `runs/`, as `docs/`'s) opens
+/// from `summary.json` and `episodes.csv`, every run done, its Comparison the one its
+/// `comparison.csv` holds; with its episodes compressed only, `sapnet open` exits 2 naming
+/// what is missing. Nothing in the folder changes either way.
+#[test]
+fn open_reads_a_shipped_folder_from_its_top_level_files_and_writes_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("shipped");
+    finished_folder(&out);
+    std::fs::remove_dir_all(out.join("runs")).unwrap();
+    let before = listing(&out);
+    let folder = FolderReader::new(&out).read().unwrap();
+    assert_eq!(folder.finished_runs(), 6);
+    assert!(folder.runs.iter().all(|r| r.episodes() == 30));
+    let workbench = workbench(&out, "c");
+    let drawn = text(&screen(&workbench, (120, 40)));
+    assert!(drawn.contains("6 of 6 runs finished"), "{drawn}");
+    let mut reader = csv::Reader::from_path(out.join("comparison.csv")).unwrap();
+    let header = reader.headers().unwrap().clone();
+    for row in reader.records().map(Result::unwrap) {
+        let column = |name: &str| -> f64 {
+            row[header.iter().position(|h| h == name).unwrap()]
+                .parse()
+                .unwrap()
+        };
+        let expected = format!(
+            "{:.1} [{:.1}, {:.1}]",
+            column("return_iqm"),
+            column("return_iqm_lo"),
+            column("return_iqm_hi")
+        );
+        assert!(drawn.contains(&expected), "{expected} in\n{drawn}");
+    }
+    assert_eq!(before, listing(&out), "opening changed the shipped folder");
+
+    // Compressed only: refused before the screen opens, naming the file and the way out.
+    let episodes = std::fs::read(out.join("episodes.csv")).unwrap();
+    std::fs::remove_file(out.join("episodes.csv")).unwrap();
+    std::fs::write(out.join("episodes.csv.xz"), &episodes[..10]).unwrap();
+    let before = listing(&out);
+    let output = sapnet().arg("open").arg(&out).output().unwrap();
+    let said = stderr(&output);
+    assert_eq!(output.status.code(), Some(2), "{said}");
+    for names in [
+        "no episodes.csv",
+        "episodes.csv.xz",
+        "xz -dk",
+        "runs/<run>/run.json",
+    ] {
+        assert!(said.contains(names), "{names:?} in {said}");
+    }
+    assert_eq!(
+        before,
+        listing(&out),
+        "the refusal changed the shipped folder"
+    );
+}
+
+/// Item 2, Sweep: `sapnet open SWEEP` reads a sweep's cells — failed (its error's last
+/// line), done, not run — and per axis value the comparison of its done cells, equal to
+/// what `sweep merge` then writes in `merged/comparison.csv`; the view at both sizes; the
+/// folder unchanged by the reading.
+#[test]
+fn the_sweep_view_shows_the_cells_and_the_merges_comparisons() {
+    use sapnet::tui::workbench::sweep::{comparisons, CellStatus, SweepBench, SweepState};
+    let tmp = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(configs("tiny_transfer.ron")).unwrap();
+    std::fs::write(tmp.path().join("base.ron"), base).unwrap();
+    let grid = tmp.path().join("grid.ron");
+    std::fs::write(
+        &grid,
+        "(base: \"base.ron\", seeds: Some(3), \
+         axes: [(path: \"sapnet.temperature\", values: [1.0, 4.0])])",
+    )
+    .unwrap();
+    let (dir, library) = (tmp.path().join("sweep"), tmp.path().join("lib"));
+    let run = |args: &[&std::ffi::OsStr]| {
+        let output = sapnet().args(args).output().unwrap();
+        output
+    };
+    let plan = run(&[
+        "sweep".as_ref(),
+        "plan".as_ref(),
+        "--grid".as_ref(),
+        grid.as_os_str(),
+        "--out".as_ref(),
+        dir.as_os_str(),
+        "--library".as_ref(),
+        library.as_os_str(),
+    ]);
+    assert!(plan.status.success(), "{}", stderr(&plan));
+    // Cell 0 before its library is trained: failed.
+    let cell = |id: &str| {
+        run(&[
+            "sweep".as_ref(),
+            "run".as_ref(),
+            dir.as_os_str(),
+            "--cell".as_ref(),
+            id.as_ref(),
+        ])
+    };
+    assert_eq!(cell("0").status.code(), Some(2));
+    let sources = run(&[
+        "sources".as_ref(),
+        "--config".as_ref(),
+        tmp.path().join("base.ron").as_os_str(),
+        "--library".as_ref(),
+        library.as_os_str(),
+    ]);
+    assert!(sources.status.success(), "{}", stderr(&sources));
+    for id in ["1", "2", "3"] {
+        let output = cell(id);
+        assert!(output.status.success(), "{}", stderr(&output));
+    }
+    let before = listing(&dir);
+    let sweep = SweepState::read(&dir).unwrap();
+    let statuses: Vec<&str> = sweep.cells.iter().map(|c| c.status.name()).collect();
+    assert_eq!(
+        statuses,
+        ["failed", "done", "done", "done", "not run", "not run"]
+    );
+    assert!(
+        matches!(&sweep.cells[0].status, CellStatus::Failed(line) if line.contains("sapnet sweep prepare")),
+        "{:?}",
+        sweep.cells[0].status
+    );
+    let values = comparisons(&dir, &sweep.done()).unwrap();
+    assert_eq!(before, listing(&dir), "reading the sweep changed it");
+
+    // What `sweep merge` writes: the same groups, the same numbers.
+    let merge = run(&["sweep".as_ref(), "merge".as_ref(), dir.as_os_str()]);
+    assert!(merge.status.success(), "{}", stderr(&merge));
+    let mut reader = csv::Reader::from_path(dir.join("merged/comparison.csv")).unwrap();
+    let header = reader.headers().unwrap().clone();
+    let rows: Vec<csv::StringRecord> = reader.records().map(Result::unwrap).collect();
+    let column = |row: &csv::StringRecord, name: &str| -> String {
+        row[header.iter().position(|h| h == name).unwrap()].to_string()
+    };
+    let mut compared = 0;
+    for value in &values {
+        for method in &value.report.comparison {
+            let row = rows
+                .iter()
+                .find(|r| {
+                    column(r, "axis") == value.axis
+                        && column(r, "value") == value.value
+                        && column(r, "method") == method.method
+                })
+                .unwrap_or_else(|| panic!("{} = {} {}", value.axis, value.value, method.method));
+            assert_eq!(column(row, "cells"), value.cells.to_string());
+            for (name, estimate) in [
+                ("return_iqm", method.training.map(|a| a.iqm)),
+                ("test_iqm", method.test.map(|a| a.iqm)),
+            ] {
+                let e = estimate.unwrap();
+                assert_eq!(column(row, name), format!("{:?}", e.point));
+                assert_eq!(column(row, &format!("{name}_lo")), format!("{:?}", e.lo));
+                assert_eq!(column(row, &format!("{name}_hi")), format!("{:?}", e.hi));
+            }
+            compared += 1;
+        }
+    }
+    assert_eq!(compared, rows.len(), "every merged row is a value's method");
+
+    // The view, its paths and the failed cell's error (a temporary path) made steady.
+    let mut bench = SweepBench::new(sweep, values);
+    bench.sweep.dir = PathBuf::from("sweep");
+    bench.sweep.cells[0].status = CellStatus::Failed(
+        "cell 0000: the source library is missing (sapnet sweep prepare)".into(),
+    );
+    for size in SIZES {
+        let (w, h) = size;
+        let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
+        terminal
+            .draw(|f| sapnet::tui::workbench::sweep_view::draw(f, &bench, Theme::plain()))
+            .unwrap();
+        let drawn = text(&terminal);
+        let first = &bench.values[0];
+        let sapnet_row = &first.report.comparison[0];
+        let shown = sapnet::report::comparison::interval(&sapnet_row.training.unwrap().iqm, 1);
+        assert!(drawn.contains(&shown), "{shown} in\n{drawn}");
+        insta::assert_snapshot!(format!("workbench_sweep_{w}x{h}"), terminal.backend());
     }
 }

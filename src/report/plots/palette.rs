@@ -133,6 +133,16 @@ pub(super) fn method_pens(kinds: &[MethodKind]) -> Vec<Pen> {
         .collect()
 }
 
+/// The colour of each method of these kinds, in order, as the plots draw it (8-bit RGB):
+/// the terminal's views use the same, so that a method reads the same on screen and in
+/// the PNG files.
+pub fn method_colours(kinds: &[MethodKind]) -> Vec<(u8, u8, u8)> {
+    method_pens(kinds)
+        .into_iter()
+        .map(|pen| (pen.colour.0, pen.colour.1, pen.colour.2))
+        .collect()
+}
+
 /// More methods than this in one chart and the chart draws most of them faint.
 pub(super) const MANY: usize = 6;
 

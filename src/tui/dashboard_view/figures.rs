@@ -39,6 +39,20 @@ pub(super) fn count(n: u64) -> String {
     }
 }
 
+/// The score columns that count steps (random's `acted`, GPI's `wins`, the Q-switch's
+/// `followed`): whole numbers, shown without decimals.
+const COUNTED: [&str; 3] = ["acted", "wins", "followed"];
+
+/// A score in the table's nine characters: a count as a whole number (`47262`; `−1200`
+/// less the highest, with `v`), anything else as [`format_activation`].
+pub(super) fn format_score(score_name: &str, a: f64) -> String {
+    if COUNTED.contains(&score_name) {
+        format!("{a:.0}").replace('-', "−")
+    } else {
+        format_activation(a)
+    }
+}
+
 /// An activation in the table's nine characters: three decimals, or an exponent from
 /// 100000 on.
 pub(super) fn format_activation(a: f64) -> String {
@@ -51,7 +65,18 @@ pub(super) fn format_activation(a: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{count, sparkline};
+    use super::{count, format_score, sparkline};
+
+    #[test]
+    fn counted_scores_have_no_decimals_and_the_others_three() {
+        assert_eq!(format_score("wins", 47262.0), "47262");
+        assert_eq!(format_score("followed", 143_250.0), "143250");
+        assert_eq!(format_score("acted", 0.0), "0");
+        // `v`: a count less the highest.
+        assert_eq!(format_score("wins", -1200.0), "−1200");
+        assert_eq!(format_score("A", 12.34567), "12.346");
+        assert_eq!(format_score("w̄", 0.25), "0.250");
+    }
 
     #[test]
     fn sparklines_share_one_scale() {

@@ -7,7 +7,8 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Cell, Row, Table};
 use ratatui::Frame;
 
-use super::figures::{count, format_activation, sparkline, thousands};
+use super::figures::{count, format_score, sparkline};
+use crate::reuse::lock_in;
 use crate::teach::labels;
 use crate::tui::dashboard::{Dashboard, LibraryView, Mode, HISTORY};
 use crate::tui::graph_view::{self, node_style};
@@ -47,27 +48,25 @@ pub(super) fn title(dashboard: &Dashboard, width: u16) -> String {
             let mean = record.test_returns.iter().sum::<f64>() / record.test_returns.len() as f64;
             format!("policies · chosen {} · test mean {mean:.1}", chosen.name)
         }
-        None => match dashboard
-            .library
-            .as_ref()
-            .and_then(|v| Some((v, v.locked?)))
-        {
-            // The softmax has collapsed: say so, and since when if it fits.
-            Some((view, (i, since))) => {
-                let name = &view.policies[i].name;
-                let full = format!(
-                    "policies · P({name}) > {} since step {}",
-                    crate::trainer::LOCK_IN,
-                    thousands(since)
-                );
-                if full.chars().count() + 4 <= usize::from(width) {
-                    full
-                } else {
-                    format!("policies · P({name}) > {}", crate::trainer::LOCK_IN)
-                }
+        // Lock-in as the table and comparison.csv say it ([`lock_in`]), where it fits.
+        None => {
+            let measured = dashboard
+                .main_run()
+                .is_some_and(|r| lock_in::measured(r.method.kind));
+            let locked = dashboard.library.as_ref().and_then(|view| {
+                let (i, since) = view.locked?;
+                Some((view.policies.get(i)?.name.as_str(), since))
+            });
+            let full = format!(
+                "policies · lock-in step {}",
+                lock_in::of_run(measured, locked)
+            );
+            if full.chars().count() + 4 <= usize::from(width) {
+                full
+            } else {
+                "policies".to_string()
             }
-            None => "policies".to_string(),
-        },
+        }
     }
 }
 
@@ -160,11 +159,10 @@ pub(super) fn draw(
                     p.description.hidden.len().to_string()
                 }));
             }
-            cells.push(Cell::from(format_activation(if relative {
-                a - highest
-            } else {
-                a
-            })));
+            cells.push(Cell::from(format_score(
+                view.score_name,
+                if relative { a - highest } else { a },
+            )));
             cells.push(Cell::from(probability_bar(probability, bar_width)));
             cells.push(Cell::from(count(view.selections[i])));
             if full {

@@ -49,17 +49,42 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
         );
         return;
     };
+    let [said, table, pairs] = areas(area, workbench);
+    frame.render_widget(Paragraph::new(coverage(workbench)), said);
+    draw_table(frame, table, workbench, report, theme);
+    draw_pairs(frame, pairs, workbench, report, theme);
+}
+
+/// The line saying over how many runs, the table, the pairs.
+fn areas(area: Rect, workbench: &Workbench) -> [Rect; 3] {
     let methods = workbench.methods() as u16;
     let table_height = (methods + 5).min(area.height.saturating_sub(1 + PAIRS_LINES));
-    let [said, table, pairs] = Layout::vertical([
+    Layout::vertical([
         Constraint::Length(1),
         Constraint::Length(table_height),
         Constraint::Fill(1),
     ])
-    .areas(area);
-    frame.render_widget(Paragraph::new(coverage(workbench)), said);
-    draw_table(frame, table, workbench, report, theme);
-    draw_pairs(frame, pairs, workbench, report, theme);
+    .areas(area)
+}
+
+/// The methods the table's inside `inside` shows, below its header line and above its
+/// axis line.
+fn window(inside: Rect, workbench: &Workbench) -> RowWindow {
+    let room = usize::from(inside.height).saturating_sub(2);
+    RowWindow::new(workbench.methods(), room, [workbench.method_cursor])
+}
+
+/// The method whose row of the table is at (`column`, `row`) of the screen, the view
+/// drawn in `area`: what a click picks.
+pub fn method_at(area: Rect, workbench: &Workbench, column: u16, row: u16) -> Option<usize> {
+    workbench.report.as_ref()?;
+    let [_, table, _] = areas(area, workbench);
+    let inside = inner(table);
+    let first = inside.y + 1;
+    if !(inside.x..inside.x + inside.width).contains(&column) || row < first {
+        return None;
+    }
+    window(inside, workbench).row_at(usize::from(row - first))
 }
 
 /// Over how many runs: every planned one, or (partial) the finished ones so far.
@@ -208,8 +233,7 @@ fn draw_table(frame: &mut Frame, area: Rect, workbench: &Workbench, report: &Rep
         header.push(Span::raw(format!("{} ", fit("", whisker_width))));
     }
     let mut lines = vec![Line::from(header).style(theme.dim())];
-    let room = usize::from(inside.height).saturating_sub(2);
-    let window = RowWindow::new(labels.len(), room, [workbench.method_cursor]);
+    let window = window(inside, workbench);
     let styles = method_styles(folder, theme);
     for i in window.rows() {
         let picked = i == workbench.method_cursor;

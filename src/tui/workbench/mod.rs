@@ -24,7 +24,10 @@
 
 pub mod cells;
 pub mod comparison_view;
+pub mod curves;
+pub mod curves_view;
 pub mod live;
+pub mod mouse;
 pub mod picker;
 pub mod protocol;
 pub mod runs_view;
@@ -32,6 +35,8 @@ pub mod session;
 pub mod session_view;
 pub mod state;
 mod stderr_capture;
+pub mod sweep;
+pub mod sweep_view;
 pub mod view;
 
 use std::path::Path;
@@ -98,7 +103,13 @@ pub fn run(dir: &Path) -> Result<()> {
             continue;
         }
         dirty = true;
-        let term::Event::Key(key) = term::read().context("reading the keyboard")? else {
+        let event = term::read().context("reading the keyboard")?;
+        if let term::Event::Mouse(mouse) = event {
+            let size = terminal.size().context("reading the terminal's size")?;
+            mouse::on_mouse(&mut workbench, mouse, size.into());
+            continue;
+        }
+        let term::Event::Key(key) = event else {
             continue; // a resize redraws
         };
         if key.kind == KeyEventKind::Press && workbench.on_key(key) == Action::Quit {

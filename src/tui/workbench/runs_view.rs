@@ -83,12 +83,7 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
         fit("source", source_width),
     );
     let mut lines = vec![Line::styled(header, theme.dim())];
-    // A line under the rows says what they hide, when they do not all fit.
-    let mut room = usize::from(inside.height) - 1;
-    if folder.runs.len() > room {
-        room = room.saturating_sub(1);
-    }
-    let rows = RowWindow::new(folder.runs.len(), room, [workbench.run_cursor]);
+    let rows = run_window(inside, workbench);
     let styles = method_styles(folder, theme);
     for i in rows.rows() {
         let run = &folder.runs[i];
@@ -149,6 +144,28 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
         ));
     }
     frame.render_widget(Paragraph::new(lines), inside);
+}
+
+/// The runs shown in the panel's inside `inside`, below its header line; a line under them
+/// says what they hide, when they do not all fit.
+fn run_window(inside: Rect, workbench: &Workbench) -> RowWindow {
+    let runs = workbench.folder.runs.len();
+    let mut room = usize::from(inside.height).saturating_sub(1);
+    if runs > room {
+        room = room.saturating_sub(1);
+    }
+    RowWindow::new(runs, room, [workbench.run_cursor])
+}
+
+/// The run whose line is at (`column`, `row`) of the screen, the view drawn in `area`: what
+/// a click picks.
+pub fn run_at(area: Rect, workbench: &Workbench, column: u16, row: u16) -> Option<usize> {
+    let inside = inner(area);
+    let first = inside.y + 1;
+    if !(inside.x..inside.x + inside.width).contains(&column) || row < first {
+        return None;
+    }
+    run_window(inside, workbench).row_at(usize::from(row - first))
 }
 
 /// `done 3 · running 2 · queued 6` (only the statuses some run has).

@@ -14,16 +14,19 @@ pub enum View {
     Runs,
     /// The methods side by side: aggregates with intervals, whiskers, pairs.
     Comparison,
+    /// Each method's learning curve over its runs, with its band ([`super::curves`]).
+    Curves,
 }
 
 impl View {
-    pub const ALL: [View; 2] = [View::Runs, View::Comparison];
+    pub const ALL: [View; 3] = [View::Runs, View::Comparison, View::Curves];
 
     /// The key that shows it, and its name in the status bar.
     pub fn key(self) -> (char, &'static str) {
         match self {
             View::Runs => ('r', "runs"),
             View::Comparison => ('c', "comparison"),
+            View::Curves => ('v', "curves"),
         }
     }
 }
@@ -111,6 +114,8 @@ pub struct Workbench {
     /// status bar, and for the overlay; the session handles them before the views do.
     pub host_bar: Vec<(&'static str, &'static str)>,
     pub host_overlay: Vec<(&'static str, &'static str)>,
+    /// The Curves view's choices.
+    pub curves: super::curves::Curves,
 }
 
 impl Workbench {
@@ -128,6 +133,7 @@ impl Workbench {
             read_error: None,
             host_bar: Vec::new(),
             host_overlay: Vec::new(),
+            curves: super::curves::Curves::default(),
         }
     }
 
@@ -162,11 +168,15 @@ impl Workbench {
             self.help = false;
             return Action::None;
         }
+        if self.view == View::Curves && self.curves.on_key(key, &self.folder) {
+            return Action::None;
+        }
         match key.code {
             KeyCode::Esc => return Action::Quit,
             KeyCode::Char('?') => self.help = true,
             KeyCode::Char('r') => self.view = View::Runs,
             KeyCode::Char('c') => self.view = View::Comparison,
+            KeyCode::Char('v') => self.view = View::Curves,
             KeyCode::Char('a') if self.view == View::Comparison => {
                 self.aggregate = self.aggregate.next();
             }
@@ -190,6 +200,7 @@ impl Workbench {
         let (cursor, rows) = match self.view {
             View::Runs => (&mut self.run_cursor, self.folder.runs.len()),
             View::Comparison => (&mut self.method_cursor, methods),
+            View::Curves => return,
         };
         let last = rows.saturating_sub(1) as isize;
         *cursor = (*cursor as isize + by).clamp(0, last) as usize;
@@ -220,6 +231,7 @@ impl Workbench {
                 "Comparison: the pairs of the other score (training return or test score)",
             ),
         ];
+        keys.extend(super::curves::KEYS);
         keys.extend(self.host_overlay.iter().copied());
         keys.push(("?", "every key"));
         keys.push(if self.host_overlay.is_empty() {
@@ -242,6 +254,7 @@ impl Workbench {
         let own: &[(&str, &str)] = match self.view {
             View::Runs => &[("↑↓", "run")],
             View::Comparison => &[("↑↓", "method"), ("a", "aggregate"), ("s", "score")],
+            View::Curves => &super::curves::COMMANDS,
         };
         let mut keys = own.to_vec();
         keys.extend(self.host_bar.iter().copied());

@@ -9,7 +9,7 @@ use ratatui::widgets::Paragraph;
 use ratatui::Frame;
 
 use super::state::{View, Workbench};
-use super::{comparison_view, runs_view};
+use super::{comparison_view, curves_view, runs_view};
 use crate::results::folder_state::FolderState;
 use crate::results::Status;
 use crate::tui::screen;
@@ -33,6 +33,7 @@ pub fn draw(frame: &mut Frame, workbench: &Workbench, theme: Theme) {
     match workbench.view {
         View::Runs => runs_view::draw(frame, body, workbench, theme),
         View::Comparison => comparison_view::draw(frame, body, workbench, theme),
+        View::Curves => curves_view::draw(frame, body, workbench, theme),
     }
     frame.render_widget(Paragraph::new(status_line(workbench, theme)), status);
     if workbench.help {

@@ -1,0 +1,457 @@
+//! The Curves view: every method's learning curve across its runs — the IQM or mean over
+//! runs of each run's moving average (MA10), with its 95% bootstrap band — in the plots'
+//! colour of each method (without colour: a marker of its own along its line), beside a
+//! legend that switches methods on and off and gives each one's value where the view
+//! ends. The points are `sample_efficiency.csv`'s ([`super::curves`]). `Enter` shows the
+//! picked method's runs one by one, each over its method's band.
+
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::canvas::{Canvas, Context, Line as Segment, Points};
+use ratatui::widgets::{Block, Paragraph};
+use ratatui::Frame;
+
+use super::cells::{fit, inner};
+use super::curves::{planned, runs_of, Curves};
+use super::state::Workbench;
+use crate::report::moving_average;
+use crate::report::plots::palette::method_colours;
+use crate::report::sample_efficiency::EfficiencyPoint;
+use crate::results::folder_state::FolderState;
+use crate::stats::Estimate;
+use crate::tui::theme::Theme;
+
+/// Without colour, each method's line carries its own marker (the legend's too).
+pub const MARKERS: [&str; 10] = ["●", "▲", "■", "◆", "✚", "○", "△", "□", "◇", "×"];
+
+/// The y axis's labels' width.
+const Y_LABELS: u16 = 7;
+
+/// A method on screen: its place in the protocol, label, colour and curve.
+struct Shown {
+    index: usize,
+    label: String,
+    colour: Color,
+    points: Vec<EfficiencyPoint>,
+}
+
+pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) {
+    let folder = &workbench.folder;
+    let curves = &workbench.curves;
+    let kinds: Vec<_> = folder
+        .config
+        .protocol
+        .methods
+        .iter()
+        .map(|m| m.kind())
+        .collect();
+    let colours = method_colours(&kinds);
+    let methods: Vec<Shown> = folder
+        .config
+        .protocol
+        .methods
+        .iter()
+        .enumerate()
+        .map(|(index, method)| {
+            let (r, g, b) = colours[index];
+            Shown {
+                index,
+                label: method.label(),
+                colour: Color::Rgb(r, g, b),
+                points: curves.curve(folder, index),
+            }
+        })
+        .collect();
+    let range = curves.range(folder);
+    let block = Block::bordered().title(title(folder, curves, range, theme));
+    frame.render_widget(block, area);
+    let inside = inner(area);
+    if inside.height < 4 || inside.width < 30 {
+        return;
+    }
+    let label_width = label_width(folder);
+    let [chart, legend] = areas(inside, label_width);
+    match curves.run {
+        Some(k) => {
+            let Some(method) = methods.get(curves.cursor) else {
+                return;
+            };
+            let runs = runs_of(folder, method.index);
+            let k = k.min(runs.len().saturating_sub(1));
+            let window = folder.config.protocol.moving_average;
+            let averages: Vec<(f64, f64)> = runs
+                .get(k)
+                .map(|r| moving_average(&r.returns, window))
+                .unwrap_or_default()
+                .into_iter()
+                .enumerate()
+                .map(|(i, a)| ((i + window) as f64, a))
+                .collect();
+            draw_chart(frame, chart, (&[method], &averages), curves, range, theme);
+            draw_runs_legend(frame, legend, folder, method, k, theme);
+        }
+        None => {
+            let shown: Vec<&Shown> = methods
+                .iter()
+                .filter(|m| !curves.hidden.contains(&m.index))
+                .collect();
+            // The picked method drawn last, over the others.
+            let ordered: Vec<&Shown> = shown
+                .iter()
+                .filter(|m| m.index != curves.cursor)
+                .chain(shown.iter().filter(|m| m.index == curves.cursor))
+                .copied()
+                .collect();
+            draw_chart(frame, chart, (&ordered, &[]), curves, range, theme);
+            draw_legend(frame, legend, &methods, curves, range, label_width, theme);
+        }
+    }
+}
+
+/// The labels' width in the legend.
+fn label_width(folder: &FolderState) -> usize {
+    folder
+        .config
+        .protocol
+        .methods
+        .iter()
+        .map(|m| m.label().chars().count())
+        .max()
+        .unwrap_or(6)
+        .clamp(6, 22)
+}
+
+/// The chart and, right of it, the legend: toggle, marker, label and the value with its
+/// interval where it fits.
+fn areas(inside: Rect, label_width: usize) -> [Rect; 2] {
+    let legend_width = (label_width as u16 + 27).min(inside.width / 2);
+    let [chart, _, legend] = Layout::horizontal([
+        Constraint::Fill(1),
+        Constraint::Length(1),
+        Constraint::Length(legend_width),
+    ])
+    .areas(inside);
+    [chart, legend]
+}
+
+/// The method whose legend line is at (`column`, `row`) of the screen, the view drawn in
+/// `area` with every method (not one method's runs): what a click shows or hides.
+pub fn legend_method_at(area: Rect, workbench: &Workbench, column: u16, row: u16) -> Option<usize> {
+    if workbench.curves.run.is_some() {
+        return None;
+    }
+    let inside = inner(area);
+    let [_, legend] = areas(inside, label_width(&workbench.folder));
+    let first = legend.y + 1;
+    if !(legend.x..legend.x + legend.width).contains(&column) || row < first {
+        return None;
+    }
+    let index = usize::from(row - first);
+    (index < workbench.methods()).then_some(index)
+}
+
+/// What the view shows, over how many runs, and where on the episodes.
+fn title(
+    folder: &FolderState,
+    curves: &Curves,
+    (from, to): (f64, f64),
+    theme: Theme,
+) -> Line<'static> {
+    let window = folder.config.protocol.moving_average;
+    let (finished, planned_runs) = (folder.finished_runs(), folder.runs.len());
+    let over = if finished == planned_runs {
+        format!("all {planned_runs} runs")
+    } else {
+        format!("partial: {finished} of {planned_runs} runs finished, running ones so far")
+    };
+    let zoom = if curves.zoom.is_some() {
+        format!(" · episodes {from:.0}–{to:.0} of {:.0}", planned(folder))
+    } else {
+        String::new()
+    };
+    Line::from(vec![
+        Span::styled(" Curves ", theme.title()),
+        Span::raw(format!(
+            "MA{window} {} over runs, 95% bootstrap band · {over}{zoom} ",
+            curves.statistic.name()
+        )),
+    ])
+}
+
+/// The points of a curve inside the episodes shown.
+fn in_range(
+    points: &[EfficiencyPoint],
+    (from, to): (f64, f64),
+) -> impl Iterator<Item = &EfficiencyPoint> {
+    points
+        .iter()
+        .filter(move |p| (from..=to).contains(&(p.episode as f64)))
+}
+
+/// The curves (each method's line and band; without colour the picked method's band
+/// only, and markers along every line), and one run's MA when its runs are read one by one.
+fn draw_chart(
+    frame: &mut Frame,
+    area: Rect,
+    (methods, run): (&[&Shown], &[(f64, f64)]),
+    curves: &Curves,
+    range: (f64, f64),
+    theme: Theme,
+) {
+    let (from, to) = range;
+    let statistic = curves.statistic;
+    let run: Vec<(f64, f64)> = run
+        .iter()
+        .copied()
+        .filter(|&(x, _)| (from..=to).contains(&x))
+        .collect();
+    let values = methods
+        .iter()
+        .flat_map(|m| in_range(&m.points, range).map(|p| statistic.of(p)))
+        .flat_map(|e| [e.lo, e.hi])
+        .chain(run.iter().map(|&(_, y)| y));
+    let (low, high) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
+        (lo.min(y), hi.max(y))
+    });
+    if !low.is_finite() {
+        frame.render_widget(
+            Paragraph::new(Line::styled(
+                "No curve to draw: no shown method has a run with episodes here.",
+                theme.dim(),
+            )),
+            area,
+        );
+        return;
+    }
+    let (low, high) = if high > low {
+        (low, high)
+    } else {
+        (low - 1.0, high + 1.0)
+    };
+    let [left, plot] =
+        Layout::horizontal([Constraint::Length(Y_LABELS), Constraint::Fill(1)]).areas(area);
+    let [plot, x_labels] =
+        Layout::vertical([Constraint::Fill(1), Constraint::Length(1)]).areas(plot);
+    // The y axis: its top, middle and bottom values.
+    let mut y_lines = vec![Line::from(""); usize::from(plot.height)];
+    let last = y_lines.len().saturating_sub(1);
+    for (row, value) in [(0, high), (last / 2, (low + high) / 2.0), (last, low)] {
+        y_lines[row] = Line::styled(format!("{value:>6.0} "), theme.dim());
+    }
+    frame.render_widget(Paragraph::new(y_lines), left);
+    let (first, end) = (format!("{from:.0}"), format!("episode {to:.0}"));
+    let gap = usize::from(x_labels.width).saturating_sub(first.len() + end.len());
+    frame.render_widget(
+        Paragraph::new(Line::styled(
+            format!("{first}{}{end}", " ".repeat(gap)),
+            theme.dim(),
+        )),
+        x_labels,
+    );
+    let picked = curves.cursor;
+    let colour = |m: &Shown| if theme.color { m.colour } else { Color::Reset };
+    // Without colour a marker every few columns along each line tells the lines apart.
+    let every = (to - from) / f64::from(plot.width.max(1)) * 8.0;
+    let canvas = Canvas::default()
+        .x_bounds([from, to])
+        .y_bounds([low, high])
+        .marker(ratatui::symbols::Marker::Braille)
+        .paint(|ctx: &mut Context| {
+            for m in methods {
+                let estimates: Vec<(f64, Estimate)> = in_range(&m.points, range)
+                    .map(|p| (p.episode as f64, statistic.of(p)))
+                    .collect();
+                if theme.color || m.index == picked {
+                    // The band's edges, dotted.
+                    let edges: Vec<(f64, f64)> = estimates
+                        .iter()
+                        .step_by(2)
+                        .flat_map(|&(x, e)| [(x, e.lo), (x, e.hi)])
+                        .collect();
+                    ctx.draw(&Points {
+                        coords: &edges,
+                        color: colour(m),
+                    });
+                }
+                for pair in estimates.windows(2) {
+                    ctx.draw(&Segment {
+                        x1: pair[0].0,
+                        y1: pair[0].1.point,
+                        x2: pair[1].0,
+                        y2: pair[1].1.point,
+                        color: colour(m),
+                    });
+                }
+                if estimates.len() == 1 {
+                    let (x, e) = estimates[0];
+                    ctx.draw(&Points {
+                        coords: &[(x, e.point)],
+                        color: colour(m),
+                    });
+                }
+            }
+            for pair in run.windows(2) {
+                ctx.draw(&Segment {
+                    x1: pair[0].0,
+                    y1: pair[0].1,
+                    x2: pair[1].0,
+                    y2: pair[1].1,
+                    color: if theme.color {
+                        Color::White
+                    } else {
+                        Color::Reset
+                    },
+                });
+            }
+            if !theme.color && run.is_empty() {
+                ctx.layer();
+                for m in methods {
+                    let mut next = f64::NEG_INFINITY;
+                    for p in in_range(&m.points, range) {
+                        let x = p.episode as f64;
+                        if x >= next {
+                            ctx.print(x, statistic.of(p).point, MARKERS[m.index % MARKERS.len()]);
+                            next = x + every;
+                        }
+                    }
+                }
+            }
+        });
+    frame.render_widget(canvas, plot);
+}
+
+/// The value of a curve where the view ends: its last point inside the episodes shown.
+pub fn value_at_end(points: &[EfficiencyPoint], range: (f64, f64)) -> Option<&EfficiencyPoint> {
+    in_range(points, range).last()
+}
+
+/// One line per method: shown or not, its colour or marker, its label, and its
+/// statistic with the 95% interval at the view's last episode.
+fn draw_legend(
+    frame: &mut Frame,
+    area: Rect,
+    methods: &[Shown],
+    curves: &Curves,
+    range: (f64, f64),
+    label_width: usize,
+    theme: Theme,
+) {
+    let width = usize::from(area.width);
+    let ends: Vec<Option<&EfficiencyPoint>> = methods
+        .iter()
+        .map(|m| value_at_end(&m.points, range))
+        .collect();
+    let at = ends.iter().flatten().map(|p| p.episode).max();
+    let mut lines = vec![Line::styled(
+        fit(
+            &match at {
+                Some(episode) => format!("{} [95% CI] at ep {episode}", curves.statistic.name()),
+                None => curves.statistic.name().to_string(),
+            },
+            width,
+        ),
+        theme.dim(),
+    )];
+    for (m, end) in methods.iter().zip(&ends) {
+        let on = !curves.hidden.contains(&m.index);
+        let style = if theme.color {
+            Style::new().fg(m.colour)
+        } else {
+            Style::new()
+        };
+        let symbol = if theme.color {
+            "━"
+        } else {
+            MARKERS[m.index % MARKERS.len()]
+        };
+        let value = end.map_or_else(
+            || "-".to_string(),
+            |p| {
+                let e = curves.statistic.of(p);
+                // Returns, to a tenth, as the tables print them.
+                let full = crate::report::comparison::interval(&e, 1);
+                if 6 + label_width + 1 + full.chars().count() <= width {
+                    full
+                } else {
+                    format!("{:.1}", e.point)
+                }
+            },
+        );
+        let picked = m.index == curves.cursor;
+        let row = |s: Style| if picked { s.patch(theme.cursor()) } else { s };
+        let text_style = if on { Style::new() } else { theme.dim() };
+        lines.push(Line::from(vec![
+            Span::styled(if on { "■ " } else { "□ " }, row(text_style)),
+            Span::styled(format!("{symbol} "), row(style)),
+            Span::styled(
+                format!("{} ", fit(&m.label, label_width)),
+                row(text_style.patch(if on { style } else { Style::new() })),
+            ),
+            Span::styled(
+                fit(&value, width.saturating_sub(label_width + 5)),
+                row(text_style),
+            ),
+        ]));
+    }
+    lines.push(Line::styled(
+        fit("space: on/off · ⏎: its runs", width),
+        theme.dim(),
+    ));
+    frame.render_widget(Paragraph::new(lines), area);
+}
+
+/// The picked method's runs, the one shown marked, each with its status and last MA.
+fn draw_runs_legend(
+    frame: &mut Frame,
+    area: Rect,
+    folder: &FolderState,
+    method: &Shown,
+    shown: usize,
+    theme: Theme,
+) {
+    let width = usize::from(area.width);
+    let window = folder.config.protocol.moving_average;
+    let runs = runs_of(folder, method.index);
+    let style = if theme.color {
+        Style::new().fg(method.colour)
+    } else {
+        Style::new()
+    };
+    let mut lines = vec![
+        Line::styled(
+            fit(&method.label, width),
+            style.add_modifier(Modifier::BOLD),
+        ),
+        Line::styled(
+            fit(&format!("run  status   episodes  MA{window}"), width),
+            theme.dim(),
+        ),
+    ];
+    for (k, run) in runs.iter().enumerate() {
+        let last = moving_average(&run.returns, window)
+            .last()
+            .map_or_else(|| "-".to_string(), |a| format!("{a:.1}"));
+        let text = format!(
+            "{} {} {} {}",
+            fit(&run.run.to_string(), 4),
+            fit(run.status.name(), 8),
+            fit(&run.episodes().to_string(), 9),
+            last
+        );
+        let line_style = if k == shown {
+            theme.cursor()
+        } else {
+            Style::new()
+        };
+        lines.push(Line::styled(fit(&text, width), line_style));
+    }
+    if runs.is_empty() {
+        lines.push(Line::styled("no run with episodes yet", theme.dim()));
+    }
+    lines.push(Line::styled(
+        fit("[ ]: run · ⏎: every method", width),
+        theme.dim(),
+    ));
+    frame.render_widget(Paragraph::new(lines), area);
+}

@@ -1,0 +1,365 @@
+//! `sapnet open SWEEP_DIR`: a sweep folder (`sapnet sweep plan`) in the Sweep view — its
+//! cells (queued, running, done, failed) and, per axis value, the comparison of its
+//! finished cells, made by the code `sweep merge` writes `merged/comparison.csv` with
+//! ([`crate::sweep::merge::groups`], [`crate::sweep::merge::value_report`]).
+//!
+//! Read only, as any folder from elsewhere: the manifest, each cell's state as `sweep
+//! status` reads it, a running cell's process from its protocol's lock (never taken) and
+//! its progress from its partial results, each done cell's records as `sweep merge` reads
+//! them. A thread reads the folder again every [`super::REFRESH`] and makes the
+//! comparisons again when the set of done cells changed.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+
+use anyhow::{Context, Result};
+use crossterm::event::{self as term, KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
+
+use crate::folder_lock::{self, Holder};
+use crate::report::Report;
+use crate::results::folder_state::FolderReader;
+use crate::sweep::status::{self, CellState};
+use crate::sweep::{cell_partial, cell_results, grid, merge, Manifest};
+use crate::tui::theme::Theme;
+
+/// Whether `dir` is a sweep folder: it holds a manifest, `sweep.ron`.
+pub fn is_sweep(dir: &Path) -> bool {
+    std::fs::symlink_metadata(dir.join("sweep.ron")).is_ok_and(|m| m.is_file())
+}
+
+/// Where a cell stands, as the Sweep view says it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CellStatus {
+    /// Not started; a live process runs the sweep's cells.
+    Queued,
+    /// Not started, and no process runs any cell now.
+    NotRun,
+    /// Its process holds its protocol's lock.
+    Running(Holder),
+    /// A partial result no process writes: killed (`sweep run` runs it again).
+    Stopped,
+    Done,
+    /// Its last attempt failed, with the error's last line.
+    Failed(String),
+}
+
+impl CellStatus {
+    pub fn name(&self) -> &'static str {
+        match self {
+            CellStatus::Queued => "queued",
+            CellStatus::NotRun => "not run",
+            CellStatus::Running(_) => "running",
+            CellStatus::Stopped => "stopped",
+            CellStatus::Done => "done",
+            CellStatus::Failed(_) => "failed",
+        }
+    }
+}
+
+/// One cell of the sweep.
+#[derive(Debug, Clone)]
+pub struct CellRow {
+    pub id: usize,
+    /// Its axis values (`sapnet.temperature=0.5, seed=1`).
+    pub axes: String,
+    pub status: CellStatus,
+    /// A running cell's runs finished of all, from its partial results.
+    pub progress: Option<(usize, usize)>,
+}
+
+/// One axis value's comparison of its finished cells.
+#[derive(Debug, Clone)]
+pub struct ValueComparison {
+    pub axis: String,
+    pub value: String,
+    /// Finished cells with that value.
+    pub cells: usize,
+    pub report: Report,
+}
+
+/// A sweep folder as read at one moment.
+#[derive(Debug, Clone)]
+pub struct SweepState {
+    pub dir: PathBuf,
+    pub axes: Vec<String>,
+    pub cells: Vec<CellRow>,
+}
+
+impl SweepState {
+    /// Reads the manifest and every cell's state; refused (naming the file) when the
+    /// manifest cannot be read.
+    pub fn read(dir: &Path) -> Result<Self> {
+        let manifest = Manifest::read(dir)?;
+        let mut cells = Vec::new();
+        for cell in &manifest.cells {
+            let partial = cell_partial(dir, cell.id);
+            let (status, progress) = match status::state(dir, cell.id) {
+                CellState::Done => (CellStatus::Done, None),
+                CellState::Failed(line) => (CellStatus::Failed(line), None),
+                CellState::Missing => (CellStatus::NotRun, None),
+                CellState::Running => match folder_lock::holder(&partial)? {
+                    Some(holder) => {
+                        // Its progress, if its summary is there yet (it is written first).
+                        let progress = FolderReader::new(&partial)
+                            .read()
+                            .ok()
+                            .map(|f| (f.finished_runs(), f.runs.len()));
+                        (CellStatus::Running(holder), progress)
+                    }
+                    None => (CellStatus::Stopped, None),
+                },
+            };
+            cells.push(CellRow {
+                id: cell.id,
+                axes: grid::describe(&cell.axes),
+                status,
+                progress,
+            });
+        }
+        let live = cells
+            .iter()
+            .any(|c| matches!(c.status, CellStatus::Running(_)));
+        if live {
+            for cell in &mut cells {
+                if cell.status == CellStatus::NotRun {
+                    cell.status = CellStatus::Queued;
+                }
+            }
+        }
+        let axes = manifest
+            .cells
+            .first()
+            .map(|c| c.axes.iter().map(|(p, _)| p.clone()).collect())
+            .unwrap_or_default();
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            axes,
+            cells,
+        })
+    }
+
+    /// The done cells' ids: the comparisons change only when these do.
+    pub fn done(&self) -> Vec<usize> {
+        self.cells
+            .iter()
+            .filter(|c| c.status == CellStatus::Done)
+            .map(|c| c.id)
+            .collect()
+    }
+
+    pub fn count(&self, name: &str) -> usize {
+        self.cells
+            .iter()
+            .filter(|c| c.status.name() == name)
+            .count()
+    }
+}
+
+/// Per axis value, the comparison of its done cells, as `sweep merge` makes it.
+pub fn comparisons(dir: &Path, done: &[usize]) -> Result<Vec<ValueComparison>> {
+    let manifest = Manifest::read(dir)?;
+    let mut read = Vec::new();
+    for cell in manifest.cells.iter().filter(|c| done.contains(&c.id)) {
+        let results = crate::results::read_results(&cell_results(dir, cell.id))
+            .with_context(|| format!("reading cell {}", crate::sweep::cell_name(cell.id)))?;
+        read.push((cell, results));
+    }
+    let axes: Vec<String> = manifest
+        .cells
+        .first()
+        .map(|c| c.axes.iter().map(|(p, _)| p.clone()).collect())
+        .unwrap_or_default();
+    let refs: Vec<(&crate::sweep::CellEntry, &crate::results::Results)> =
+        read.iter().map(|(c, r)| (*c, r)).collect();
+    Ok(merge::groups(&axes, &refs)
+        .into_iter()
+        .map(|(axis, value, group)| {
+            let (report, _) = merge::value_report(&axis, &value, &group);
+            ValueComparison {
+                cells: group.len(),
+                axis,
+                value,
+                report,
+            }
+        })
+        .collect())
+}
+
+/// Which of the Sweep view's lists the arrows move in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Focus {
+    Cells,
+    Values,
+}
+
+/// The Sweep view's state: the folder as last read, its comparisons, what is picked.
+pub struct SweepBench {
+    pub sweep: SweepState,
+    pub values: Vec<ValueComparison>,
+    /// The comparisons of newly done cells are being made.
+    pub computing: bool,
+    pub focus: Focus,
+    pub cell_cursor: usize,
+    pub value_cursor: usize,
+    pub help: bool,
+    /// The last refresh's failure, shown until a read succeeds again.
+    pub read_error: Option<String>,
+}
+
+impl SweepBench {
+    pub fn new(sweep: SweepState, values: Vec<ValueComparison>) -> Self {
+        Self {
+            sweep,
+            values,
+            computing: false,
+            focus: Focus::Values,
+            cell_cursor: 0,
+            value_cursor: 0,
+            help: false,
+            read_error: None,
+        }
+    }
+
+    pub fn on_key(&mut self, key: KeyEvent) -> bool {
+        let ctrl_c =
+            key.code == KeyCode::Char('c') && key.modifiers.contains(KeyModifiers::CONTROL);
+        if ctrl_c || matches!(key.code, KeyCode::Char('q') | KeyCode::Esc) {
+            return false;
+        }
+        if self.help {
+            self.help = false;
+            return true;
+        }
+        let (cursor, rows) = match self.focus {
+            Focus::Cells => (&mut self.cell_cursor, self.sweep.cells.len()),
+            Focus::Values => (&mut self.value_cursor, self.values.len()),
+        };
+        let last = rows.saturating_sub(1);
+        match key.code {
+            KeyCode::Char('?') => self.help = true,
+            KeyCode::Tab | KeyCode::BackTab => {
+                self.focus = match self.focus {
+                    Focus::Cells => Focus::Values,
+                    Focus::Values => Focus::Cells,
+                };
+            }
+            KeyCode::Up | KeyCode::Char('k') => *cursor = cursor.saturating_sub(1),
+            KeyCode::Down | KeyCode::Char('j') => *cursor = (*cursor + 1).min(last),
+            KeyCode::PageUp => *cursor = cursor.saturating_sub(10),
+            KeyCode::PageDown => *cursor = (*cursor + 10).min(last),
+            _ => {}
+        }
+        true
+    }
+
+    fn refreshed(&mut self, sweep: SweepState, values: Option<Vec<ValueComparison>>) {
+        self.sweep = sweep;
+        if let Some(values) = values {
+            self.values = values;
+            self.computing = false;
+        }
+        self.read_error = None;
+        self.cell_cursor = self
+            .cell_cursor
+            .min(self.sweep.cells.len().saturating_sub(1));
+        self.value_cursor = self.value_cursor.min(self.values.len().saturating_sub(1));
+    }
+
+    /// Every key, for `?`.
+    pub fn keys(&self) -> Vec<(&'static str, &'static str)> {
+        vec![
+            (
+                "Tab",
+                "move between the cells and the axis values (the comparison shown is the \
+                 picked value's)",
+            ),
+            ("↑ ↓ j k, PgUp PgDn", "pick a cell or an axis value"),
+            ("?", "every key"),
+            (
+                "q, Esc, Ctrl-C",
+                "quit (the folder is only read: nothing in it changes)",
+            ),
+        ]
+    }
+}
+
+/// What the reading thread sends: the sweep as read, with the comparisons when its done
+/// cells changed; or why the read failed.
+type Read = Result<(SweepState, Option<Vec<ValueComparison>>), String>;
+
+/// Opens the sweep folder `dir` in the Sweep view until the user quits.
+pub fn run(dir: &Path) -> Result<()> {
+    let sweep = SweepState::read(dir).with_context(|| format!("sapnet open {}", dir.display()))?;
+    // A done cell that cannot be read is refused before the terminal is taken.
+    let done = sweep.done();
+    let values =
+        comparisons(dir, &done).with_context(|| format!("sapnet open {}", dir.display()))?;
+    let mut bench = SweepBench::new(sweep, values);
+    let theme = Theme::from_env();
+    let (reads_tx, reads) = mpsc::channel();
+    let (_stop, stop) = mpsc::channel::<()>();
+    let owned = dir.to_path_buf();
+    std::thread::Builder::new()
+        .name("sapnet open: reading the sweep".into())
+        .spawn(move || read_on(&owned, done, &reads_tx, &stop))
+        .context("starting the thread that reads the sweep")?;
+    let (mut terminal, _guard) = super::super::open_terminal()?;
+    let mut dirty = true;
+    loop {
+        for read in reads.try_iter() {
+            match read {
+                Ok((sweep, values)) => bench.refreshed(sweep, values),
+                Err(error) => bench.read_error = Some(error),
+            }
+            dirty = true;
+        }
+        if crate::signals::received().is_some() {
+            return Ok(());
+        }
+        if dirty {
+            terminal
+                .draw(|frame| super::sweep_view::draw(frame, &bench, theme))
+                .context("drawing the sweep")?;
+            dirty = false;
+        }
+        if !term::poll(super::super::FRAME).context("reading the keyboard")? {
+            continue;
+        }
+        dirty = true;
+        let term::Event::Key(key) = term::read().context("reading the keyboard")? else {
+            continue;
+        };
+        if key.kind == KeyEventKind::Press && !bench.on_key(key) {
+            return Ok(());
+        }
+    }
+}
+
+/// Reads the sweep every [`super::REFRESH`] until `stop` is dropped, with the comparisons
+/// made again when its done cells changed.
+fn read_on(
+    dir: &Path,
+    mut reported: Vec<usize>,
+    reads: &mpsc::Sender<Read>,
+    stop: &mpsc::Receiver<()>,
+) {
+    loop {
+        match stop.recv_timeout(super::REFRESH) {
+            Err(mpsc::RecvTimeoutError::Timeout) => {}
+            _ => return,
+        }
+        let read = SweepState::read(dir).and_then(|sweep| {
+            let done = sweep.done();
+            if done == reported {
+                Ok((sweep, None))
+            } else {
+                let values = comparisons(dir, &done)?;
+                reported = done;
+                Ok((sweep, Some(values)))
+            }
+        });
+        if reads.send(read.map_err(|e| format!("{e:#}"))).is_err() {
+            return;
+        }
+    }
+}

@@ -1,0 +1,332 @@
+//! The Sweep view: a line saying what sweep this is and how far it is; its cells, one a
+//! line (axis values, status, a running cell's process and progress, a failed one's
+//! error); per axis value, how many cells finished, and the picked value's comparison —
+//! each method's IQM of the training return and of the test score with their 95%
+//! intervals, printed as the stdout table prints them; the status bar of its keys.
+
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::style::Style;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Paragraph};
+use ratatui::Frame;
+
+use super::cells::{fit, inner};
+use super::sweep::{CellStatus, Focus, SweepBench};
+use crate::report::comparison::interval;
+use crate::tui::row_window::RowWindow;
+use crate::tui::screen;
+use crate::tui::theme::Theme;
+
+pub fn draw(frame: &mut Frame, bench: &SweepBench, theme: Theme) {
+    let area = frame.area();
+    if screen::too_small(frame, area) {
+        return;
+    }
+    let [header, body, status] = Layout::vertical([
+        Constraint::Length(1),
+        Constraint::Fill(1),
+        Constraint::Length(1),
+    ])
+    .areas(area);
+    frame.render_widget(Paragraph::new(header_line(bench, theme)), header);
+    // The cells take up to two fifths of the screen, their rows and borders.
+    let cells_height = (bench.sweep.cells.len() as u16 + 3).min(body.height * 2 / 5);
+    let [cells, values] =
+        Layout::vertical([Constraint::Length(cells_height), Constraint::Fill(1)]).areas(body);
+    draw_cells(frame, cells, bench, theme);
+    let list_width = bench
+        .values
+        .iter()
+        .map(|v| v.axis.chars().count() + v.value.chars().count() + 14)
+        .max()
+        .unwrap_or(20)
+        .clamp(20, usize::from(values.width / 3)) as u16;
+    let [list, comparison] =
+        Layout::horizontal([Constraint::Length(list_width), Constraint::Fill(1)]).areas(values);
+    draw_values(frame, list, bench, theme);
+    draw_comparison(frame, comparison, bench, theme);
+    frame.render_widget(Paragraph::new(status_line(bench, theme)), status);
+    if bench.help {
+        screen::draw_help(frame, area, &bench.keys(), theme);
+    }
+}
+
+fn header_line(bench: &SweepBench, theme: Theme) -> Line<'static> {
+    let sweep = &bench.sweep;
+    let counts: Vec<String> = ["done", "running", "queued", "stopped", "failed", "not run"]
+        .iter()
+        .filter_map(|name| {
+            let n = sweep.count(name);
+            (n > 0).then(|| format!("{name} {n}"))
+        })
+        .collect();
+    let mut spans = vec![
+        Span::styled(format!(" {} ", sweep.dir.display()), theme.title()),
+        Span::raw(format!(
+            "· sweep of {} cells over {} · {}",
+            sweep.cells.len(),
+            sweep.axes.join(", "),
+            counts.join(" · ")
+        )),
+    ];
+    if let Some(error) = &bench.read_error {
+        spans.push(Span::styled(
+            format!(" · re-reading failed, showing the last read: {error}"),
+            theme.stopped(),
+        ));
+    }
+    Line::from(spans)
+}
+
+fn status_style(status: &CellStatus, theme: Theme) -> Style {
+    match status {
+        CellStatus::Running(_) => theme.active(),
+        CellStatus::Failed(_) | CellStatus::Stopped => theme.stopped(),
+        CellStatus::Queued | CellStatus::NotRun => theme.dim(),
+        CellStatus::Done => Style::new(),
+    }
+}
+
+/// What a cell's line says beside its status.
+fn detail(status: &CellStatus, progress: Option<(usize, usize)>) -> String {
+    match status {
+        CellStatus::Running(holder) => {
+            let mut text = format!("written by {}", holder.describe());
+            if let Some((finished, all)) = progress {
+                text.push_str(&format!(" · {finished} of {all} runs finished"));
+            }
+            text
+        }
+        CellStatus::Failed(line) => line.clone(),
+        CellStatus::Stopped => "no process writes it: `sweep run` runs it again".into(),
+        CellStatus::Done | CellStatus::Queued | CellStatus::NotRun => String::new(),
+    }
+}
+
+fn draw_cells(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) {
+    let focused = bench.focus == Focus::Cells;
+    let title = Line::from(vec![Span::styled(
+        " Cells ",
+        if focused {
+            theme.title().patch(theme.cursor())
+        } else {
+            theme.title()
+        },
+    )]);
+    frame.render_widget(Block::bordered().title(title), area);
+    let inside = inner(area);
+    if inside.height < 2 {
+        return;
+    }
+    let cells = &bench.sweep.cells;
+    let axes_width = cells
+        .iter()
+        .map(|c| c.axes.chars().count())
+        .max()
+        .unwrap_or(4)
+        .clamp(4, usize::from(inside.width) / 2);
+    let width = usize::from(inside.width);
+    let mut lines = vec![Line::styled(
+        fit(
+            &format!("cell {} status   ", fit("axes", axes_width)),
+            width,
+        ),
+        theme.dim(),
+    )];
+    let window = RowWindow::new(
+        cells.len(),
+        usize::from(inside.height) - 1,
+        [bench.cell_cursor],
+    );
+    for i in window.rows() {
+        let cell = &cells[i];
+        let picked = focused && i == bench.cell_cursor;
+        let row = |s: Style| if picked { s.patch(theme.cursor()) } else { s };
+        let lead = format!("{:04} {} ", cell.id, fit(&cell.axes, axes_width));
+        let rest = width.saturating_sub(lead.chars().count() + 9);
+        lines.push(Line::from(vec![
+            Span::styled(lead, row(Style::new())),
+            Span::styled(
+                format!("{} ", fit(cell.status.name(), 8)),
+                row(status_style(&cell.status, theme)),
+            ),
+            Span::styled(
+                fit(&detail(&cell.status, cell.progress), rest),
+                row(Style::new()),
+            ),
+        ]));
+    }
+    frame.render_widget(Paragraph::new(lines), inside);
+}
+
+fn draw_values(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) {
+    let focused = bench.focus == Focus::Values;
+    let title = Span::styled(
+        " Axis values ",
+        if focused {
+            theme.title().patch(theme.cursor())
+        } else {
+            theme.title()
+        },
+    );
+    frame.render_widget(Block::bordered().title(title), area);
+    let inside = inner(area);
+    let width = usize::from(inside.width);
+    if bench.values.is_empty() {
+        frame.render_widget(
+            Paragraph::new(Line::styled(fit("no cell done yet", width), theme.dim())),
+            inside,
+        );
+        return;
+    }
+    let window = RowWindow::new(
+        bench.values.len(),
+        usize::from(inside.height),
+        [bench.value_cursor],
+    );
+    let lines: Vec<Line> = window
+        .rows()
+        .map(|i| {
+            let v = &bench.values[i];
+            let text = fit(
+                &format!("{} = {} ({} cells)", v.axis, v.value, v.cells),
+                width,
+            );
+            if i == bench.value_cursor {
+                Line::styled(text, theme.cursor())
+            } else {
+                Line::raw(text)
+            }
+        })
+        .collect();
+    frame.render_widget(Paragraph::new(lines), inside);
+}
+
+/// The picked value's comparison: each method's runs and IQMs with their intervals.
+fn draw_comparison(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) {
+    let Some(value) = bench.values.get(bench.value_cursor) else {
+        let said = if bench.computing {
+            "Making the comparison of the finished cells…"
+        } else {
+            "The comparison of an axis value is made of its finished cells: it appears when \
+             the first one is done."
+        };
+        frame.render_widget(
+            Paragraph::new(Line::styled(said, theme.dim()))
+                .wrap(ratatui::widgets::Wrap { trim: true })
+                .block(Block::bordered().title(Span::styled(" Comparison ", theme.title()))),
+            area,
+        );
+        return;
+    };
+    let report = &value.report;
+    let title = Line::from(vec![
+        Span::styled(format!(" {} = {} ", value.axis, value.value), theme.title()),
+        Span::raw(format!(
+            "· {} finished cells, as sweep merge's comparison.csv ",
+            value.cells
+        )),
+    ]);
+    frame.render_widget(Block::bordered().title(title), area);
+    let inside = inner(area);
+    let width = usize::from(inside.width);
+    let digits = report.units.digits();
+    let method_width = report
+        .comparison
+        .iter()
+        .map(|c| c.method.chars().count())
+        .max()
+        .unwrap_or(6)
+        .clamp(6, 22);
+    let cell =
+        |a: Option<crate::stats::Estimate>| a.map_or("-".to_string(), |e| interval(&e, digits));
+    let columns: Vec<[String; 3]> = report
+        .comparison
+        .iter()
+        .map(|c| {
+            [
+                c.runs.to_string(),
+                cell(c.training.map(|a| a.iqm)),
+                cell(c.test.map(|a| a.iqm)),
+            ]
+        })
+        .collect();
+    let heads = [
+        "runs".to_string(),
+        "return IQM [95% CI]".to_string(),
+        format!("{} IQM [95% CI]", report.test_score.short()),
+    ];
+    let widths: Vec<usize> = (0..3)
+        .map(|k| {
+            columns
+                .iter()
+                .map(|c| c[k].chars().count())
+                .chain([heads[k].chars().count()])
+                .max()
+                .unwrap_or(4)
+        })
+        .collect();
+    let line = |method: &str, cells: &[String; 3]| {
+        fit(
+            &format!(
+                "{} {} {} {}",
+                fit(method, method_width),
+                fit(&cells[0], widths[0]),
+                fit(&cells[1], widths[1]),
+                fit(&cells[2], widths[2])
+            ),
+            width,
+        )
+    };
+    let mut lines = vec![Line::styled(line("method", &heads), theme.dim())];
+    let room = usize::from(inside.height).saturating_sub(2);
+    for (row, cells) in report.comparison.iter().zip(&columns).take(room) {
+        lines.push(Line::raw(line(&row.method, cells)));
+    }
+    if report.comparison.len() > room {
+        lines.push(Line::styled(
+            format!("… {} more methods", report.comparison.len() - room),
+            theme.dim(),
+        ));
+    } else if report.units == crate::report::Units::Normalised {
+        lines.push(Line::styled(
+            fit(
+                "normalised to [0, 1] by each task's range, stratified by task",
+                width,
+            ),
+            theme.dim(),
+        ));
+    }
+    frame.render_widget(Paragraph::new(lines), inside);
+}
+
+fn status_line(bench: &SweepBench, theme: Theme) -> Line<'static> {
+    let mut spans = vec![Span::raw(" ")];
+    for (key, what) in [
+        (
+            "Tab",
+            if bench.focus == Focus::Cells {
+                "axis values"
+            } else {
+                "cells"
+            },
+        ),
+        (
+            "↑↓",
+            if bench.focus == Focus::Cells {
+                "cell"
+            } else {
+                "value"
+            },
+        ),
+    ] {
+        spans.push(Span::styled(key.to_string(), theme.title()));
+        spans.push(Span::raw(format!(" {what}  ")));
+    }
+    spans.push(Span::styled("│ ", theme.dim()));
+    spans.push(Span::styled("?", theme.title()));
+    spans.push(Span::raw(" keys  "));
+    spans.push(Span::styled("q", theme.title()));
+    spans.push(Span::raw(" quit"));
+    Line::from(spans)
+}
