@@ -56,7 +56,18 @@ pub struct Teach {
     prompt: Option<Prompt>,
     /// Exercise mode (`X`): before each call the student types its ΔA; the score so far.
     exercise: Option<Score>,
+    /// The lesson file this session was opened from, for what the net does not hold: the
+    /// policies' descriptions where categories build M, and what `w` writes back.
+    source: TeachConfig,
+    /// `M`: clicks edit edges — a first click picks a policy, a second joins it to the
+    /// one clicked or cuts their edge.
+    linking: bool,
+    /// In `M` mode, the policy the first click picked.
+    link_from: Option<usize>,
 }
+
+/// The weight of an edge added by the mouse (`M`): Fig. 2's; `5` and `+`/`−` change it.
+pub const MOUSE_EDGE_WEIGHT: f64 = 0.4;
 
 /// An exercise's score: answers right of answers given.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -85,6 +96,10 @@ pub enum PromptKind {
     Save,
     /// Exercise mode: the ΔA the next call deposits, or `stop` where eq. 10 stops it.
     Predict,
+    /// `n` in a lesson of categories: the new policy's category.
+    AddPolicy,
+    /// `C`: the picked policy's new category.
+    SetCategory,
 }
 
 impl PromptKind {
@@ -94,6 +109,8 @@ impl PromptKind {
             PromptKind::AddEdge => "add edge I J W (0-based, as --add-edge):",
             PromptKind::Save => "save the lesson to:",
             PromptKind::Predict => "ΔA of the next call (a number, or stop)?",
+            PromptKind::AddPolicy => "category of the new policy (as --add-policy):",
+            PromptKind::SetCategory => "new category of the picked policy (as --set-category):",
         }
     }
 }
@@ -166,6 +183,40 @@ impl Teach {
             notice: None,
             prompt: None,
             exercise: None,
+            source: TeachConfig::default(),
+            linking: false,
+            link_from: None,
+        }
+    }
+
+    /// The lesson file the session was opened from: its policies' descriptions, where
+    /// categories build M, are kept for the category edits and for `w`.
+    pub fn with_source(mut self, source: TeachConfig) -> Self {
+        self.source = source;
+        self
+    }
+
+    /// Whether the lesson's graph is built from categories (eq. 3–5), so that the policies
+    /// have a category to change.
+    pub fn has_categories(&self) -> bool {
+        !self.source.descriptions.is_empty()
+    }
+
+    /// The picked policy's category (the first prototype's key), where there are categories.
+    pub fn category_of(&self, i: usize) -> Option<String> {
+        let prototype = self.source.first_prototype().ok()?;
+        let policy = self.source.descriptions.get(i)?;
+        Some(super::category::key(&prototype, policy))
+    }
+
+    /// The names as the lesson gives them, and how the screen calls the policies from them.
+    fn set_names(&mut self, given: Vec<String>) {
+        let fresh = Teach::new(given, self.net.clone());
+        self.names = fresh.names;
+        self.descriptions = fresh.descriptions;
+        self.paper_names = fresh.paper_names;
+        if self.paper_names.is_none() {
+            self.paper_numbering = false;
         }
     }
 
@@ -243,11 +294,102 @@ impl Teach {
         }
     }
 
-    /// Picks policy `i` (a click on its node or row); out of range changes nothing.
+    /// Picks policy `i` (a click on its node or row); out of range changes nothing. In
+    /// `M` mode a second click on another policy joins the two (weight
+    /// [`MOUSE_EDGE_WEIGHT`]) or cuts their edge, and a second click on the same one lets
+    /// it go.
     pub fn pick(&mut self, i: usize) {
-        if i < self.net.len() {
-            self.cursor = i;
-            self.edge = 0;
+        if i >= self.net.len() {
+            return;
+        }
+        match self.link_from.take() {
+            Some(from) if self.linking && from != i => {
+                let edit = if self.net.graph().weight(from, i).is_some() {
+                    GraphEdit::Cut { i: from, j: i }
+                } else {
+                    GraphEdit::Add {
+                        i: from,
+                        j: i,
+                        w: MOUSE_EDGE_WEIGHT,
+                    }
+                };
+                self.edit_graph(edit);
+                self.select_edge_to(i);
+                return;
+            }
+            Some(_) => {
+                self.notice = Some(format!("{} let go", self.names()[i]));
+            }
+            None if self.linking => {
+                self.link_from = Some(i);
+                self.notice = Some(format!(
+                    "{} picked: click another policy to join them or cut their edge",
+                    self.names()[i]
+                ));
+            }
+            None => {}
+        }
+        self.cursor = i;
+        self.edge = 0;
+    }
+
+    /// `M`: clicks edit edges, or pick as before.
+    pub fn toggle_linking(&mut self) {
+        self.linking = !self.linking;
+        self.link_from = None;
+        self.notice = Some(if self.linking {
+            "M: click a policy, then another: joined at 0.4 (5 and +/− reweigh) or their \
+             edge cut; M again ends it"
+                .to_string()
+        } else {
+            "M ended: a click picks a policy".to_string()
+        });
+    }
+
+    /// Whether clicks edit edges (`M`).
+    pub fn is_linking(&self) -> bool {
+        self.linking
+    }
+
+    /// Selects the picked policy's edge to `j`, if there is one, for `5` and `x`.
+    fn select_edge_to(&mut self, j: usize) {
+        if let Some(at) = self
+            .net
+            .graph()
+            .neighbours(self.cursor)
+            .position(|(k, _)| k == j)
+        {
+            self.edge = at;
+            self.knob = Knob::EdgeWeight;
+        }
+    }
+
+    /// `n`: adds a policy — at once where the lesson gives its edges (joined to nothing),
+    /// or asking its category where categories build M.
+    pub fn add_policy(&mut self) {
+        if self.has_categories() {
+            self.open_prompt(PromptKind::AddPolicy);
+        } else {
+            self.edit_graph(GraphEdit::AddPolicy {
+                category: super::edit::NO_CATEGORY.to_string(),
+            });
+        }
+    }
+
+    /// `D`: removes the picked policy and its edges.
+    pub fn remove_policy(&mut self) {
+        self.edit_graph(GraphEdit::RemovePolicy { i: self.cursor });
+    }
+
+    /// `C`: asks the picked policy's new category (refused where there are none).
+    pub fn change_category(&mut self) {
+        if self.has_categories() {
+            self.open_prompt(PromptKind::SetCategory);
+        } else {
+            self.edit_graph(GraphEdit::SetCategory {
+                i: self.cursor,
+                category: super::edit::NO_CATEGORY.to_string(),
+            });
         }
     }
 
@@ -344,6 +486,14 @@ impl Teach {
             probabilities: (old_p, new_p),
         });
         self.net = turned;
+        if self.knob == Knob::EdgeWeight && self.has_categories() {
+            // M is now set by hand, not by the categories: the lesson gives its edges.
+            self.source.descriptions.clear();
+            self.notice = Some(
+                "M set by hand: the lesson now gives its graph by its edges, not by categories"
+                    .to_string(),
+            );
+        }
         if let Some(policy) = policy {
             self.walk = Some(self.start(policy, before));
             self.sync();
@@ -475,6 +625,9 @@ impl Teach {
         let text = match kind {
             PromptKind::AddEdge | PromptKind::Predict => String::new(),
             PromptKind::Save => LESSON_FILE.to_string(),
+            PromptKind::AddPolicy | PromptKind::SetCategory => {
+                self.category_of(self.cursor).unwrap_or_default()
+            }
         };
         self.prompt = Some(Prompt { kind, text });
     }
@@ -517,6 +670,13 @@ impl Teach {
                 }
             }
             PromptKind::Predict => self.check_answer(&prompt.text),
+            PromptKind::AddPolicy => self.edit_graph(GraphEdit::AddPolicy {
+                category: prompt.text.trim().to_string(),
+            }),
+            PromptKind::SetCategory => self.edit_graph(GraphEdit::SetCategory {
+                i: self.cursor,
+                category: prompt.text.trim().to_string(),
+            }),
             PromptKind::Save => {
                 let path = PathBuf::from(prompt.text.trim());
                 self.notice = Some(match self.lesson_file().save(&path) {
@@ -624,53 +784,83 @@ impl Teach {
         }
     }
 
-    /// Edits the graph as `sapnet teach --add-edge`/`--cut-edge` do (the same checks, the
+    /// Edits the graph or its policies as `sapnet teach --add-edge`, `--cut-edge`,
+    /// `--add-policy`, `--remove-policy` and `--set-category` do (the same checks, the
     /// same refusals), then builds the net the lesson file would: a refusal changes
     /// nothing and is said. The walk on screen restarts from the activations it started
-    /// from, as a knob's turn restarts it.
+    /// from (a new policy's 0, a removed one's dropped), as a knob's turn restarts it.
     pub fn edit_graph(&mut self, edit: GraphEdit) {
         self.running = false;
         self.notice = None;
+        let (policy, before) = match &self.walk {
+            Some(w) => (Some(w.policy), w.before.clone()),
+            None => (None, self.net.activations().to_vec()),
+        };
         let mut lesson = self.lesson_file();
-        let built = lesson.apply(edit).and_then(|()| lesson.lesson());
-        let net = match built {
-            Ok(lesson) => lesson.net,
+        let built = lesson.apply(&edit).and_then(|()| lesson.lesson());
+        let built = match built {
+            Ok(built) => built,
             Err(why) => {
                 self.notice = Some(format!("{}: {why}", edit.flag()));
                 return;
             }
         };
-        let (policy, before) = match &self.walk {
-            Some(w) => (Some(w.policy), w.before.clone()),
-            None => (None, self.net.activations().to_vec()),
+        let old_calls = walk_end(&self.net, policy, &before).2;
+        let moved = policy.and_then(|p| edit.renumbered(p));
+        // The built net holds the lesson's `initial`: the walk's starting activations,
+        // renumbered.
+        let before = built.net.activations().to_vec();
+        let new_calls = walk_end(&built.net, moved, &before).2;
+        let count_changed = built.net.len() != self.net.len();
+        self.net = built.net;
+        self.source = lesson;
+        self.set_names(built.names);
+        self.groups = match built.groups {
+            Some(groups) => Some(groups),
+            None if count_changed => None,
+            None => self.groups.take(),
         };
-        let (old_calls, new_calls) = (
-            walk_end(&self.net, policy, &before).2,
-            walk_end(&net, policy, &before).2,
-        );
-        self.net = net;
+        self.initial = edit.renumber(&self.initial, 0.0);
+        if !self.excluded.is_empty() {
+            self.excluded = edit.renumber(&self.excluded, false);
+        }
+        self.cursor = edit
+            .renumbered(self.cursor)
+            .unwrap_or(self.cursor)
+            .min(self.net.len() - 1);
+        if matches!(edit, GraphEdit::AddPolicy { .. }) {
+            self.cursor = self.net.len() - 1;
+        }
         self.edge = 0;
-        self.notice = Some(match policy {
-            Some(p) => format!(
+        self.notice = Some(match (policy, moved) {
+            (Some(_), Some(p)) => format!(
                 "{} done: {}'s walk {old_calls} → {new_calls} calls, restarted",
                 edit.flag(),
                 self.names()[p]
             ),
-            None => format!("{} done", edit.flag()),
+            (Some(_), None) => format!(
+                "{} done: the walk's own policy is gone, so is its walk",
+                edit.flag()
+            ),
+            (None, _) => format!("{} done", edit.flag()),
         });
-        match policy {
+        match moved {
             Some(policy) => {
                 self.walk = Some(self.start(policy, before));
                 self.sync();
             }
-            None => self.set_activations(before),
+            None => {
+                self.walk = None;
+                self.set_activations(before);
+            }
         }
     }
 
     /// The lesson as it stands, in the format `sapnet teach --config` reads: the graph
-    /// (its edges), T_ω, 𝒜, τ and the paths as edited, the policies' names as the lesson
-    /// gave them, and as `initial` the activations the walk on screen started from (so
-    /// `--activate` of its policy replays it), or those on screen without a walk.
+    /// (its edges, or the policies' descriptions where categories build it), T_ω, 𝒜, τ
+    /// and the paths as edited, the policies' names as the lesson gave them, and as
+    /// `initial` the activations the walk on screen started from (so `--activate` of its
+    /// policy replays it), or those on screen without a walk.
     pub fn lesson_file(&self) -> TeachConfig {
         let params = self.net.params();
         let activations = match &self.walk {
@@ -685,16 +875,38 @@ impl Teach {
             .iter()
             .enumerate()
             .all(|(i, name)| *name == format!("π{i}"));
+        let defaults = TeachConfig::default();
+        let by_categories = self.has_categories();
         TeachConfig {
             policies: self.net.len(),
             names: if default_names { Vec::new() } else { names },
-            edges: self.net.graph().edges().collect(),
+            edges: if by_categories {
+                Vec::new()
+            } else {
+                self.net.graph().edges().collect()
+            },
+            descriptions: self.source.descriptions.clone(),
+            prototypes: if by_categories {
+                params.prototypes.clone()
+            } else {
+                defaults.prototypes
+            },
+            delta: if by_categories {
+                params.delta
+            } else {
+                defaults.delta
+            },
+            base_graph: if by_categories {
+                params.base_graph
+            } else {
+                defaults.base_graph
+            },
             threshold: params.threshold,
             coefficient: params.coefficient,
             temperature: params.temperature,
             paths: params.paths,
             initial: activations.iter().any(|&a| a != 0.0).then_some(activations),
-            ..TeachConfig::default()
+            ..self.source.clone()
         }
     }
 
