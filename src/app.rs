@@ -245,13 +245,19 @@ fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
             teach = teach.with_groups(groups);
         }
         // Each activation finishes the walk before it; the last is left to step, unless
-        // --run.
+        // --run. Without --activate, a lesson saved mid-walk reopens where it was.
         for &i in &args.activate {
             teach.move_cursor(i as isize - teach.cursor() as isize);
             teach.activate();
         }
+        if let (true, Some(position)) = (args.activate.is_empty(), lesson.walk) {
+            teach.resume_walk(position);
+        }
         if args.run {
             teach.run_to_end();
+        }
+        if args.exercise {
+            teach.toggle_exercise();
         }
         return tui::run_teach(teach);
     }
@@ -269,6 +275,11 @@ fn edited_lesson(cli: &Cli, args: &TeachArgs) -> Result<(TeachConfig, String)> {
         lesson
             .apply(&edit)
             .map_err(|why| anyhow::anyhow!("{}: {why} ({origin})", edit.flag()))?;
+    }
+    if let Some(decay) = args.decay {
+        crate::teach::lesson::check_decay(decay)
+            .map_err(|why| anyhow::anyhow!("--decay {decay}: {why}"))?;
+        lesson.decay = decay;
     }
     if args.save.is_some() {
         lesson.lesson().map_err(|message| ConfigError::Invalid {

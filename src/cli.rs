@@ -637,7 +637,19 @@ pub struct TeachArgs {
     #[arg(long, conflicts_with = "headless")]
     pub run: bool,
 
-    /// With --headless: print one JSON object {activations, probabilities, trace}.
+    /// Between two activations, multiply every activation by (1 − D), 0 ≤ D ≤ 1 (overrides
+    /// the lesson's `decay`). The paper has no decay (eq. 8-11 only add): D = 0, the
+    /// default, is the paper; D > 0 lets older activations fade, as spreading-activation
+    /// models in psychology do.
+    #[arg(long, value_name = "D", allow_negative_numbers = true)]
+    pub decay: Option<f64>,
+
+    /// Open in exercise mode: before each call the student types its ΔA (X ends it).
+    #[arg(long, conflicts_with_all = ["headless", "save"])]
+    pub exercise: bool,
+
+    /// With --headless: print one JSON object {activations, probabilities, trace,
+    /// through_time}.
     #[arg(long, requires = "headless")]
     pub json: bool,
 

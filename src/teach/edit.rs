@@ -110,6 +110,13 @@ impl TeachConfig {
     /// a weight is not above 0, or a cut edge is not there. The net's own bounds (a walk
     /// that would not end) are checked when the lesson is built ([`TeachConfig::lesson`]).
     pub fn apply(&mut self, edit: &GraphEdit) -> Result<(), String> {
+        self.apply_edit(edit)?;
+        // A saved walk's position was on the graph before the edit.
+        self.walk = None;
+        Ok(())
+    }
+
+    fn apply_edit(&mut self, edit: &GraphEdit) -> Result<(), String> {
         match edit {
             GraphEdit::AddPolicy { category } => return self.add_policy(category),
             GraphEdit::RemovePolicy { i } => return self.remove_policy(*i),
@@ -270,7 +277,9 @@ impl TeachConfig {
 
     /// Writes the lesson to `path` in the format `teach --config` reads, atomically.
     pub fn save(&self, path: &Path) -> Result<()> {
-        let body = ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default())
+        // Written as it is read (a saved walk is `Some(activate: 1, calls: 5)`).
+        let body = crate::ron_file::ron_options()
+            .to_string_pretty(self, ron::ser::PrettyConfig::default())
             .context("writing the lesson as RON")?;
         let text = format!(
             "// A sapnet lesson (`sapnet teach --config {}`).\n{body}\n",

@@ -279,7 +279,8 @@ fn a_policy_added_by_key_is_the_one_added_by_flag() {
         by_flags.to_str().unwrap(),
     ]);
     let keys = TeachConfig::load(Some(&by_keys)).unwrap();
-    assert_eq!(keys, TeachConfig::load(Some(&by_flags)).unwrap());
+    let flags = TeachConfig::load(Some(&by_flags)).unwrap();
+    assert_eq!((&keys.names, &keys.net), (&flags.names, &flags.net));
     assert_eq!(keys.net.len(), 5);
     let walk = |file: &std::path::Path| {
         sapnet(&[
@@ -404,4 +405,62 @@ fn clicks_in_m_mode_join_and_cut_edges() {
     teach.pick(1);
     assert_eq!(teach.cursor(), 1);
     assert_eq!(teach.net().graph().edges().count(), 4, "a click only picks");
+}
+
+/// `w` mid-walk keeps the walk's position: the saved lesson, run headless without
+/// `--activate`, prints the calls the screen showed and the activations it showed; with
+/// `--activate 1` it walks the whole walk from the same start.
+#[test]
+fn a_lesson_saved_mid_walk_gives_the_trace_the_screen_showed() {
+    let dir = tempfile::tempdir().unwrap();
+    let saved = dir.path().join("mid.ron");
+    let mut teach = fig2();
+    teach.move_cursor(1);
+    press(&mut teach, KeyCode::Char('a'));
+    for _ in 0..7 {
+        press(&mut teach, KeyCode::Char('s'));
+    }
+    press(&mut teach, KeyCode::Char('w'));
+    for _ in "lesson.ron".chars() {
+        press(&mut teach, KeyCode::Backspace);
+    }
+    type_line(&mut teach, saved.to_str().unwrap());
+    let notice = teach.notice().unwrap();
+    assert!(notice.ends_with("at call 7 of π1's walk"), "{notice}");
+    let shown = teach.walk().unwrap();
+
+    let out = sapnet(&[
+        "teach",
+        "--headless",
+        "--json",
+        "--config",
+        saved.to_str().unwrap(),
+    ]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let trace = json["trace"].as_array().unwrap();
+    assert_eq!(trace.len(), 7);
+    for (row, step) in trace.iter().zip(shown.trace) {
+        assert_eq!(row["to"], step.to);
+        assert_eq!(row["from"], step.from);
+        assert_eq!(row["delta"].as_f64().unwrap(), step.delta);
+    }
+    let activations: Vec<f64> = json["activations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(activations, teach.net().activations());
+
+    let whole = sapnet(&[
+        "teach",
+        "--headless",
+        "--json",
+        "--activate",
+        "1",
+        "--config",
+        saved.to_str().unwrap(),
+    ]);
+    let whole: serde_json::Value = serde_json::from_slice(&whole.stdout).unwrap();
+    assert_eq!(whole["trace"].as_array().unwrap().len(), 21);
 }

@@ -36,9 +36,15 @@ pub(crate) fn teach_help(
             "M, click, click",
             "mouse edits M: click two policies to join them (0.4) or cut",
         ),
-        ("n", "add a policy (its category asked where categories build M)"),
+        (
+            "n",
+            "add a policy (its category asked where categories build M)",
+        ),
         ("D", "remove the picked policy and its edges"),
-        ("C", "change the picked policy's category (as --set-category)"),
+        (
+            "C",
+            "change the picked policy's category (as --set-category)",
+        ),
         (
             "w",
             "write the lesson as it stands to a file (--config reads it)",
