@@ -234,7 +234,8 @@ fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
         );
         return Ok(());
     }
-    let lesson = lesson.lesson().map_err(|message| ConfigError::Invalid {
+    let source = lesson;
+    let lesson = source.lesson().map_err(|message| ConfigError::Invalid {
         origin: edited_origin(&origin, args),
         message,
     })?;
@@ -248,26 +249,32 @@ fn run_teach(cli: &Cli, args: &TeachArgs) -> Result<()> {
         }
         // SIGTERM or SIGHUP end teach mode as `q` does, the terminal restored.
         let _stop = crate::signals::stop_on_signals()?;
-        let mut teach = Teach::new(lesson.names, lesson.net);
+        let mut teach = Teach::new(lesson.names, lesson.net).with_source(source);
         if let Some(groups) = lesson.groups {
             teach = teach.with_groups(groups);
         }
         // Each activation finishes the walk before it; the last is left to step, unless
-        // --run.
+        // --run. Without --activate, a lesson saved mid-walk reopens where it was.
         for &i in &args.activate {
             teach.move_cursor(i as isize - teach.cursor() as isize);
             teach.activate();
         }
+        if let (true, Some(position)) = (args.activate.is_empty(), lesson.walk) {
+            teach.resume_walk(position);
+        }
         if args.run {
             teach.run_to_end();
+        }
+        if args.exercise {
+            teach.toggle_exercise();
         }
         return tui::run_teach(teach);
     }
     crate::teach::headless::run_lesson(lesson, &origin, args, &mut std::io::stdout().lock())
 }
 
-/// The lesson `--config` names (Fig. 2 without one) with `--add-edge` and `--cut-edge`
-/// applied in order, each refused naming itself; a lesson to save is built first, so that
+/// The lesson `--config` names (Fig. 2 without one) with its graph edits (`--add-edge`,
+/// `--cut-edge`, `--add-policy`, `--remove-policy`, `--set-category`) applied in order, each refused naming itself; a lesson to save is built first, so that
 /// one the net refuses is never written.
 fn edited_lesson(cli: &Cli, args: &TeachArgs) -> Result<(TeachConfig, String)> {
     let (mut lesson, origin) = TeachConfig::read(cli.run.config.as_deref())?;
@@ -275,8 +282,13 @@ fn edited_lesson(cli: &Cli, args: &TeachArgs) -> Result<(TeachConfig, String)> {
         let edit = crate::teach::edit::GraphEdit::parse(flag, values)
             .map_err(|why| anyhow::anyhow!("{flag} {}: {why}", values.join(" ")))?;
         lesson
-            .apply(edit)
+            .apply(&edit)
             .map_err(|why| anyhow::anyhow!("{}: {why} ({origin})", edit.flag()))?;
+    }
+    if let Some(decay) = args.decay {
+        crate::teach::lesson::check_decay(decay)
+            .map_err(|why| anyhow::anyhow!("--decay {decay}: {why}"))?;
+        lesson.decay = decay;
     }
     if args.save.is_some() {
         lesson.lesson().map_err(|message| ConfigError::Invalid {

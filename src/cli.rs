@@ -323,11 +323,19 @@ pub fn parse() -> Cli {
     cli
 }
 
-/// `teach`'s `--add-edge` and `--cut-edge`, each with its values, in the order given: clap
-/// keeps each flag's values apart, and their positions say the order.
+/// `teach`'s graph edits (`--add-edge`, `--cut-edge`, `--add-policy`, `--remove-policy`,
+/// `--set-category`), each with its values, in the order given: clap keeps each flag's
+/// values apart, and their positions say the order.
 fn edits_in_order(teach: &clap::ArgMatches) -> Vec<(&'static str, Vec<String>)> {
     let mut edits: Vec<(usize, &'static str, Vec<String>)> = Vec::new();
-    for (id, flag, arity) in [("add_edge", "--add-edge", 3), ("cut_edge", "--cut-edge", 2)] {
+    let flags = [
+        ("add_edge", "--add-edge", 3),
+        ("cut_edge", "--cut-edge", 2),
+        ("add_policy", "--add-policy", 1),
+        ("remove_policy", "--remove-policy", 1),
+        ("set_category", "--set-category", 2),
+    ];
+    for (id, flag, arity) in flags {
         let (Some(indices), Some(values)) = (teach.indices_of(id), teach.get_many::<String>(id))
         else {
             continue;
@@ -631,7 +639,19 @@ pub struct TeachArgs {
     #[arg(long, conflicts_with = "headless")]
     pub run: bool,
 
-    /// With --headless: print one JSON object {activations, probabilities, trace}.
+    /// Between two activations, multiply every activation by (1 − D), 0 ≤ D ≤ 1 (overrides
+    /// the lesson's `decay`). The paper has no decay (eq. 8-11 only add): D = 0, the
+    /// default, is the paper; D > 0 lets older activations fade, as spreading-activation
+    /// models in psychology do.
+    #[arg(long, value_name = "D", allow_negative_numbers = true)]
+    pub decay: Option<f64>,
+
+    /// Open in exercise mode: before each call the student types its ΔA (X ends it).
+    #[arg(long, conflicts_with_all = ["headless", "save"])]
+    pub exercise: bool,
+
+    /// With --headless: print one JSON object {activations, probabilities, trace,
+    /// through_time}.
     #[arg(long, requires = "headless")]
     pub json: bool,
 
@@ -644,6 +664,24 @@ pub struct TeachArgs {
     /// applied in order with --add-edge.
     #[arg(long = "cut-edge", num_args = 2, value_names = ["I", "J"], action = clap::ArgAction::Append)]
     pub cut_edge: Vec<String>,
+
+    /// Add a policy, last, before the lesson opens: in CATEGORY (the first prototype's
+    /// key, e.g. 2 for two hidden layers) where the lesson gives `descriptions`, or `-`
+    /// (joined to nothing; join it with --add-edge) where it gives `edges`; repeatable,
+    /// applied in order with the other edits.
+    #[arg(long = "add-policy", value_name = "CATEGORY", action = clap::ArgAction::Append, allow_hyphen_values = true)]
+    pub add_policy: Vec<String>,
+
+    /// Remove policy I and its edges before the lesson opens (the later policies move
+    /// down one number); repeatable, applied in order with the other edits.
+    #[arg(long = "remove-policy", value_name = "I", action = clap::ArgAction::Append)]
+    pub remove_policy: Vec<String>,
+
+    /// Move policy I to CATEGORY (the first prototype's key) before the lesson opens,
+    /// where the lesson gives `descriptions` (M follows, eq. 3-5); repeatable, applied in
+    /// order with the other edits.
+    #[arg(long = "set-category", num_args = 2, value_names = ["I", "CATEGORY"], action = clap::ArgAction::Append)]
+    pub set_category: Vec<String>,
 
     /// Write the lesson, its edits applied, to FILE in the format --config reads, and exit.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["headless", "activate", "run"])]

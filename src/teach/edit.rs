@@ -1,21 +1,35 @@
-//! Edits of a lesson's graph made before it is taught — `sapnet teach --add-edge I J W
-//! --cut-edge I J --save OUT` (issue 39), for lessons prepared by script: each edit
+//! Edits of a lesson's graph — `sapnet teach --add-edge I J W --cut-edge I J --add-policy
+//! CATEGORY --remove-policy I --set-category I CATEGORY --save OUT` (issue 39), for
+//! lessons prepared by script, and the same edits by key and by mouse in teach mode: each
 //! applied in the order given, each refused with the reason the lesson or the net gives.
 
 use std::path::Path;
 
 use anyhow::{Context, Result};
 
-use super::lesson::TeachConfig;
+use super::category;
+use super::lesson::{TeachConfig, MAX_LESSON_POLICIES};
+use crate::sapnet::Prototype;
 
-/// One edit of the graph M (its edges are undirected).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// One edit of the graph M (its edges are undirected) or of its policies.
+#[derive(Debug, Clone, PartialEq)]
 pub enum GraphEdit {
     /// An edge between `i` and `j` of weight `w`, added or, if there is one, reweighted.
     Add { i: usize, j: usize, w: f64 },
     /// The edge between `i` and `j` removed.
     Cut { i: usize, j: usize },
+    /// A new policy, last, in `category` (the first prototype's key) where the lesson is
+    /// built from `descriptions`; `-` where it gives its `edges` (the policy joins
+    /// nothing until an edge is added).
+    AddPolicy { category: String },
+    /// Policy `i` and its edges removed; the policies after it move down one number.
+    RemovePolicy { i: usize },
+    /// Policy `i` moved to `category` (the first prototype's key): M is rebuilt (eq. 3–5).
+    SetCategory { i: usize, category: String },
 }
+
+/// The category `--add-policy` takes in a lesson given by its edges: none.
+pub const NO_CATEGORY: &str = "-";
 
 impl GraphEdit {
     /// The edit a flag's values say: `--add-edge I J W` or `--cut-edge I J`.
@@ -43,16 +57,50 @@ impl GraphEdit {
                 i: index(0, "I")?,
                 j: index(1, "J")?,
             }),
+            ("--add-policy", 1) => Ok(Self::AddPolicy {
+                category: values[0].clone(),
+            }),
+            ("--remove-policy", 1) => Ok(Self::RemovePolicy { i: index(0, "I")? }),
+            ("--set-category", 2) => Ok(Self::SetCategory {
+                i: index(0, "I")?,
+                category: values[1].clone(),
+            }),
             _ => Err(format!("expected {flag} with its values, got {values:?}")),
         }
     }
 
     /// As the user typed it, for messages.
     pub fn flag(&self) -> String {
-        match *self {
+        match self {
             Self::Add { i, j, w } => format!("--add-edge {i} {j} {w}"),
             Self::Cut { i, j } => format!("--cut-edge {i} {j}"),
+            Self::AddPolicy { category } => format!("--add-policy {category}"),
+            Self::RemovePolicy { i } => format!("--remove-policy {i}"),
+            Self::SetCategory { i, category } => format!("--set-category {i} {category}"),
         }
+    }
+
+    /// Where policy `k` stands after this edit: `None` if it is removed.
+    pub fn renumbered(&self, k: usize) -> Option<usize> {
+        match *self {
+            Self::RemovePolicy { i } if k == i => None,
+            Self::RemovePolicy { i } if k > i => Some(k - 1),
+            _ => Some(k),
+        }
+    }
+
+    /// `values`, one per policy, as they stand after this edit: a new policy's is
+    /// `fresh`, a removed one's dropped.
+    pub fn renumber<T: Clone>(&self, values: &[T], fresh: T) -> Vec<T> {
+        let mut values = values.to_vec();
+        match *self {
+            Self::AddPolicy { .. } => values.push(fresh),
+            Self::RemovePolicy { i } if i < values.len() => {
+                values.remove(i);
+            }
+            _ => {}
+        }
+        values
     }
 }
 
@@ -61,7 +109,20 @@ impl TeachConfig {
     /// from categories, an index names no policy, an edge would join a policy to itself,
     /// a weight is not above 0, or a cut edge is not there. The net's own bounds (a walk
     /// that would not end) are checked when the lesson is built ([`TeachConfig::lesson`]).
-    pub fn apply(&mut self, edit: GraphEdit) -> Result<(), String> {
+    pub fn apply(&mut self, edit: &GraphEdit) -> Result<(), String> {
+        self.apply_edit(edit)?;
+        // A saved walk's position was on the graph before the edit.
+        self.walk = None;
+        Ok(())
+    }
+
+    fn apply_edit(&mut self, edit: &GraphEdit) -> Result<(), String> {
+        match edit {
+            GraphEdit::AddPolicy { category } => return self.add_policy(category),
+            GraphEdit::RemovePolicy { i } => return self.remove_policy(*i),
+            GraphEdit::SetCategory { i, category } => return self.set_category(*i, category),
+            GraphEdit::Add { .. } | GraphEdit::Cut { .. } => {}
+        }
         if !self.descriptions.is_empty() {
             return Err(
                 "this lesson builds its graph from categories (`descriptions`, eq. \
@@ -70,14 +131,12 @@ impl TeachConfig {
             );
         }
         let n = self.count()?;
-        let (i, j) = match edit {
+        let (i, j) = match *edit {
             GraphEdit::Add { i, j, .. } | GraphEdit::Cut { i, j } => (i, j),
+            _ => unreachable!("the policies' edits returned above"),
         };
-        if let Some(k) = [i, j].into_iter().find(|&k| k >= n) {
-            return Err(format!(
-                "there is no policy {k}; the lesson has {n}, numbered 0 to {}",
-                n.saturating_sub(1)
-            ));
+        for k in [i, j] {
+            self.policy_exists(k, n)?;
         }
         if i == j {
             return Err(format!(
@@ -88,29 +147,139 @@ impl TeachConfig {
             .edges
             .iter()
             .position(|&(a, b, _)| (a, b) == (i, j) || (a, b) == (j, i));
-        match (edit, at) {
-            (GraphEdit::Add { w, .. }, _) if !(w.is_finite() && w > 0.0) => {
+        let weight = match edit {
+            GraphEdit::Add { w, .. } => Some(*w),
+            _ => None,
+        };
+        match (weight, at) {
+            (Some(w), _) if !(w.is_finite() && w > 0.0) => {
                 Err(format!("the weight must be a number above 0, got {w}"))
             }
-            (GraphEdit::Add { w, .. }, Some(k)) => {
+            (Some(w), Some(k)) => {
                 self.edges[k].2 = w;
                 Ok(())
             }
-            (GraphEdit::Add { w, .. }, None) => {
+            (Some(w), None) => {
                 self.edges.push((i, j, w));
                 Ok(())
             }
-            (GraphEdit::Cut { .. }, Some(k)) => {
+            (None, Some(k)) => {
                 self.edges.remove(k);
                 Ok(())
             }
-            (GraphEdit::Cut { .. }, None) => Err(format!("there is no edge between {i} and {j}")),
+            (None, None) => Err(format!("there is no edge between {i} and {j}")),
+        }
+    }
+
+    /// `--add-policy CATEGORY`: a policy added last, in `category` where the lesson is
+    /// built from categories, joined to nothing (`-`) where it gives its edges.
+    fn add_policy(&mut self, category: &str) -> Result<(), String> {
+        let n = self.count()?;
+        if n >= MAX_LESSON_POLICIES {
+            return Err(format!(
+                "the lesson has {n} policies, the most a lesson may have"
+            ));
+        }
+        if self.descriptions.is_empty() {
+            if category.trim() != NO_CATEGORY {
+                return Err(format!(
+                    "this lesson gives its graph by `edges`, so its policies have no \
+                     category: `{NO_CATEGORY}` adds a policy joined to nothing (then join it \
+                     with --add-edge)"
+                ));
+            }
+        } else {
+            let prototype = self.first_prototype()?;
+            let policy = category::new_policy(&prototype, &self.descriptions, category)?;
+            self.descriptions.push(policy);
+        }
+        if self.policies > 0 {
+            self.policies += 1;
+        }
+        if !self.names.is_empty() {
+            self.names.push(format!("π{n}"));
+        }
+        if let Some(initial) = &mut self.initial {
+            initial.push(0.0);
+        }
+        Ok(())
+    }
+
+    /// `--remove-policy I`: policy `i` and its edges gone, the later ones renumbered.
+    fn remove_policy(&mut self, i: usize) -> Result<(), String> {
+        let n = self.count()?;
+        self.policy_exists(i, n)?;
+        if n == 1 {
+            return Err("a lesson keeps at least one policy".into());
+        }
+        let renumber = |k: usize| if k > i { k - 1 } else { k };
+        self.edges = self
+            .edges
+            .iter()
+            .filter(|&&(a, b, _)| a != i && b != i)
+            .map(|&(a, b, w)| (renumber(a), renumber(b), w))
+            .collect();
+        if !self.descriptions.is_empty() {
+            self.descriptions.remove(i);
+        }
+        if !self.names.is_empty() {
+            self.names.remove(i);
+        }
+        if self.policies > 0 {
+            self.policies -= 1;
+        }
+        if let Some(initial) = &mut self.initial {
+            if i < initial.len() {
+                initial.remove(i);
+            }
+        }
+        Ok(())
+    }
+
+    /// `--set-category I CATEGORY`: policy `i`'s description changed so that the first
+    /// prototype gives it `category`; M follows from the categories when the lesson is
+    /// built.
+    fn set_category(&mut self, i: usize, category: &str) -> Result<(), String> {
+        let n = self.count()?;
+        self.policy_exists(i, n)?;
+        if self.descriptions.is_empty() {
+            return Err(
+                "this lesson gives its graph by `edges`, so its policies have no \
+                        category (eq. 3-5 build M from categories where the lesson gives \
+                        `descriptions`): change its edges instead"
+                    .into(),
+            );
+        }
+        let prototype = self.first_prototype()?;
+        self.descriptions[i] = category::with_key(&prototype, &self.descriptions[i], category)?;
+        Ok(())
+    }
+
+    /// The prototype whose key is a policy's category (the first one, as the screen
+    /// groups the graph's nodes by it).
+    pub fn first_prototype(&self) -> Result<Prototype, String> {
+        self.prototypes
+            .first()
+            .map(|p| p.prototype.clone())
+            .ok_or_else(|| "the lesson has no prototype to give its policies a category".into())
+    }
+
+    fn policy_exists(&self, k: usize, n: usize) -> Result<(), String> {
+        if k < n {
+            Ok(())
+        } else {
+            Err(format!(
+                "there is no policy {k}; the lesson has {n}, numbered 0 to {}",
+                n.saturating_sub(1)
+            ))
         }
     }
 
     /// Writes the lesson to `path` in the format `teach --config` reads, atomically.
     pub fn save(&self, path: &Path) -> Result<()> {
-        let body = ron::ser::to_string_pretty(self, ron::ser::PrettyConfig::default())
+        // Written as it is read (a saved walk is `Some(activate: 1, calls: 5)`).
+        let body = crate::ron_file::ron_options()
+            .to_string_pretty(self, ron::ser::PrettyConfig::default())
             .context("writing the lesson as RON")?;
         let text = format!(
             "// A sapnet lesson (`sapnet teach --config {}`).\n{body}\n",
@@ -134,13 +303,17 @@ mod tests {
     #[test]
     fn edges_are_added_reweighted_and_cut_in_order() {
         let mut lesson = fig2();
-        lesson.apply(GraphEdit::Add { i: 0, j: 3, w: 0.3 }).unwrap();
+        lesson
+            .apply(&GraphEdit::Add { i: 0, j: 3, w: 0.3 })
+            .unwrap();
         assert!(lesson.edges.contains(&(0, 3, 0.3)));
         // Undirected: (3, 0) is the same edge.
-        lesson.apply(GraphEdit::Add { i: 3, j: 0, w: 0.2 }).unwrap();
+        lesson
+            .apply(&GraphEdit::Add { i: 3, j: 0, w: 0.2 })
+            .unwrap();
         assert!(lesson.edges.contains(&(0, 3, 0.2)));
         assert_eq!(lesson.edges.len(), 5);
-        lesson.apply(GraphEdit::Cut { i: 3, j: 0 }).unwrap();
+        lesson.apply(&GraphEdit::Cut { i: 3, j: 0 }).unwrap();
         assert_eq!(lesson.edges, fig2().edges);
         assert!(lesson.lesson().is_ok());
     }
@@ -163,10 +336,120 @@ mod tests {
         ];
         for (edit, says) in cases {
             let mut lesson = fig2();
-            let error = lesson.apply(edit).unwrap_err();
+            let error = lesson.apply(&edit).unwrap_err();
             assert!(error.contains(says), "{edit:?}: {error}");
             assert_eq!(lesson.edges, fig2().edges, "a refused edit changed nothing");
         }
+    }
+
+    fn table2() -> TeachConfig {
+        crate::ron_file::parse_ron(include_str!("../../assets/teach_table2.ron"), "t2").unwrap()
+    }
+
+    /// Table II: categories of 3, 4 and 3 policies (1, 2 and 3 hidden layers), each a
+    /// clique: 3 + 6 + 3 edges.
+    #[test]
+    fn a_policy_changes_category_and_m_follows() {
+        let mut lesson = table2();
+        let edit = GraphEdit::SetCategory {
+            i: 0,
+            category: "2".into(),
+        };
+        lesson.apply(&edit).unwrap();
+        assert_eq!(lesson.descriptions[0].hidden, [100, 100]);
+        let built = lesson.lesson().unwrap();
+        // Categories of 2, 5 and 3: 1 + 10 + 3 edges; policy 0 joined to 3…6.
+        assert_eq!(built.net.graph().edges().count(), 14);
+        assert_eq!(built.net.graph().weight(0, 3), Some(0.95));
+        assert_eq!(built.net.graph().weight(0, 1), None);
+        assert_eq!(built.groups.unwrap()[..4], [0, 1, 1, 0]);
+    }
+
+    #[test]
+    fn policies_are_added_to_a_category_and_removed() {
+        let mut lesson = table2();
+        let add = GraphEdit::AddPolicy {
+            category: "3".into(),
+        };
+        lesson.apply(&add).unwrap();
+        assert_eq!(lesson.descriptions[10].hidden, [100, 100, 100]);
+        assert_eq!(lesson.names[10], "π10");
+        let built = lesson.lesson().unwrap();
+        // The third category now has 4 policies: 3 + 6 + 6 edges.
+        assert_eq!(built.net.len(), 11);
+        assert_eq!(built.net.graph().edges().count(), 15);
+        assert_eq!(built.net.graph().weight(10, 7), Some(0.95));
+
+        let mut added = fig2();
+        added
+            .apply(&GraphEdit::AddPolicy {
+                category: "-".into(),
+            })
+            .unwrap();
+        let built = added.lesson().unwrap();
+        assert_eq!(built.net.len(), 5);
+        assert_eq!(built.net.graph().degree(4), 0);
+        // Fig. 2's edges (0,1) (0,2) (1,2) (1,3) without π1: (0,2) is now (0,1).
+        let mut removed = fig2();
+        removed.apply(&GraphEdit::RemovePolicy { i: 1 }).unwrap();
+        assert_eq!(removed.edges, [(0, 1, 0.4)]);
+        assert_eq!(removed.lesson().unwrap().net.len(), 3);
+    }
+
+    #[test]
+    fn policy_edits_the_lesson_cannot_take_are_refused_saying_why() {
+        let cases = [
+            (
+                fig2(),
+                GraphEdit::AddPolicy {
+                    category: "2".into(),
+                },
+                "no category: `-` adds",
+            ),
+            (
+                fig2(),
+                GraphEdit::SetCategory {
+                    i: 0,
+                    category: "2".into(),
+                },
+                "no category",
+            ),
+            (
+                fig2(),
+                GraphEdit::RemovePolicy { i: 4 },
+                "there is no policy 4",
+            ),
+            (
+                table2(),
+                GraphEdit::SetCategory {
+                    i: 0,
+                    category: "two".into(),
+                },
+                "a number of hidden layers",
+            ),
+            (
+                table2(),
+                GraphEdit::SetCategory {
+                    i: 10,
+                    category: "2".into(),
+                },
+                "there is no policy 10",
+            ),
+            (
+                table2(),
+                GraphEdit::Add { i: 0, j: 3, w: 0.3 },
+                "from categories",
+            ),
+        ];
+        for (mut lesson, edit, says) in cases {
+            let before = lesson.clone();
+            let error = lesson.apply(&edit).unwrap_err();
+            assert!(error.contains(says), "{edit:?}: {error}");
+            assert_eq!(lesson, before, "a refused edit changed nothing");
+        }
+        let mut one = crate::ron_file::parse_ron::<TeachConfig>("(policies: 1)", "one").unwrap();
+        let e = one.apply(&GraphEdit::RemovePolicy { i: 0 }).unwrap_err();
+        assert_eq!(e, "a lesson keeps at least one policy");
     }
 
     #[test]
@@ -179,6 +462,17 @@ mod tests {
         assert_eq!(
             GraphEdit::parse("--cut-edge", &v(&["1", "2"])),
             Ok(GraphEdit::Cut { i: 1, j: 2 })
+        );
+        assert_eq!(
+            GraphEdit::parse("--set-category", &v(&["1", "2"])),
+            Ok(GraphEdit::SetCategory {
+                i: 1,
+                category: "2".into()
+            })
+        );
+        assert_eq!(
+            GraphEdit::parse("--remove-policy", &v(&["3"])),
+            Ok(GraphEdit::RemovePolicy { i: 3 })
         );
         assert!(GraphEdit::parse("--add-edge", &v(&["a", "3", "0.3"]))
             .unwrap_err()
@@ -193,7 +487,9 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("lesson.ron");
         let mut lesson = fig2();
-        lesson.apply(GraphEdit::Add { i: 0, j: 3, w: 0.3 }).unwrap();
+        lesson
+            .apply(&GraphEdit::Add { i: 0, j: 3, w: 0.3 })
+            .unwrap();
         lesson.save(&path).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         let back: TeachConfig = crate::ron_file::parse_ron(&text, "lesson.ron").unwrap();

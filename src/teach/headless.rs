@@ -1,4 +1,6 @@
-//! `sapnet teach --headless`: activate policies in order and print every `spread` call.
+//! `sapnet teach --headless`: activate policies in order (the activations decayed by D
+//! between two) and print every `spread` call, the final state and A and P through time;
+//! or, for a lesson saved mid-walk and no `--activate`, that walk as far as it was made.
 
 use std::io::Write;
 use std::path::Path;
@@ -6,7 +8,8 @@ use std::path::Path;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 
-use super::lesson::{Lesson, TeachConfig};
+use super::lesson::{Lesson, TeachConfig, WalkPosition};
+use super::session::{Teach, TimeRow};
 use crate::cli::TeachArgs;
 use crate::sapnet::TraceStep;
 
@@ -16,6 +19,8 @@ struct JsonTrace<'a> {
     activations: &'a [f64],
     probabilities: &'a [f64],
     trace: Vec<TraceStep>,
+    /// A and P after each activation's walk.
+    through_time: &'a [TimeRow],
 }
 
 /// Loads the teach file (the embedded Fig. 2 without one), activates `args.activate` in
@@ -35,7 +40,13 @@ pub fn run_lesson(
     args: &TeachArgs,
     out: &mut impl Write,
 ) -> Result<()> {
-    let Lesson { names, mut net, .. } = lesson;
+    let Lesson {
+        names,
+        mut net,
+        walk,
+        decay,
+        ..
+    } = lesson;
     if let Some(&i) = args.activate.iter().find(|&&i| i >= net.len()) {
         bail!(
             "--activate {i}: there is no policy {i}; {origin} has {} policies, numbered 0 to {}",
@@ -45,10 +56,31 @@ pub fn run_lesson(
     }
 
     let mut per_activation = Vec::with_capacity(args.activate.len());
-    for &i in &args.activate {
-        let mut trace = Vec::new();
-        net.activate_traced(i, true, &mut trace);
-        per_activation.push((i, trace));
+    let mut through_time = Vec::with_capacity(args.activate.len());
+    match (args.activate.is_empty(), walk) {
+        (true, Some(position)) => {
+            let (trace, row) = saved_walk(&names, &mut net, position);
+            per_activation.push((position.activate, trace));
+            through_time.push(row);
+        }
+        _ => {
+            for (k, &i) in args.activate.iter().enumerate() {
+                if k > 0 && decay > 0.0 {
+                    let kept = 1.0 - decay;
+                    let decayed = net.activations().iter().map(|a| a * kept).collect();
+                    net.set_activations(decayed)
+                        .expect("activations of the same graph, scaled down");
+                }
+                let mut trace = Vec::new();
+                net.activate_traced(i, true, &mut trace);
+                per_activation.push((i, trace));
+                through_time.push(TimeRow {
+                    activated: i,
+                    activations: net.activations().to_vec(),
+                    probabilities: net.probabilities(),
+                });
+            }
+        }
     }
     let probabilities = net.probabilities();
 
@@ -57,6 +89,7 @@ pub fn run_lesson(
             activations: net.activations(),
             probabilities: &probabilities,
             trace: per_activation.into_iter().flat_map(|(_, t)| t).collect(),
+            through_time: &through_time,
         };
         serde_json::to_writer(&mut *out, &report)?;
         writeln!(out)?;
@@ -107,6 +140,67 @@ pub fn run_lesson(
     )?;
     for ((name, a), prob) in names.iter().zip(net.activations()).zip(&probabilities) {
         writeln!(out, "{name:<width$}  {a:>12.6}  {prob:>11.6}")?;
+    }
+    if through_time.len() > 1 {
+        writeln!(out)?;
+        write_through_time(out, &through_time, &names, decay)?;
+    }
+    Ok(())
+}
+
+/// A lesson saved mid-walk (`w`): its walk from `initial`, made as teach mode makes it,
+/// as far as it was; `net` is left with the activations the screen showed.
+fn saved_walk(
+    names: &[String],
+    net: &mut crate::sapnet::SapNet,
+    position: WalkPosition,
+) -> (Vec<TraceStep>, TimeRow) {
+    let mut teach = Teach::new(names.to_vec(), net.clone());
+    teach.resume_walk(position);
+    let trace = teach.walk().map(|w| w.trace.to_vec()).unwrap_or_default();
+    *net = teach.net().clone();
+    let row = TimeRow {
+        activated: position.activate,
+        activations: net.activations().to_vec(),
+        probabilities: net.probabilities(),
+    };
+    (trace, row)
+}
+
+/// A and P of every policy after each activation's walk, a row per policy and a column
+/// pair per walk.
+fn write_through_time(
+    out: &mut impl Write,
+    rows: &[TimeRow],
+    names: &[String],
+    decay: f64,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "through time: A and P after each walk (decay D = {decay} between activations)"
+    )?;
+    let width = names
+        .iter()
+        .map(|n| n.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(6);
+    write!(out, "{:<width$}", "policy")?;
+    for (t, row) in rows.iter().enumerate() {
+        let head = format!("{}:{}", t + 1, names[row.activated]);
+        write!(out, "  {head:>10}  {:>8}", "P")?;
+    }
+    writeln!(out)?;
+    for (i, name) in names.iter().enumerate() {
+        write!(out, "{name:<width$}")?;
+        for row in rows {
+            write!(
+                out,
+                "  {:>10.6}  {:>8.4}",
+                row.activations[i], row.probabilities[i]
+            )?;
+        }
+        writeln!(out)?;
     }
     Ok(())
 }

@@ -9,6 +9,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use super::questions::{self, Question};
 use crate::ron_file::{parse_ron, sapnet_field, ConfigError};
 use crate::sapnet::{
     BaseGraph, Graph, Paths, PolicyDescription, Prototype, SapNet, SapNetError, SapNetParams,
@@ -48,6 +49,30 @@ pub struct TeachConfig {
     pub paths: Paths,
     /// Activations before the first activation; default all 0.
     pub initial: Option<Vec<f64>>,
+    /// Where the walk on screen stood when the lesson was saved (`w`): teach mode reopens
+    /// there, and `--headless` without `--activate` prints that walk so far.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub walk: Option<WalkPosition>,
+    /// D, the share of every activation lost between two activations (A ← (1−D)·A). The
+    /// paper has no decay (eq. 8–11): D = 0, the default, is the paper.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub decay: f64,
+    /// Questions asked when a walk ends, each with its hidden answer.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub questions: Vec<Question>,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// Where a saved walk stood: the policy activated (from `initial`) and the `spread` calls
+/// made so far.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WalkPosition {
+    pub activate: usize,
+    pub calls: usize,
 }
 
 impl Default for TeachConfig {
@@ -66,6 +91,9 @@ impl Default for TeachConfig {
             temperature: p.temperature,
             paths: p.paths,
             initial: None,
+            walk: None,
+            decay: 0.0,
+            questions: Vec::new(),
         }
     }
 }
@@ -83,6 +111,11 @@ pub struct Lesson {
     /// Each policy's category under the first prototype, where the lesson gives
     /// `descriptions`: the screen draws a category's policies together.
     pub groups: Option<Vec<usize>>,
+    /// The saved walk's position, checked against the walk it names.
+    pub walk: Option<WalkPosition>,
+    /// D between activations (0: the paper).
+    pub decay: f64,
+    pub questions: Vec<Question>,
 }
 
 impl TeachConfig {
@@ -191,7 +224,19 @@ impl TeachConfig {
                 .map_or(Prototype::HiddenLayers, |p| p.prototype.clone());
             prototype.group_indices(&self.descriptions)
         });
-        Ok(Lesson { names, net, groups })
+        check_decay(self.decay).map_err(|e| format!("field `decay`: {e}"))?;
+        questions::validate(&self.questions, n)?;
+        if let Some(walk) = self.walk {
+            check_walk(&net, walk)?;
+        }
+        Ok(Lesson {
+            names,
+            net,
+            groups,
+            walk: self.walk,
+            decay: self.decay,
+            questions: self.questions.clone(),
+        })
     }
 
     /// With the graph given by its `edges`, the fields that build M from categories would
@@ -240,6 +285,39 @@ impl TeachConfig {
             Some((_, count)) => Ok(count),
         }
     }
+}
+
+/// D must leave some of every activation and take none away twice: 0 ≤ D ≤ 1.
+pub fn check_decay(decay: f64) -> Result<(), String> {
+    if (0.0..=1.0).contains(&decay) {
+        Ok(())
+    } else {
+        Err(format!(
+            "expected a number from 0 to 1 (the share of every activation lost between two \
+             activations; 0 is the paper), got {decay}"
+        ))
+    }
+}
+
+/// A saved walk names a policy of the lesson and no more calls than its walk makes.
+fn check_walk(net: &SapNet, walk: WalkPosition) -> Result<(), String> {
+    let n = net.len();
+    if walk.activate >= n {
+        return Err(format!(
+            "field `walk`: expected `activate` to name a policy, 0 to {}, got {}",
+            n.saturating_sub(1),
+            walk.activate
+        ));
+    }
+    let mut calls = crate::sapnet::CallCount::default();
+    net.clone().activate_traced(walk.activate, true, &mut calls);
+    if walk.calls > calls.0 {
+        return Err(format!(
+            "field `walk`: expected at most {} calls (the walk from policy {} makes {}), got {}",
+            calls.0, walk.activate, calls.0, walk.calls
+        ));
+    }
+    Ok(())
 }
 
 fn in_field(field: &'static str) -> impl Fn(SapNetError) -> String {
@@ -325,6 +403,46 @@ mod tests {
         assert!(e.contains("field `initial`"), "{e}");
         let e = lesson("(threshold: 1.0)").unwrap_err();
         assert!(e.contains("no policies"), "{e}");
+    }
+
+    #[test]
+    fn a_saved_walk_decay_and_questions_are_checked_by_field() {
+        let ok = lesson(
+            "(policies: 4, edges: [(0, 1, 0.4), (1, 3, 0.4)], walk: Some(activate: 1, \
+             calls: 2), decay: 0.5, questions: [(ask: \"Which?\", answer: Policy(3))])",
+        )
+        .unwrap();
+        assert_eq!(
+            ok.walk,
+            Some(WalkPosition {
+                activate: 1,
+                calls: 2
+            })
+        );
+        assert_eq!(ok.decay, 0.5);
+        let cases = [
+            (
+                "walk: Some(activate: 4, calls: 0)",
+                "field `walk`: expected `activate`",
+            ),
+            // From π1: to π0 and π3 (Ω = 0.4), each back to π1 (Ω = 0.8), which calls its
+            // two neighbours at Ω = 1.2 (stopped): 2 × (1 + 1 + 2) = 8 calls.
+            (
+                "walk: Some(activate: 1, calls: 9)",
+                "expected at most 8 calls",
+            ),
+            ("decay: 1.5", "field `decay`: expected a number from 0 to 1"),
+            (
+                "questions: [(ask: \"Which?\", answer: Policy(4))]",
+                "field `questions[0].answer`",
+            ),
+        ];
+        for (field, says) in cases {
+            let text = format!("(policies: 4, edges: [(0, 1, 0.4), (1, 3, 0.4)], {field})");
+            let e = lesson(&text).unwrap_err();
+            assert!(e.starts_with("config test.ron: "), "{e}");
+            assert!(e.contains(says), "{field}: {e}");
+        }
     }
 
     #[test]

@@ -7,17 +7,21 @@
 //! - [`knobs`]: the session's live edits (T_ω, 𝒜, τ, paths, an edge's weight) and what
 //!   each changed.
 //! - [`labels`]: short names for policies and tasks, for a graph node or a narrow column.
-//! - [`edit`]: the graph's edits made before a lesson is taught (`--add-edge`,
-//!   `--cut-edge`) and the lesson saved (`--save`).
+//! - [`edit`]: the graph's edits (edges, policies, categories), by flag before a lesson is
+//!   taught or by key in it, and the lesson saved (`--save`, `w`).
+//! - [`category`]: a policy's category as the first prototype's key, typed and changed.
+//! - [`questions`]: a lesson's questions with hidden answers, asked when a walk ends.
 //! - [`headless`]: `sapnet teach --headless`, the trace as a table or as JSON.
 //!
 //! Nothing here draws: the terminal UI (`tui`) imports this module, never the reverse.
 
+pub mod category;
 pub mod edit;
 pub mod headless;
 pub mod knobs;
 pub mod labels;
 pub mod lesson;
+pub mod questions;
 pub mod session;
 
 pub use lesson::{Lesson, TeachConfig};
@@ -32,6 +36,8 @@ mod tests {
         let files = [
             ("mod.rs", include_str!("mod.rs")),
             ("edit.rs", include_str!("edit.rs")),
+            ("category.rs", include_str!("category.rs")),
+            ("questions.rs", include_str!("questions.rs")),
             ("lesson.rs", include_str!("lesson.rs")),
             ("headless.rs", include_str!("headless.rs")),
             ("knobs.rs", include_str!("knobs.rs")),

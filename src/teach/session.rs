@@ -8,11 +8,16 @@
 //! responsive.
 
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
 
 use super::edit::GraphEdit;
 use super::knobs::{refusal, walk_end, EditReport, Knob};
 use super::labels;
 use super::lesson::TeachConfig;
+use super::lesson::WalkPosition;
+use super::questions::Question;
 use crate::sapnet::{Call, SapNet, SpreadState, Spreader, TraceStep};
 
 /// Calls `r` makes between two frames: a few milliseconds' worth.
@@ -56,7 +61,84 @@ pub struct Teach {
     prompt: Option<Prompt>,
     /// Exercise mode (`X`): before each call the student types its ΔA; the score so far.
     exercise: Option<Score>,
+    /// The lesson file this session was opened from, for what the net does not hold: the
+    /// policies' descriptions where categories build M, and what `w` writes back.
+    source: TeachConfig,
+    /// `M`: clicks edit edges — a first click picks a policy, a second joins it to the
+    /// one clicked or cuts their edge.
+    linking: bool,
+    /// In `M` mode, the policy the first click picked.
+    link_from: Option<usize>,
+    /// D: the share of every activation lost between two activations (0: the paper).
+    decay: f64,
+    /// A and P at the end of each walk finished since the lesson (or `c`) started.
+    history: Vec<TimeRow>,
+    /// The lesson's questions, asked one after another when a walk ends.
+    questions: Vec<Question>,
+    /// The next question to ask.
+    next_question: usize,
+    /// The questions' score.
+    quiz: Score,
+    /// `r`: calls made one at a time at [`Teach::speed`], the next when this is due.
+    animation: Option<Instant>,
+    /// Index into [`SPEEDS`].
+    speed: usize,
+    /// What the panel under the edits shows (`v` cycles).
+    panel: WalkPanel,
 }
+
+/// Calls a second `r` makes along the edges (`<` and `>` choose).
+pub const SPEEDS: [f64; 6] = [0.5, 1.0, 2.0, 4.0, 8.0, 16.0];
+/// `r`'s speed at the start: two calls a second, slow enough to follow on the graph.
+const DEFAULT_SPEED: usize = 2;
+
+/// What the panel under the edits shows; `v` goes to the next.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum WalkPanel {
+    /// The calls made, one row each.
+    #[default]
+    Trace,
+    /// The calls as the recursion makes them: each under the call that made it.
+    Tree,
+    /// A and P of every policy over the calls made so far.
+    Chart,
+    /// A and P of every policy after each activation's walk.
+    ThroughTime,
+}
+
+impl WalkPanel {
+    fn next(self) -> Self {
+        match self {
+            Self::Trace => Self::Tree,
+            Self::Tree => Self::Chart,
+            Self::Chart => Self::ThroughTime,
+            Self::ThroughTime => Self::Trace,
+        }
+    }
+
+    /// Its name, in the panel's title and the status bar.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Trace => "trace",
+            Self::Tree => "tree",
+            Self::Chart => "chart",
+            Self::ThroughTime => "through time",
+        }
+    }
+}
+
+/// A and P of every policy at the end of one activation's walk (`through_time` in
+/// `--json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TimeRow {
+    /// The policy activated.
+    pub activated: usize,
+    pub activations: Vec<f64>,
+    pub probabilities: Vec<f64>,
+}
+
+/// The weight of an edge added by the mouse (`M`): Fig. 2's; `5` and `+`/`−` change it.
+pub const MOUSE_EDGE_WEIGHT: f64 = 0.4;
 
 /// An exercise's score: answers right of answers given.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -85,6 +167,12 @@ pub enum PromptKind {
     Save,
     /// Exercise mode: the ΔA the next call deposits, or `stop` where eq. 10 stops it.
     Predict,
+    /// `n` in a lesson of categories: the new policy's category.
+    AddPolicy,
+    /// `C`: the picked policy's new category.
+    SetCategory,
+    /// The lesson's `k`-th question, at a walk's end.
+    Question(usize),
 }
 
 impl PromptKind {
@@ -94,6 +182,9 @@ impl PromptKind {
             PromptKind::AddEdge => "add edge I J W (0-based, as --add-edge):",
             PromptKind::Save => "save the lesson to:",
             PromptKind::Predict => "ΔA of the next call (a number, or stop)?",
+            PromptKind::AddPolicy => "category of the new policy (as --add-policy):",
+            PromptKind::SetCategory => "new category of the picked policy (as --set-category):",
+            PromptKind::Question(_) => "the lesson asks:",
         }
     }
 }
@@ -166,6 +257,189 @@ impl Teach {
             notice: None,
             prompt: None,
             exercise: None,
+            source: TeachConfig::default(),
+            linking: false,
+            link_from: None,
+            decay: 0.0,
+            history: Vec::new(),
+            questions: Vec::new(),
+            next_question: 0,
+            quiz: Score::default(),
+            animation: None,
+            speed: DEFAULT_SPEED,
+            panel: WalkPanel::default(),
+        }
+    }
+
+    /// The lesson file the session was opened from: its policies' descriptions, where
+    /// categories build M, are kept for the category edits and for `w`.
+    pub fn with_source(mut self, source: TeachConfig) -> Self {
+        self.decay = source.decay;
+        self.questions = source.questions.clone();
+        self.source = source;
+        self
+    }
+
+    /// D between activations (`--decay`; 0 is the paper).
+    pub fn with_decay(mut self, decay: f64) -> Self {
+        self.decay = decay;
+        self
+    }
+
+    pub fn decay(&self) -> f64 {
+        self.decay
+    }
+
+    /// A and P after each walk so far, and the walk on screen's as it stands last (`true`
+    /// while it is still in progress).
+    pub fn through_time(&self) -> (Vec<TimeRow>, bool) {
+        let mut rows = self.history.clone();
+        let mut in_progress = false;
+        if let Some(walk) = &self.walk {
+            rows.push(TimeRow {
+                activated: walk.policy,
+                activations: self.net.activations().to_vec(),
+                probabilities: self.net.probabilities(),
+            });
+            in_progress = !walk.state.is_done();
+        }
+        (rows, in_progress)
+    }
+
+    /// Reopens a saved walk (`walk` of a lesson file): activates its policy and makes its
+    /// calls.
+    pub fn resume_walk(&mut self, position: WalkPosition) {
+        if position.activate >= self.net.len() {
+            return;
+        }
+        self.cursor = position.activate;
+        self.activate();
+        for _ in 0..position.calls {
+            self.call();
+        }
+        self.sync();
+    }
+
+    /// What the panel under the edits shows.
+    pub fn panel(&self) -> WalkPanel {
+        self.panel
+    }
+
+    /// `v`: the trace, the tree, the chart, A and P through time, in turn.
+    pub fn next_panel(&mut self) {
+        self.panel = self.panel.next();
+    }
+
+    /// `r`'s speed, in calls a second.
+    pub fn speed(&self) -> f64 {
+        SPEEDS[self.speed]
+    }
+
+    /// `<` / `>`: `r` slower or faster.
+    pub fn change_speed(&mut self, faster: bool) {
+        self.speed = if faster {
+            (self.speed + 1).min(SPEEDS.len() - 1)
+        } else {
+            self.speed.saturating_sub(1)
+        };
+        self.notice = Some(format!("r walks {} calls a second", self.speed()));
+    }
+
+    /// `r`: the walk's calls made one at a time at [`speed`](Self::speed), lit on the
+    /// graph as they go; `r` again pauses.
+    pub fn animate(&mut self) {
+        self.running = false;
+        let going = self.walk.as_ref().is_some_and(|w| !w.state.is_done());
+        self.animation = match self.animation {
+            Some(_) => None,
+            None if going => Some(Instant::now()),
+            None => None,
+        };
+    }
+
+    /// Whether `r` is walking.
+    pub fn is_animating(&self) -> bool {
+        self.animation.is_some()
+    }
+
+    /// The questions' score, once one is answered.
+    pub fn quiz(&self) -> Option<Score> {
+        (self.quiz.asked > 0).then_some(self.quiz)
+    }
+
+    /// How many questions the lesson holds, and how many are asked.
+    pub fn questions(&self) -> (usize, usize) {
+        (self.questions.len(), self.next_question)
+    }
+
+    /// What the prompt asks, on screen: a question's own text.
+    pub fn prompt_question(&self) -> Option<String> {
+        let prompt = self.prompt.as_ref()?;
+        Some(match prompt.kind {
+            PromptKind::Question(k) => self.questions.get(k).map(Question::prompt)?,
+            kind => kind.question().to_string(),
+        })
+    }
+
+    /// At a walk's end, the next of the lesson's questions is asked.
+    fn ask_at_walk_end(&mut self) {
+        let done = self.walk.as_ref().is_some_and(|w| w.state.is_done());
+        if done && self.prompt.is_none() && self.next_question < self.questions.len() {
+            self.running = false;
+            self.animation = None;
+            self.prompt = Some(Prompt {
+                kind: PromptKind::Question(self.next_question),
+                text: String::new(),
+            });
+        }
+    }
+
+    /// Checks the answer to question `k`, says right or the answer, and asks the next.
+    fn check_question(&mut self, k: usize, typed: &str) {
+        let Some(question) = self.questions.get(k) else {
+            return;
+        };
+        let verdict = question.check(typed, self.names());
+        self.next_question = k + 1;
+        self.quiz.asked += 1;
+        if verdict.right {
+            self.quiz.right += 1;
+        }
+        let said = if verdict.right {
+            format!("right: {}", verdict.answer)
+        } else if typed.trim().is_empty() {
+            format!("no answer: it is {}", verdict.answer)
+        } else {
+            format!("not {}: it is {}", typed.trim(), verdict.answer)
+        };
+        self.notice = Some(format!(
+            "{said} · questions {}/{}",
+            self.quiz.right, self.quiz.asked
+        ));
+        self.ask_at_walk_end();
+    }
+
+    /// Whether the lesson's graph is built from categories (eq. 3–5), so that the policies
+    /// have a category to change.
+    pub fn has_categories(&self) -> bool {
+        !self.source.descriptions.is_empty()
+    }
+
+    /// The picked policy's category (the first prototype's key), where there are categories.
+    pub fn category_of(&self, i: usize) -> Option<String> {
+        let prototype = self.source.first_prototype().ok()?;
+        let policy = self.source.descriptions.get(i)?;
+        Some(super::category::key(&prototype, policy))
+    }
+
+    /// The names as the lesson gives them, and how the screen calls the policies from them.
+    fn set_names(&mut self, given: Vec<String>) {
+        let fresh = Teach::new(given, self.net.clone());
+        self.names = fresh.names;
+        self.descriptions = fresh.descriptions;
+        self.paper_names = fresh.paper_names;
+        if self.paper_names.is_none() {
+            self.paper_numbering = false;
         }
     }
 
@@ -243,11 +517,102 @@ impl Teach {
         }
     }
 
-    /// Picks policy `i` (a click on its node or row); out of range changes nothing.
+    /// Picks policy `i` (a click on its node or row); out of range changes nothing. In
+    /// `M` mode a second click on another policy joins the two (weight
+    /// [`MOUSE_EDGE_WEIGHT`]) or cuts their edge, and a second click on the same one lets
+    /// it go.
     pub fn pick(&mut self, i: usize) {
-        if i < self.net.len() {
-            self.cursor = i;
-            self.edge = 0;
+        if i >= self.net.len() {
+            return;
+        }
+        match self.link_from.take() {
+            Some(from) if self.linking && from != i => {
+                let edit = if self.net.graph().weight(from, i).is_some() {
+                    GraphEdit::Cut { i: from, j: i }
+                } else {
+                    GraphEdit::Add {
+                        i: from,
+                        j: i,
+                        w: MOUSE_EDGE_WEIGHT,
+                    }
+                };
+                self.edit_graph(edit);
+                self.select_edge_to(i);
+                return;
+            }
+            Some(_) => {
+                self.notice = Some(format!("{} let go", self.names()[i]));
+            }
+            None if self.linking => {
+                self.link_from = Some(i);
+                self.notice = Some(format!(
+                    "{} picked: click another policy to join them or cut their edge",
+                    self.names()[i]
+                ));
+            }
+            None => {}
+        }
+        self.cursor = i;
+        self.edge = 0;
+    }
+
+    /// `M`: clicks edit edges, or pick as before.
+    pub fn toggle_linking(&mut self) {
+        self.linking = !self.linking;
+        self.link_from = None;
+        self.notice = Some(if self.linking {
+            "M: click a policy, then another: joined at 0.4 (5 and +/− reweigh) or their \
+             edge cut; M again ends it"
+                .to_string()
+        } else {
+            "M ended: a click picks a policy".to_string()
+        });
+    }
+
+    /// Whether clicks edit edges (`M`).
+    pub fn is_linking(&self) -> bool {
+        self.linking
+    }
+
+    /// Selects the picked policy's edge to `j`, if there is one, for `5` and `x`.
+    fn select_edge_to(&mut self, j: usize) {
+        if let Some(at) = self
+            .net
+            .graph()
+            .neighbours(self.cursor)
+            .position(|(k, _)| k == j)
+        {
+            self.edge = at;
+            self.knob = Knob::EdgeWeight;
+        }
+    }
+
+    /// `n`: adds a policy — at once where the lesson gives its edges (joined to nothing),
+    /// or asking its category where categories build M.
+    pub fn add_policy(&mut self) {
+        if self.has_categories() {
+            self.open_prompt(PromptKind::AddPolicy);
+        } else {
+            self.edit_graph(GraphEdit::AddPolicy {
+                category: super::edit::NO_CATEGORY.to_string(),
+            });
+        }
+    }
+
+    /// `D`: removes the picked policy and its edges.
+    pub fn remove_policy(&mut self) {
+        self.edit_graph(GraphEdit::RemovePolicy { i: self.cursor });
+    }
+
+    /// `C`: asks the picked policy's new category (refused where there are none).
+    pub fn change_category(&mut self) {
+        if self.has_categories() {
+            self.open_prompt(PromptKind::SetCategory);
+        } else {
+            self.edit_graph(GraphEdit::SetCategory {
+                i: self.cursor,
+                category: super::edit::NO_CATEGORY.to_string(),
+            });
         }
     }
 
@@ -299,6 +664,7 @@ impl Teach {
     /// before and after. A value the net refuses changes nothing and is said.
     pub fn edit(&mut self, up: bool) {
         self.running = false;
+        self.animation = None;
         self.notice = None;
         let (policy, before) = match &self.walk {
             Some(w) => (Some(w.policy), w.before.clone()),
@@ -344,6 +710,14 @@ impl Teach {
             probabilities: (old_p, new_p),
         });
         self.net = turned;
+        if self.knob == Knob::EdgeWeight && self.has_categories() {
+            // M is now set by hand, not by the categories: the lesson gives its edges.
+            self.source.descriptions.clear();
+            self.notice = Some(
+                "M set by hand: the lesson now gives its graph by its edges, not by categories"
+                    .to_string(),
+            );
+        }
         if let Some(policy) = policy {
             self.walk = Some(self.start(policy, before));
             self.sync();
@@ -369,6 +743,20 @@ impl Teach {
                 self.names()[policy]
             ));
         }
+        if let Some(walk) = &self.walk {
+            // The walk before this one ends here: a row of the table through time, then
+            // the decay between the two activations.
+            self.history.push(TimeRow {
+                activated: walk.policy,
+                activations: self.net.activations().to_vec(),
+                probabilities: self.net.probabilities(),
+            });
+            if self.decay > 0.0 {
+                let kept = 1.0 - self.decay;
+                let decayed = self.net.activations().iter().map(|a| a * kept).collect();
+                self.set_activations(decayed);
+            }
+        }
         let before = self.net.activations().to_vec();
         let walk = self.start(self.cursor, before);
         self.walk = Some(walk);
@@ -379,22 +767,28 @@ impl Teach {
     /// step.
     pub fn step(&mut self) -> Option<TraceStep> {
         self.running = false;
+        self.animation = None;
         self.notice = None;
         let call = self.call();
         self.sync();
+        self.ask_at_walk_end();
         call
     }
 
-    /// `r`: makes every remaining call of the walk in progress.
+    /// Makes every remaining call of the walk in progress.
     pub fn run_to_end(&mut self) {
         self.running = false;
+        self.animation = None;
         while self.call().is_some() {}
         self.sync();
     }
 
-    /// `r` in a front end: the remaining calls are made by [`advance`](Self::advance).
+    /// `R` in a front end: the remaining calls are made by [`advance`](Self::advance), as
+    /// fast as it goes.
     pub fn run(&mut self) {
+        self.animation = None;
         self.running = self.walk.as_ref().is_some_and(|w| !w.state.is_done());
+        self.ask_at_walk_end();
     }
 
     /// Whether `r` is still making calls.
@@ -404,6 +798,23 @@ impl Teach {
 
     /// Makes up to `calls` of the remaining calls while running; returns how many.
     pub fn advance(&mut self, calls: usize) -> usize {
+        self.advance_at(calls, Instant::now())
+    }
+
+    /// [`advance`](Self::advance) at the time `now`: `r`'s walk makes the calls due by
+    /// then at its speed (at most one a frame, so each is seen on the graph).
+    pub fn advance_at(&mut self, calls: usize, now: Instant) -> usize {
+        if let Some(due) = self.animation {
+            if now < due {
+                return 0;
+            }
+            let made = usize::from(self.call().is_some());
+            self.sync();
+            let going = self.walk.as_ref().is_some_and(|w| !w.state.is_done());
+            self.animation = going.then(|| now + Duration::from_secs_f64(1.0 / SPEEDS[self.speed]));
+            self.ask_at_walk_end();
+            return made;
+        }
         if !self.running {
             return 0;
         }
@@ -415,12 +826,14 @@ impl Teach {
             self.running = false;
         }
         self.sync();
+        self.ask_at_walk_end();
         made
     }
 
     /// `u`: takes back the last call (or, before any, the activation itself).
     pub fn undo(&mut self) {
         self.running = false;
+        self.animation = None;
         self.notice = None;
         let Some(walk) = self.walk.take() else {
             return;
@@ -444,8 +857,10 @@ impl Teach {
     /// `c`: back to the activations the lesson started with.
     pub fn reset(&mut self) {
         self.running = false;
+        self.animation = None;
         self.notice = None;
         self.walk = None;
+        self.history.clear();
         self.set_activations(self.initial.clone());
     }
 
@@ -473,8 +888,11 @@ impl Teach {
         self.running = false;
         self.notice = None;
         let text = match kind {
-            PromptKind::AddEdge | PromptKind::Predict => String::new(),
+            PromptKind::AddEdge | PromptKind::Predict | PromptKind::Question(_) => String::new(),
             PromptKind::Save => LESSON_FILE.to_string(),
+            PromptKind::AddPolicy | PromptKind::SetCategory => {
+                self.category_of(self.cursor).unwrap_or_default()
+            }
         };
         self.prompt = Some(Prompt { kind, text });
     }
@@ -495,7 +913,12 @@ impl Teach {
 
     /// Esc in the prompt: nothing is done.
     pub fn prompt_cancel(&mut self) {
-        self.prompt = None;
+        if let Some(PromptKind::Question(k)) = self.prompt.take().map(|p| p.kind) {
+            // Skipped: its answer stays hidden, the next is asked.
+            self.next_question = k + 1;
+            self.notice = Some("question skipped".to_string());
+            self.ask_at_walk_end();
+        }
     }
 
     /// Enter in the prompt: adds the edge or writes the lesson; what went wrong (a value
@@ -517,6 +940,14 @@ impl Teach {
                 }
             }
             PromptKind::Predict => self.check_answer(&prompt.text),
+            PromptKind::Question(k) => self.check_question(k, &prompt.text),
+            PromptKind::AddPolicy => self.edit_graph(GraphEdit::AddPolicy {
+                category: prompt.text.trim().to_string(),
+            }),
+            PromptKind::SetCategory => self.edit_graph(GraphEdit::SetCategory {
+                i: self.cursor,
+                category: prompt.text.trim().to_string(),
+            }),
             PromptKind::Save => {
                 let path = PathBuf::from(prompt.text.trim());
                 self.notice = Some(match self.lesson_file().save(&path) {
@@ -526,7 +957,11 @@ impl Teach {
                         path.display(),
                         self.walk
                             .as_ref()
-                            .map(|w| format!(", --activate {} replays this walk", w.policy))
+                            .map(|w| format!(
+                                " at call {} of {}'s walk",
+                                w.trace.len(),
+                                self.names()[w.policy]
+                            ))
                             .unwrap_or_default()
                     ),
                     Err(error) => format!("not saved: {error:#}"),
@@ -624,53 +1059,86 @@ impl Teach {
         }
     }
 
-    /// Edits the graph as `sapnet teach --add-edge`/`--cut-edge` do (the same checks, the
+    /// Edits the graph or its policies as `sapnet teach --add-edge`, `--cut-edge`,
+    /// `--add-policy`, `--remove-policy` and `--set-category` do (the same checks, the
     /// same refusals), then builds the net the lesson file would: a refusal changes
     /// nothing and is said. The walk on screen restarts from the activations it started
-    /// from, as a knob's turn restarts it.
+    /// from (a new policy's 0, a removed one's dropped), as a knob's turn restarts it.
     pub fn edit_graph(&mut self, edit: GraphEdit) {
         self.running = false;
+        self.animation = None;
         self.notice = None;
+        let (policy, before) = match &self.walk {
+            Some(w) => (Some(w.policy), w.before.clone()),
+            None => (None, self.net.activations().to_vec()),
+        };
         let mut lesson = self.lesson_file();
-        let built = lesson.apply(edit).and_then(|()| lesson.lesson());
-        let net = match built {
-            Ok(lesson) => lesson.net,
+        // The walk restarts on the edited graph: no position to check against it.
+        lesson.walk = None;
+        let built = lesson.apply(&edit).and_then(|()| lesson.lesson());
+        let built = match built {
+            Ok(built) => built,
             Err(why) => {
                 self.notice = Some(format!("{}: {why}", edit.flag()));
                 return;
             }
         };
-        let (policy, before) = match &self.walk {
-            Some(w) => (Some(w.policy), w.before.clone()),
-            None => (None, self.net.activations().to_vec()),
+        let old_calls = walk_end(&self.net, policy, &before).2;
+        let moved = policy.and_then(|p| edit.renumbered(p));
+        // The built net holds the lesson's `initial`: the walk's starting activations,
+        // renumbered.
+        let before = built.net.activations().to_vec();
+        let new_calls = walk_end(&built.net, moved, &before).2;
+        let count_changed = built.net.len() != self.net.len();
+        self.net = built.net;
+        self.source = lesson;
+        self.set_names(built.names);
+        self.groups = match built.groups {
+            Some(groups) => Some(groups),
+            None if count_changed => None,
+            None => self.groups.take(),
         };
-        let (old_calls, new_calls) = (
-            walk_end(&self.net, policy, &before).2,
-            walk_end(&net, policy, &before).2,
-        );
-        self.net = net;
+        self.initial = edit.renumber(&self.initial, 0.0);
+        if !self.excluded.is_empty() {
+            self.excluded = edit.renumber(&self.excluded, false);
+        }
+        self.cursor = edit
+            .renumbered(self.cursor)
+            .unwrap_or(self.cursor)
+            .min(self.net.len() - 1);
+        if matches!(edit, GraphEdit::AddPolicy { .. }) {
+            self.cursor = self.net.len() - 1;
+        }
         self.edge = 0;
-        self.notice = Some(match policy {
-            Some(p) => format!(
+        self.notice = Some(match (policy, moved) {
+            (Some(_), Some(p)) => format!(
                 "{} done: {}'s walk {old_calls} → {new_calls} calls, restarted",
                 edit.flag(),
                 self.names()[p]
             ),
-            None => format!("{} done", edit.flag()),
+            (Some(_), None) => format!(
+                "{} done: the walk's own policy is gone, so is its walk",
+                edit.flag()
+            ),
+            (None, _) => format!("{} done", edit.flag()),
         });
-        match policy {
+        match moved {
             Some(policy) => {
                 self.walk = Some(self.start(policy, before));
                 self.sync();
             }
-            None => self.set_activations(before),
+            None => {
+                self.walk = None;
+                self.set_activations(before);
+            }
         }
     }
 
     /// The lesson as it stands, in the format `sapnet teach --config` reads: the graph
-    /// (its edges), T_ω, 𝒜, τ and the paths as edited, the policies' names as the lesson
-    /// gave them, and as `initial` the activations the walk on screen started from (so
-    /// `--activate` of its policy replays it), or those on screen without a walk.
+    /// (its edges, or the policies' descriptions where categories build it), T_ω, 𝒜, τ
+    /// and the paths as edited, the policies' names as the lesson gave them, and as
+    /// `initial` the activations the walk on screen started from (so `--activate` of its
+    /// policy replays it), or those on screen without a walk.
     pub fn lesson_file(&self) -> TeachConfig {
         let params = self.net.params();
         let activations = match &self.walk {
@@ -685,16 +1153,44 @@ impl Teach {
             .iter()
             .enumerate()
             .all(|(i, name)| *name == format!("π{i}"));
+        let defaults = TeachConfig::default();
+        let by_categories = self.has_categories();
         TeachConfig {
             policies: self.net.len(),
             names: if default_names { Vec::new() } else { names },
-            edges: self.net.graph().edges().collect(),
+            edges: if by_categories {
+                Vec::new()
+            } else {
+                self.net.graph().edges().collect()
+            },
+            descriptions: self.source.descriptions.clone(),
+            prototypes: if by_categories {
+                params.prototypes.clone()
+            } else {
+                defaults.prototypes
+            },
+            delta: if by_categories {
+                params.delta
+            } else {
+                defaults.delta
+            },
+            base_graph: if by_categories {
+                params.base_graph
+            } else {
+                defaults.base_graph
+            },
             threshold: params.threshold,
             coefficient: params.coefficient,
             temperature: params.temperature,
             paths: params.paths,
             initial: activations.iter().any(|&a| a != 0.0).then_some(activations),
-            ..TeachConfig::default()
+            walk: self.walk.as_ref().map(|w| WalkPosition {
+                activate: w.policy,
+                calls: w.trace.len(),
+            }),
+            decay: self.decay,
+            questions: self.questions.clone(),
+            ..self.source.clone()
         }
     }
 
@@ -981,5 +1477,140 @@ mod tests {
         assert_eq!(teach.score(), None);
         teach.step_or_ask();
         assert!(teach.prompt().is_none(), "out of exercise mode s steps");
+    }
+
+    fn two_policies(extra: &str) -> Teach {
+        let text = format!("(policies: 2, edges: [(0, 1, 0.4)]{extra})");
+        let source: TeachConfig = crate::ron_file::parse_ron(&text, "two").unwrap();
+        let lesson = source.lesson().unwrap();
+        Teach::new(lesson.names, lesson.net).with_source(source)
+    }
+
+    fn close(got: &[f64], want: &[f64]) -> bool {
+        got.len() == want.len() && got.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12)
+    }
+
+    /// Two policies joined at 0.4, D = 0.5. Activating π0: A[π0] = 1, then π1 gets
+    /// η/(h×Ω) = 1/(1×0.4) = 2.5, π0 back 1/(2×0.8) = 0.625, and the third call stops
+    /// (Ω = 1.2): A = (1.625, 2.5). The decay halves it to (0.8125, 1.25) before π1's
+    /// activation, which adds 1 to π1, 2.5 to π0 and 0.625 to π1: (3.3125, 2.875).
+    #[test]
+    fn one_decay_step_between_two_activations_by_hand() {
+        let mut teach = two_policies(", decay: 0.5");
+        assert_eq!(teach.decay(), 0.5);
+        teach.activate();
+        teach.run_to_end();
+        assert!(close(teach.net().activations(), &[1.625, 2.5]));
+        teach.move_cursor(1);
+        teach.activate();
+        assert!(
+            close(teach.net().activations(), &[0.8125, 2.25]),
+            "decayed, then eq. 8"
+        );
+        teach.run_to_end();
+        assert!(close(teach.net().activations(), &[3.3125, 2.875]));
+        let (rows, in_progress) = teach.through_time();
+        assert!(!in_progress);
+        assert_eq!(rows.iter().map(|r| r.activated).collect::<Vec<_>>(), [0, 1]);
+        assert!(close(&rows[0].activations, &[1.625, 2.5]));
+        assert!(close(&rows[1].activations, &[3.3125, 2.875]));
+        // P by eq. 6 at τ = 1: e^1.625 / (e^1.625 + e^2.5) = 1 / (1 + e^0.875).
+        let p0 = 1.0 / (1.0 + 0.875f64.exp());
+        assert!(close(&rows[0].probabilities, &[p0, 1.0 - p0]));
+        teach.reset();
+        assert!(teach.through_time().0.is_empty());
+    }
+
+    #[test]
+    fn the_lessons_questions_are_asked_at_the_walks_end_and_scored() {
+        let mut teach = two_policies(
+            ", questions: [(ask: \"Which policy has the highest P?\", answer: Policy(1)), \
+             (ask: \"A of π0?\", answer: Number(value: 1.625, tolerance: 0.001))]",
+        );
+        teach.activate();
+        teach.step();
+        teach.step();
+        assert!(teach.prompt().is_none(), "not before the walk's end");
+        teach.step();
+        assert_eq!(
+            teach.prompt().map(|p| p.kind),
+            Some(PromptKind::Question(0))
+        );
+        let asked = teach.prompt_question().unwrap();
+        assert_eq!(
+            asked,
+            "Which policy has the highest P? (a policy's name or index):"
+        );
+        "π0".chars().for_each(|c| teach.prompt_type(c));
+        teach.prompt_submit();
+        assert_eq!(teach.notice(), Some("not π0: it is π1 · questions 0/1"));
+        assert_eq!(
+            teach.prompt().map(|p| p.kind),
+            Some(PromptKind::Question(1))
+        );
+        "1.625".chars().for_each(|c| teach.prompt_type(c));
+        teach.prompt_submit();
+        assert_eq!(teach.notice(), Some("right: 1.625 ± 0.001 · questions 1/2"));
+        assert!(teach.prompt().is_none());
+        assert_eq!(teach.quiz(), Some(Score { right: 1, asked: 2 }));
+        // Asked once: the next walk's end asks nothing more.
+        teach.activate();
+        teach.run_to_end();
+        teach.step();
+        assert!(teach.prompt().is_none());
+    }
+
+    #[test]
+    fn r_walks_a_call_at_a_time_at_its_speed() {
+        let mut teach = fig2();
+        teach.activate();
+        teach.animate();
+        assert!(teach.is_animating() && !teach.is_running());
+        let start = Instant::now();
+        assert_eq!(
+            teach.advance_at(CALLS_PER_FRAME, start),
+            1,
+            "one call at once"
+        );
+        assert_eq!(
+            teach.advance_at(CALLS_PER_FRAME, start),
+            0,
+            "the next not yet due"
+        );
+        // Two calls a second: the next is due half a second on.
+        let later = start + Duration::from_millis(500);
+        assert_eq!(teach.advance_at(CALLS_PER_FRAME, later), 1);
+        assert_eq!(teach.walk().unwrap().trace.len(), 2);
+        teach.change_speed(true);
+        assert_eq!(teach.speed(), 4.0);
+        teach.animate();
+        assert!(!teach.is_animating(), "r again pauses");
+        teach.run();
+        teach.advance(CALLS_PER_FRAME);
+        assert!(teach.walk().unwrap().done, "R runs to the end");
+    }
+
+    /// `w` keeps the walk's position, and a lesson reopened there shows the same calls.
+    #[test]
+    fn a_saved_walk_reopens_at_its_call() {
+        let mut teach = fig2();
+        teach.move_cursor(1);
+        teach.activate();
+        for _ in 0..5 {
+            teach.step();
+        }
+        let saved = teach.lesson_file();
+        assert_eq!(
+            saved.walk,
+            Some(WalkPosition {
+                activate: 1,
+                calls: 5
+            })
+        );
+        let lesson = saved.lesson().unwrap();
+        let mut reopened = Teach::new(lesson.names, lesson.net).with_source(saved);
+        reopened.resume_walk(lesson.walk.unwrap());
+        assert_eq!(reopened.walk(), teach.walk());
+        assert_eq!(reopened.net().activations(), teach.net().activations());
     }
 }

@@ -23,7 +23,10 @@ fn json_is_one_object_with_the_fig2_values() {
     let object = json.as_object().unwrap();
     let mut keys: Vec<_> = object.keys().map(String::as_str).collect();
     keys.sort_unstable();
-    assert_eq!(keys, ["activations", "probabilities", "trace"]);
+    assert_eq!(
+        keys,
+        ["activations", "probabilities", "through_time", "trace"]
+    );
 
     let numbers = |key: &str| -> Vec<f64> {
         json[key]
@@ -275,4 +278,93 @@ fn edits_the_lesson_refuses_are_said_and_nothing_is_saved() {
         assert!(error.contains(says), "{edits:?}: {error}");
         assert!(!saved.exists(), "{edits:?}: a refused lesson was saved");
     }
+}
+
+/// Two policies joined at 0.4 (see the hand count in `one_decay_step_between_two_activations_by_hand`,
+/// src/teach/session.rs): π0's walk ends at A = (1.625, 2.5); D = 0.5 halves it to
+/// (0.8125, 1.25); π1's walk adds (2.5, 1.625): (3.3125, 2.875).
+#[test]
+fn decay_between_activations_and_the_table_through_time() {
+    let tmp = tempfile::tempdir().unwrap();
+    let lesson = tmp.path().join("two.ron");
+    std::fs::write(&lesson, "(policies: 2, edges: [(0, 1, 0.4)])").unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["teach", "--headless", "--config", lesson.to_str().unwrap()];
+        args.extend_from_slice(&["--activate", "0", "--activate", "1"]);
+        args.extend_from_slice(extra);
+        sapnet(&args)
+    };
+    let out = run(&["--decay", "0.5", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = json["through_time"].as_array().unwrap();
+    let values = |row: &serde_json::Value, key: &str| -> Vec<f64> {
+        row[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    assert_eq!(rows.len(), 2);
+    assert_eq!(rows[0]["activated"], 0);
+    assert_eq!(rows[1]["activated"], 1);
+    for (got, want) in [
+        (values(&rows[0], "activations"), [1.625, 2.5]),
+        (values(&rows[1], "activations"), [3.3125, 2.875]),
+        (values(&json, "activations"), [3.3125, 2.875]),
+    ] {
+        assert!(
+            got.iter().zip(want).all(|(g, w)| (g - w).abs() < 1e-12),
+            "{got:?}"
+        );
+    }
+    let p0 = 1.0 / (1.0 + 0.875f64.exp());
+    assert!((values(&rows[0], "probabilities")[0] - p0).abs() < 1e-12);
+
+    // D = 0 is the paper: the two walks simply add up.
+    let paper: serde_json::Value = serde_json::from_slice(&run(&["--json"]).stdout).unwrap();
+    let a = values(&paper, "activations");
+    assert!((a[0] - (1.625 + 2.5)).abs() < 1e-12, "{a:?}");
+
+    // The table says the decay and has a column pair per walk.
+    let text = String::from_utf8(run(&["--decay", "0.5"]).stdout).unwrap();
+    assert!(
+        text.contains("through time: A and P after each walk (decay D = 0.5"),
+        "{text}"
+    );
+    assert!(text.contains("  3.312500"), "{text}");
+
+    let out = run(&["--decay", "1.5"]);
+    assert_eq!(out.status.code(), Some(2));
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        said.contains("--decay 1.5: expected a number from 0 to 1"),
+        "{said}"
+    );
+}
+
+/// A lesson file's questions are checked as a config is: file, field, what was expected.
+#[test]
+fn a_bad_question_is_refused_naming_its_file_and_field() {
+    let tmp = tempfile::tempdir().unwrap();
+    let lesson = tmp.path().join("quiz.ron");
+    std::fs::write(
+        &lesson,
+        "(policies: 2, edges: [(0, 1, 0.4)], questions: [(ask: \"Which?\", answer: Policy(5))])",
+    )
+    .unwrap();
+    let out = sapnet(&["teach", "--headless", "--config", lesson.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(said.contains("quiz.ron"), "{said}");
+    assert!(
+        said.contains("field `questions[0].answer`: expected Policy(0) to Policy(1)"),
+        "{said}"
+    );
+    assert!(!said.contains("panicked"), "{said}");
 }

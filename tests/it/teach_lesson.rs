@@ -225,3 +225,242 @@ fn a_teacher_adds_an_edge_and_saves_the_lesson_in_tmux() {
     ]);
     assert_eq!(by_keys.stdout, by_flags.stdout);
 }
+
+fn table2() -> Teach {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/teach_table2.ron");
+    let (source, _) = TeachConfig::read(Some(&path)).unwrap();
+    let lesson = source.lesson().unwrap();
+    Teach::new(lesson.names, lesson.net)
+        .with_groups(lesson.groups.unwrap())
+        .with_source(source)
+}
+
+/// `n` adds a policy to Fig. 2 (joined to nothing, its graph given by edges), `E` joins
+/// it; the walk on screen restarts; `w` then writes the lesson `--add-policy - --add-edge`
+/// writes, and it walks as they do.
+#[test]
+fn a_policy_added_by_key_is_the_one_added_by_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut teach = fig2();
+    teach.move_cursor(1);
+    press(&mut teach, KeyCode::Char('a'));
+    press(&mut teach, KeyCode::Char('s'));
+    press(&mut teach, KeyCode::Char('n'));
+    assert_eq!(teach.net().len(), 5);
+    assert_eq!(teach.names()[4], "π4");
+    assert_eq!(teach.cursor(), 4, "the new policy is picked");
+    assert_eq!(
+        teach.notice(),
+        Some("--add-policy - done: π1's walk 21 → 21 calls, restarted")
+    );
+    let walk = teach.walk().unwrap();
+    assert_eq!((walk.policy, walk.trace.len()), (1, 0));
+    assert_eq!(teach.net().activations(), [0.0, 1.0, 0.0, 0.0, 0.0]);
+    press(&mut teach, KeyCode::Char('E'));
+    type_line(&mut teach, "4 3 0.3");
+    assert_eq!(teach.net().graph().weight(3, 4), Some(0.3));
+
+    let by_keys = dir.path().join("by-keys.ron");
+    press(&mut teach, KeyCode::Char('w'));
+    for _ in "lesson.ron".chars() {
+        press(&mut teach, KeyCode::Backspace);
+    }
+    type_line(&mut teach, by_keys.to_str().unwrap());
+    let by_flags = dir.path().join("by-flags.ron");
+    sapnet(&[
+        "teach",
+        "--add-policy",
+        "-",
+        "--add-edge",
+        "4",
+        "3",
+        "0.3",
+        "--save",
+        by_flags.to_str().unwrap(),
+    ]);
+    let keys = TeachConfig::load(Some(&by_keys)).unwrap();
+    let flags = TeachConfig::load(Some(&by_flags)).unwrap();
+    assert_eq!((&keys.names, &keys.net), (&flags.names, &flags.net));
+    assert_eq!(keys.net.len(), 5);
+    let walk = |file: &std::path::Path| {
+        sapnet(&[
+            "teach",
+            "--headless",
+            "--config",
+            file.to_str().unwrap(),
+            "--activate",
+            "1",
+            "--json",
+        ])
+        .stdout
+    };
+    assert_eq!(walk(&by_keys), walk(&by_flags));
+}
+
+/// `D` removes the picked policy: π3 of Fig. 2 leaves the triangle π0 π1 π2, where π1's
+/// walk makes 14 calls (from π1, k = 2, to π0 and π2 at Ω = 0.4; each on to its two
+/// neighbours at Ω = 0.8; each of those to two at Ω = 1.2, stopped: 2 × (1 + 2 + 4)).
+/// Removing the walk's own policy ends the walk.
+#[test]
+fn a_policy_removed_by_key_restarts_the_walk_without_it() {
+    let mut teach = fig2();
+    teach.move_cursor(1);
+    press(&mut teach, KeyCode::Char('a'));
+    teach.move_cursor(2);
+    press(&mut teach, KeyCode::Char('D'));
+    assert_eq!(
+        teach.notice(),
+        Some("--remove-policy 3 done: π1's walk 21 → 14 calls, restarted")
+    );
+    assert_eq!(teach.net().len(), 3);
+    assert_eq!(teach.cursor(), 2);
+    teach.run_to_end();
+    assert_eq!(teach.walk().unwrap().trace.len(), 14);
+    teach.move_cursor(-1);
+    press(&mut teach, KeyCode::Char('D'));
+    assert_eq!(
+        teach.notice(),
+        Some("--remove-policy 1 done: the walk's own policy is gone, so is its walk")
+    );
+    assert!(teach.walk().is_none());
+    assert_eq!(
+        teach.net().graph().edges().collect::<Vec<_>>(),
+        [(0, 1, 0.4)]
+    );
+}
+
+/// `C` moves a policy of Table II to another category (the number of hidden layers): M
+/// follows (eq. 3–5), the graph regroups; Fig. 2, given by edges, has no category and
+/// the key says so in `--set-category`'s words.
+#[test]
+fn a_category_changed_by_key_rebuilds_m_and_fig2_refuses_it() {
+    let mut teach = table2();
+    press(&mut teach, KeyCode::Char('C'));
+    assert_eq!(
+        teach.prompt().unwrap().text,
+        "1",
+        "the current category offered"
+    );
+    press(&mut teach, KeyCode::Backspace);
+    type_line(&mut teach, "2");
+    assert_eq!(teach.notice(), Some("--set-category 0 2 done"));
+    let graph = teach.net().graph();
+    assert_eq!(graph.weight(0, 3), Some(0.95));
+    assert_eq!(graph.weight(0, 1), None);
+    assert_eq!(graph.edges().count(), 14);
+    assert_eq!(teach.groups().unwrap()[..4], [0, 1, 1, 0]);
+    // A typed category the prototype cannot read changes nothing.
+    press(&mut teach, KeyCode::Char('C'));
+    press(&mut teach, KeyCode::Backspace);
+    type_line(&mut teach, "two");
+    let notice = teach.notice().unwrap();
+    assert!(
+        notice.starts_with("--set-category 0 two: a category under HiddenLayers is"),
+        "{notice}"
+    );
+    // The saved lesson keeps its categories, not the edges they gave.
+    let saved = teach.lesson_file();
+    assert!(saved.edges.is_empty());
+    assert_eq!(saved.descriptions[0].hidden, [100, 100]);
+
+    let mut fig2 = fig2();
+    press(&mut fig2, KeyCode::Char('C'));
+    let notice = fig2.notice().unwrap();
+    assert!(
+        notice.starts_with("--set-category 0 -: this lesson gives its graph by `edges`"),
+        "{notice}"
+    );
+    let flags = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args(["teach", "--set-category", "0", "-", "--headless"])
+        .output()
+        .unwrap();
+    assert_eq!(flags.status.code(), Some(2));
+    let said = String::from_utf8_lossy(&flags.stderr);
+    let reason = notice.split_once(": ").unwrap().1;
+    assert!(said.contains(reason), "{said}");
+}
+
+/// `M`: a click picks a policy, a click on another joins them at 0.4 (that edge then
+/// selected for `5` and `x`), the same two clicks again cut it, and a second click on
+/// the same policy lets it go.
+#[test]
+fn clicks_in_m_mode_join_and_cut_edges() {
+    let mut teach = fig2();
+    press(&mut teach, KeyCode::Char('M'));
+    assert!(teach.is_linking());
+    teach.pick(0);
+    teach.pick(3);
+    assert_eq!(teach.net().graph().weight(0, 3), Some(0.4));
+    assert_eq!(teach.notice(), Some("--add-edge 0 3 0.4 done"));
+    assert_eq!(teach.selected_edge(), Some((0, 3)));
+    teach.pick(0);
+    teach.pick(3);
+    assert_eq!(teach.net().graph().weight(0, 3), None);
+    assert_eq!(teach.notice(), Some("--cut-edge 0 3 done"));
+    teach.pick(2);
+    teach.pick(2);
+    assert_eq!(teach.notice(), Some("π2 let go"));
+    assert_eq!(teach.net().graph().edges().count(), 4);
+    press(&mut teach, KeyCode::Char('M'));
+    teach.pick(1);
+    assert_eq!(teach.cursor(), 1);
+    assert_eq!(teach.net().graph().edges().count(), 4, "a click only picks");
+}
+
+/// `w` mid-walk keeps the walk's position: the saved lesson, run headless without
+/// `--activate`, prints the calls the screen showed and the activations it showed; with
+/// `--activate 1` it walks the whole walk from the same start.
+#[test]
+fn a_lesson_saved_mid_walk_gives_the_trace_the_screen_showed() {
+    let dir = tempfile::tempdir().unwrap();
+    let saved = dir.path().join("mid.ron");
+    let mut teach = fig2();
+    teach.move_cursor(1);
+    press(&mut teach, KeyCode::Char('a'));
+    for _ in 0..7 {
+        press(&mut teach, KeyCode::Char('s'));
+    }
+    press(&mut teach, KeyCode::Char('w'));
+    for _ in "lesson.ron".chars() {
+        press(&mut teach, KeyCode::Backspace);
+    }
+    type_line(&mut teach, saved.to_str().unwrap());
+    let notice = teach.notice().unwrap();
+    assert!(notice.ends_with("at call 7 of π1's walk"), "{notice}");
+    let shown = teach.walk().unwrap();
+
+    let out = sapnet(&[
+        "teach",
+        "--headless",
+        "--json",
+        "--config",
+        saved.to_str().unwrap(),
+    ]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let trace = json["trace"].as_array().unwrap();
+    assert_eq!(trace.len(), 7);
+    for (row, step) in trace.iter().zip(shown.trace) {
+        assert_eq!(row["to"], step.to);
+        assert_eq!(row["from"], step.from);
+        assert_eq!(row["delta"].as_f64().unwrap(), step.delta);
+    }
+    let activations: Vec<f64> = json["activations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(activations, teach.net().activations());
+
+    let whole = sapnet(&[
+        "teach",
+        "--headless",
+        "--json",
+        "--activate",
+        "1",
+        "--config",
+        saved.to_str().unwrap(),
+    ]);
+    let whole: serde_json::Value = serde_json::from_slice(&whole.stdout).unwrap();
+    assert_eq!(whole["trace"].as_array().unwrap().len(), 21);
+}

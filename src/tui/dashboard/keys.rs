@@ -203,8 +203,8 @@ impl Dashboard {
     }
 }
 
-/// Applies a teach-mode key (arrows, `a`, `s`, `r`, `u`, `c`, `p`, and the edits `1`…`5`,
-/// `+`, `−`, `e`); `false` if it is not one.
+/// Applies a teach-mode key (arrows, `a`, `s`, `r`, `R`, `<`, `>`, `v`, `u`, `c`, `p`, the edits `1`…`5`, `+`,
+/// `−`, `e`, the graph's `E`, `x`, `n`, `D`, `C`, `M`, `w`, `X`); `false` if it is not one.
 pub fn apply_teach_key(teach: &mut Teach, key: KeyEvent) -> bool {
     // A line being typed takes every key until Enter or Esc.
     if teach.prompt().is_some() {
@@ -221,6 +221,10 @@ pub fn apply_teach_key(teach: &mut Teach, key: KeyEvent) -> bool {
         KeyCode::Char('w') => teach.open_prompt(PromptKind::Save),
         KeyCode::Char('E') => teach.open_prompt(PromptKind::AddEdge),
         KeyCode::Char('x') => teach.cut_selected_edge(),
+        KeyCode::Char('n') => teach.add_policy(),
+        KeyCode::Char('D') => teach.remove_policy(),
+        KeyCode::Char('C') => teach.change_category(),
+        KeyCode::Char('M') => teach.toggle_linking(),
         KeyCode::Char(c) if Knob::from_key(c).is_some() => {
             teach.choose_knob(Knob::from_key(c).expect("checked"));
         }
@@ -236,7 +240,11 @@ pub fn apply_teach_key(teach: &mut Teach, key: KeyEvent) -> bool {
         KeyCode::Char('a') => teach.activate(),
         KeyCode::Char('s') => teach.step_or_ask(),
         KeyCode::Char('X') => teach.toggle_exercise(),
-        KeyCode::Char('r') => teach.run(),
+        KeyCode::Char('r') => teach.animate(),
+        KeyCode::Char('R') => teach.run(),
+        KeyCode::Char('<') | KeyCode::Char(',') => teach.change_speed(false),
+        KeyCode::Char('>') | KeyCode::Char('.') => teach.change_speed(true),
+        KeyCode::Char('v') => teach.next_panel(),
         KeyCode::Char('u') => teach.undo(),
         KeyCode::Char('c') => teach.reset(),
         KeyCode::Char('p') => {

@@ -25,10 +25,15 @@ pub(super) fn paragraph(teach: &Teach, theme: Theme, compact: bool) -> Paragraph
         format!("{} {symbol} {}", knob.key(), knob.value(teach.net(), edge))
     };
     let said = if let Some(prompt) = teach.prompt() {
+        // A question asked after an answer: the verdict stays in view above it.
+        let verdict = teach
+            .notice()
+            .map(|n| format!("{n} · "))
+            .unwrap_or_default();
         Some(Line::styled(
             format!(
-                "{} {}█  (Enter, Esc cancels)",
-                prompt.kind.question(),
+                "{verdict}{} {}█  (Enter, Esc cancels)",
+                teach.prompt_question().unwrap_or_default(),
                 prompt.text
             ),
             theme.active(),

@@ -33,6 +33,19 @@ pub(crate) fn teach_help(
         ("E", "add an edge I J W, or reweight it (as --add-edge)"),
         ("x", "cut the picked policy's selected edge"),
         (
+            "M, click, click",
+            "mouse edits M: click two policies to join them (0.4) or cut",
+        ),
+        (
+            "n",
+            "add a policy (its category asked where categories build M)",
+        ),
+        ("D", "remove the picked policy and its edges"),
+        (
+            "C",
+            "change the picked policy's category (as --set-category)",
+        ),
+        (
             "w",
             "write the lesson as it stands to a file (--config reads it)",
         ),
