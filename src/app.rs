@@ -322,15 +322,15 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     }
     if cli.run.compare.is_some() {
         anyhow::bail!(
-            "--compare is for the dashboard: with --headless, `sapnet plot DIR` redraws a \
+            "--compare is for the dashboard (the UI's Run view): with --headless, `sapnet plot DIR` redraws a \
              results folder's plots"
         );
     }
     if cli.run.follow.is_some() {
-        anyhow::bail!("--follow is for the dashboard: --headless runs every method");
+        anyhow::bail!("--follow is for the UI: --headless follows no run");
     }
     if cli.run.follow_run.is_some() {
-        anyhow::bail!("--follow-run is for the dashboard: --headless runs every run");
+        anyhow::bail!("--follow-run is for the UI: --headless follows no run");
     }
     let dir = match &cli.run.out {
         Some(dir) => dir.clone(),
@@ -421,6 +421,13 @@ fn run_in_ui(cli: &Cli, config: Config) -> Result<()> {
         Some(dir) => tui::reference::bands_of_folder(dir, &config.env.gym_id())?,
         None => Vec::new(),
     };
+    // Said before the folder is taken or a run starts.
+    if !std::io::IsTerminal::is_terminal(&std::io::stdout()) {
+        anyhow::bail!(
+            "the protocol runs in the terminal UI, and stdout is not a terminal: use \
+             --headless (the same protocol and files, progress on stderr)"
+        );
+    }
     let output = OutputOptions {
         dir: match &cli.run.out {
             Some(dir) => dir.clone(),

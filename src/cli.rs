@@ -6,9 +6,10 @@ use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// SAP-Net: reuse a library of DQN policies by spreading activation over a policy graph.
 ///
-/// With no subcommand, opens the live dashboard on `--config` (default: the embedded
+/// With no subcommand, runs the whole protocol of `--config` (default: the embedded
 /// `assets/cartpole.ron`, the paper's CartPole-v1 experiment: SAP-Net and three DQN
-/// baselines); with `--headless`, runs that experiment's whole protocol and writes results.
+/// baselines) in the terminal UI, one run followed live, results written to --out as
+/// `--headless` writes them; with `--headless`, the same protocol without the UI.
 #[derive(Debug, Parser)]
 #[command(name = "sapnet", version, about, long_about = None)]
 pub struct Cli {
@@ -27,11 +28,12 @@ pub struct RunArgs {
     #[arg(long, short, value_name = "FILE", global = true)]
     pub config: Option<PathBuf>,
 
-    /// Run without the terminal UI: progress on stderr, results in --out.
+    /// Run without the terminal UI: progress on stderr, results in --out (the same files
+    /// the UI's protocol writes).
     #[arg(long)]
     pub headless: bool,
 
-    /// With --headless: also add each run's chosen policy, fine-tuned, to the library as
+    /// Also add each run's chosen policy, fine-tuned, to the library as
     /// <LIBRARY>/<task>/chosen/<out dir>-<method>-run<r> (Algorithm 3's last step). Without
     /// it a run writes only under --out (its policies/ holds the same files).
     #[arg(long)]
@@ -75,19 +77,20 @@ pub struct RunArgs {
     #[arg(long)]
     pub quick: bool,
 
-    /// The dashboard trains and shows run 0 of this method (its label in results, e.g.
-    /// `ucb1`, `sapnet-episode`), beside the first DQN baseline. Default: the first
-    /// SAP-Net method, else the first that reuses the library.
+    /// The UI follows run 0 of this method (its label in results, e.g. `ucb1`,
+    /// `sapnet-episode`, `dqn[100]`) in its Run view: pause, step and speed act on it, the
+    /// other runs train at full speed. Default: the first SAP-Net method, else the first
+    /// that reuses the library, else the first.
     #[arg(long, value_name = "METHOD")]
     pub follow: Option<String>,
 
-    /// The dashboard trains run N of the followed method and of the DQN baseline instead of
-    /// run 0, with the seeds a headless protocol gives run N: to watch a run the results
-    /// single out. Runs are numbered from 0, as in the results' files (`sapnet-run2`).
+    /// The UI follows run N of the followed method instead of run 0 (the seeds a headless
+    /// protocol gives run N): to watch a run the results single out. Runs are numbered
+    /// from 0, as in the results' files (`sapnet-run2`).
     #[arg(long, value_name = "N")]
     pub follow_run: Option<u32>,
 
-    /// The dashboard draws a finished protocol's results (a `--headless` output folder)
+    /// The Run view draws a finished protocol's results (a `--headless` output folder)
     /// under the live curves: for each method on screen, the mean of its runs' moving
     /// averages and its 95% bootstrap interval.
     #[arg(long, value_name = "DIR")]
@@ -104,13 +107,13 @@ pub struct RunArgs {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=crate::limits::MAX_RUNS as i64))]
     pub runs: Option<u32>,
 
-    /// With --headless: also write trace.csv, every spread call (eq. 9-11) of every
+    /// Also write trace.csv, every spread call (eq. 9-11) of every
     /// positive activation of SAP-Net's runs, as teach mode shows them. One row per call:
     /// millions over a full protocol, so best with --quick or a small config.
     #[arg(long)]
     pub trace: bool,
 
-    /// With --headless: also write each run's TensorBoard event file, live, under
+    /// Also write each run's TensorBoard event file, live, under
     /// <out>/tensorboard/<method>-run<r>/ (CleanRL's tag names, SAP-Net's activations and
     /// probabilities, the run's hyper-parameters): `tensorboard --logdir <out>/tensorboard`.
     #[arg(long)]

@@ -238,8 +238,11 @@ fn a_diverging_run_stops_with_an_error_and_keeps_its_last_good_weights() {
     }
 }
 
+/// Issue 36: the output flags are the UI's too (it runs the protocol into --out); with
+/// no terminal to draw on, the UI says so and points at --headless before it takes a
+/// folder or trains anything.
 #[test]
-fn output_flags_without_headless_are_refused_before_the_dashboard_opens() {
+fn output_flags_without_headless_and_without_a_terminal_are_refused_before_anything_is_written() {
     for flag in [
         &["--out", "somewhere"][..],
         &["--trace"],
@@ -250,8 +253,8 @@ fn output_flags_without_headless_are_refused_before_the_dashboard_opens() {
         assert_eq!(output.status.code(), Some(2));
         assert!(
             stderr(&output).contains(
-                "--out, --force, --jobs, --trace, --tensorboard and --add-to-library are for \
-                 --headless runs"
+                "the protocol runs in the terminal UI, and stdout is not a terminal: use \
+                 --headless"
             ),
             "{}",
             stderr(&output)

@@ -76,6 +76,8 @@ pub fn run(start: Start, settings: &Settings) -> Result<Ended> {
     let task = start.config.env.gym_id();
     let dir = start.output.dir.clone();
     let followed = start.followed.clone();
+    let capture = StderrCapture::start();
+    let (mut terminal, guard) = crate::tui::open_terminal()?;
     let protocol = ProtocolRun::start(
         start.config,
         start.output,
@@ -86,8 +88,6 @@ pub fn run(start: Start, settings: &Settings) -> Result<Ended> {
     let mut session = Session::new(&dir, &task, followed, Phase::Running);
     session.reference = settings.reference.clone();
     let reads = FolderReads::start(&dir)?;
-    let capture = StderrCapture::start();
-    let (mut terminal, guard) = crate::tui::open_terminal()?;
     let mut running = Running {
         protocol: Some(protocol),
         reads,

@@ -510,6 +510,9 @@ impl Session {
     /// Follows `key`: the run followed so far is let go at full speed (a run left paused
     /// would hold the protocol up for ever).
     pub fn follow(&mut self, key: RunKey) {
+        if self.followed.as_ref() == Some(&key) {
+            return;
+        }
         if let Some(left) = self.followed_run_mut() {
             let board = &mut left.dashboard;
             if board.mode != Mode::Running || board.speed != 0 {
@@ -573,6 +576,44 @@ mod tests {
         let ctrl_c = KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL);
         assert_eq!(session.on_key(ctrl_c), Request::None);
         assert_eq!(session.on_key(ctrl_c), Request::Stop { then_quit: true });
+    }
+
+    #[test]
+    fn a_run_left_is_let_go_at_full_speed() {
+        use crate::reuse::Method;
+        use crate::trainer::{command_channel, MethodId};
+        let mut session = Session::new(
+            Path::new("out/x"),
+            "CartPole-v1",
+            Some(("sapnet".into(), 0)),
+            Phase::Running,
+        );
+        let mut receivers = Vec::new();
+        for (i, method) in [Method::SapNet, Method::Random].iter().enumerate() {
+            let (commands, receiver) = command_channel();
+            receivers.push(receiver);
+            session.on_watched(Watched::Started {
+                method: MethodId::new(i, method),
+                run: 0,
+                commands,
+            });
+        }
+        // Space pauses the followed run; `-` slows it.
+        session.on_key(key(' '));
+        session.on_key(key('-'));
+        let board = |s: &Session, label: &str| {
+            let run = &s.runs[&(label.to_string(), 0)];
+            (run.dashboard.mode, run.dashboard.speed)
+        };
+        assert_eq!(board(&session, "sapnet"), (Mode::Paused, 1));
+        // `m` follows the other run training; the one left runs again at full speed.
+        session.on_key(key('m'));
+        assert_eq!(session.followed, Some(("random".to_string(), 0)));
+        assert_eq!(board(&session, "sapnet"), (Mode::Running, 0));
+        // Following the run already followed changes nothing.
+        session.on_key(key(' '));
+        session.follow(("random".to_string(), 0));
+        assert_eq!(board(&session, "random"), (Mode::Paused, 0));
     }
 
     #[test]
