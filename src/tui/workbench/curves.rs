@@ -53,8 +53,12 @@ pub struct Curves {
     /// among those with episodes).
     pub run: Option<usize>,
     /// Each method's curve, with the episode counts of the runs it was made of.
-    cache: RefCell<Vec<Option<(Vec<usize>, Vec<EfficiencyPoint>)>>>,
+    cache: RefCell<Vec<Option<Cached>>>,
 }
+
+/// A method's curve and the episode counts of the runs it was made of: made again when
+/// they change.
+type Cached = (Vec<usize>, Vec<EfficiencyPoint>);
 
 impl Default for Curves {
     fn default() -> Self {
