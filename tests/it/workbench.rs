@@ -958,4 +958,48 @@ fn the_sweep_view_shows_the_cells_and_the_merges_comparisons() {
         assert!(drawn.contains(&shown), "{shown} in\n{drawn}");
         insta::assert_snapshot!(format!("workbench_sweep_{w}x{h}"), terminal.backend());
     }
+
+    // A cell being run: its process, from its protocol's lock, and its progress; the
+    // cells not started are queued while it runs. Stopped (SIGSTOP) once its folder is
+    // locked and its summary written, so that it holds still while read.
+    let child = sapnet()
+        .args(["sweep", "run"])
+        .arg(&dir)
+        .args(["--cell", "4", "--jobs", "1"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let partial = dir.join("results/.0004.partial");
+    let started = Instant::now();
+    while !(partial.join("summary.json").exists() && partial.join(".sapnet.lock").exists()) {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "cell 4 never started"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    signal(&child, "STOP");
+    let stat = format!("/proc/{}/stat", child.id());
+    while !std::fs::read_to_string(&stat).is_ok_and(|s| s.contains(") T ")) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let live = SweepState::read(&dir);
+    let pid = child.id();
+    end(child);
+    let live = live.unwrap();
+    let statuses: Vec<&str> = live.cells.iter().map(|c| c.status.name()).collect();
+    if live.cells[4].status == CellStatus::Done {
+        // The cell finished before it was stopped: nothing running to see.
+        eprintln!("cell 4 finished before it could be stopped");
+        return;
+    }
+    assert_eq!(statuses[4..], ["running", "queued"], "{statuses:?}");
+    assert!(
+        matches!(&live.cells[4].status, CellStatus::Running(holder) if holder.pid == pid),
+        "{:?}",
+        live.cells[4].status
+    );
+    // Two methods × two runs.
+    assert_eq!(live.cells[4].progress.map(|(_, all)| all), Some(4));
 }

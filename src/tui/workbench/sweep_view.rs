@@ -39,8 +39,8 @@ pub fn draw(frame: &mut Frame, bench: &SweepBench, theme: Theme) {
         .iter()
         .map(|v| v.axis.chars().count() + v.value.chars().count() + 8)
         .max()
-        .unwrap_or(20)
-        .clamp(20, usize::from(values.width / 3)) as u16;
+        .unwrap_or(24)
+        .clamp(24, usize::from(values.width / 3).max(24)) as u16;
     let [list, comparison] =
         Layout::horizontal([Constraint::Length(list_width), Constraint::Fill(1)]).areas(values);
     draw_values(frame, list, bench, theme);
