@@ -63,7 +63,7 @@ mod tests {
             "BestSource",
             "Dqn(hidden: [16])",
         ]
-        .map(|text| ron::from_str(text).unwrap())
+        .map(|text| crate::ron_file::ron_options().from_str(text).unwrap())
         .to_vec();
         let kinds: Vec<&str> = every
             .iter()

@@ -475,7 +475,11 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
             .unwrap_or_else(|| panic!("{label} in the legend of\n{drawn}"))
             .to_string();
         let at = line.find(&format!("{label} ")).unwrap() + label.len();
-        line[at..].trim().trim_end_matches('│').trim().to_string()
+        line[at..]
+            .trim_end_matches('"')
+            .trim_end_matches('│')
+            .trim()
+            .to_string()
     };
     let tenth = |row: &(String, String, [String; 3])| {
         let [v, lo, hi] = row.2.clone().map(|x| x.parse::<f64>().unwrap());
@@ -498,7 +502,7 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
     let (from, to) = workbench.curves.range(&workbench.folder);
     assert_eq!((from, to), (6.0, 26.0));
     let drawn = text(&screen(&workbench, (120, 40)));
-    assert!(drawn.contains("episodes 6–26 of 30"), "{drawn}");
+    assert!(drawn.contains("ep 6–26 of 30"), "{drawn}");
     assert!(drawn.contains("IQM [95% CI] at ep 26"), "{drawn}");
     for label in labels {
         let rows = efficiency_rows(&out, label, "iqm");
@@ -609,7 +613,13 @@ fn the_comparison_view_and_lock_in_equal_the_table_and_comparison_csv() {
     let workbench = workbench(&out, "c");
     let drawn = text(&screen(&workbench, (120, 40)));
     let mut measured = Vec::new();
-    for (line, row) in table.iter().zip(&rows) {
+    // The view's rows, in the table's order below its header (a long label is cut).
+    let view_rows: Vec<&str> = drawn
+        .lines()
+        .skip_while(|l| !l.starts_with("\"│method "))
+        .skip(1)
+        .collect();
+    for ((line, row), shown) in table.iter().zip(&rows).zip(view_rows) {
         let method = &row[0];
         assert_eq!(&line[0], method);
         // The table's cells are comparison.csv's numbers to a tenth.
@@ -629,10 +639,11 @@ fn the_comparison_view_and_lock_in_equal_the_table_and_comparison_csv() {
             );
         }
         // The view's row shows those two cells, and no other interval.
-        let shown = drawn
-            .lines()
-            .find(|l| l.starts_with(&format!("│{method} ")))
-            .unwrap_or_else(|| panic!("{method} in\n{drawn}"));
+        let label: String = method.chars().take(21).collect();
+        assert!(
+            shown.starts_with(&format!("\"│{label}")),
+            "{method}: {shown}"
+        );
         let intervals: Vec<String> = intervals_in(shown);
         assert_eq!(
             intervals,
@@ -662,8 +673,8 @@ fn the_comparison_view_and_lock_in_equal_the_table_and_comparison_csv() {
         measured,
         [
             "sapnet",
-            "sapnet[episode,decay0.99]",
-            "sapnet[k5,linear5to1]",
+            "sapnet-episode-decay0.99",
+            "sapnet-tau-lin5-1-k5",
             "prql[8]"
         ],
         "lock-in means something for the learned selections only"
@@ -947,4 +958,48 @@ fn the_sweep_view_shows_the_cells_and_the_merges_comparisons() {
         assert!(drawn.contains(&shown), "{shown} in\n{drawn}");
         insta::assert_snapshot!(format!("workbench_sweep_{w}x{h}"), terminal.backend());
     }
+
+    // A cell being run: its process, from its protocol's lock, and its progress; the
+    // cells not started are queued while it runs. Stopped (SIGSTOP) once its folder is
+    // locked and its summary written, so that it holds still while read.
+    let child = sapnet()
+        .args(["sweep", "run"])
+        .arg(&dir)
+        .args(["--cell", "4", "--jobs", "1"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let partial = dir.join("results/.0004.partial");
+    let started = Instant::now();
+    while !(partial.join("summary.json").exists() && partial.join(".sapnet.lock").exists()) {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "cell 4 never started"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    signal(&child, "STOP");
+    let stat = format!("/proc/{}/stat", child.id());
+    while !std::fs::read_to_string(&stat).is_ok_and(|s| s.contains(") T ")) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let live = SweepState::read(&dir);
+    let pid = child.id();
+    end(child);
+    let live = live.unwrap();
+    let statuses: Vec<&str> = live.cells.iter().map(|c| c.status.name()).collect();
+    if live.cells[4].status == CellStatus::Done {
+        // The cell finished before it was stopped: nothing running to see.
+        eprintln!("cell 4 finished before it could be stopped");
+        return;
+    }
+    assert_eq!(statuses[4..], ["running", "queued"], "{statuses:?}");
+    assert!(
+        matches!(&live.cells[4].status, CellStatus::Running(holder) if holder.pid == pid),
+        "{:?}",
+        live.cells[4].status
+    );
+    // Two methods × two runs.
+    assert_eq!(live.cells[4].progress.map(|(_, all)| all), Some(4));
 }

@@ -27,39 +27,87 @@ pub(super) const KEYS: &[(&str, &str)] = &[
     ("+/−", "its positive / negative transitions so far (eq. 7)"),
     (
         "lock-in step",
-        "the step one source's P passed 0.99 (as the table and comparison.csv): SAP-Net and \
-         PRQ-learning only, whose P is learned; - for the others",
+        "P first above 0.99: sapnet, prql only; - elsewhere",
     ),
-    ("", ""),
-    ("score, P(π)", "the table's two columns, by method:"),
+];
+
+/// What the table's score column and P(π) are, by the score's name (the column's
+/// header), one line per method.
+const COLUMNS: &[(&str, &str, &str)] = &[
     (
+        "A",
         "sapnet",
         "A: activation (eq. 5); P: the softmax of A (eq. 6)",
     ),
-    ("prql", "W: mean scaled discounted return; P: softmax(τ·W)"),
     (
+        "W",
+        "prql",
+        "W: mean scaled discounted return; P: softmax(τ·W)",
+    ),
+    (
+        "mean",
         "ucb1",
-        "mean: scaled return of its pulls; P: 1 on the next pull",
+        "mean: scaled return of its pulls; P: 1 on the next",
     ),
     (
+        "acted",
         "random",
-        "acted: steps it acted; P: 1/N (per episode: the drawn one)",
+        "acted: steps it acted; P: 1/N (per episode: 1 drawn)",
     ),
-    ("best-source", "score: its recorded score; P: 1 on the best"),
     (
+        "score",
+        "best-source",
+        "score: its recorded score; P: 1 on the best",
+    ),
+    (
+        "wins",
         "gpi",
-        "wins: steps whose action took its Q (the max); P: their share",
+        "wins: steps its Q won the max; P: their share",
     ),
     (
+        "followed",
         "qswitch",
-        "followed: steps that followed its action; P: their share",
+        "followed: steps that took its action; P: their share",
     ),
     (
+        "λ",
         "qdagger",
-        "λ: λ_t on the teacher's row; P: the teacher's share of steps",
+        "λ: λ_t on the teacher's row; P: the teacher's share",
     ),
-    (
-        "a2t",
-        "w̄: mean attention weight over the run; P: its weight now",
-    ),
+    ("w̄", "a2t", "w̄: mean attention weight; P: its weight now"),
 ];
+
+/// The overlay's lines: the keys and symbols, then what the score and P(π) columns mean
+/// for the followed method (`score_name`) and, when `room` lines allow, for every other.
+pub(super) fn keys(score_name: Option<&str>, room: usize) -> Vec<(&'static str, &'static str)> {
+    let mut lines = KEYS.to_vec();
+    let followed = COLUMNS
+        .iter()
+        .filter(|(name, ..)| Some(*name) == score_name);
+    let others = COLUMNS
+        .iter()
+        .filter(|(name, ..)| Some(*name) != score_name);
+    let all = lines.len() + COLUMNS.len() <= room;
+    lines.extend(
+        followed
+            .chain(others.filter(|_| all))
+            .map(|&(_, method, what)| (method, what)),
+    );
+    lines
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_followed_methods_columns_first_and_the_others_where_they_fit() {
+        let short = keys(Some("wins"), KEYS.len() + 3);
+        assert_eq!(short.len(), KEYS.len() + 1);
+        assert_eq!(short.last().unwrap().0, "gpi");
+        let tall = keys(Some("wins"), 40);
+        assert_eq!(tall.len(), KEYS.len() + COLUMNS.len());
+        assert_eq!(tall[KEYS.len()].0, "gpi", "the followed method first");
+        assert_eq!(keys(None, KEYS.len()).len(), KEYS.len());
+    }
+}

@@ -41,7 +41,10 @@ pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
         if let (Some(teach), Mode::Teach) = (&dashboard.teach, dashboard.mode) {
             draw_help(frame, area, &teach_view::teach_help(teach, true), theme);
         } else {
-            draw_help(frame, area, help::KEYS, theme);
+            let score_name = dashboard.library.as_ref().map(|v| v.score_name);
+            // The overlay's borders and margins take four lines.
+            let room = usize::from(area.height).saturating_sub(4);
+            draw_help(frame, area, &help::keys(score_name, room), theme);
         }
     }
 }

@@ -53,8 +53,12 @@ pub struct Curves {
     /// among those with episodes).
     pub run: Option<usize>,
     /// Each method's curve, with the episode counts of the runs it was made of.
-    cache: RefCell<Vec<Option<(Vec<usize>, Vec<EfficiencyPoint>)>>>,
+    cache: RefCell<Vec<Option<Cached>>>,
 }
+
+/// A method's curve and the episode counts of the runs it was made of: made again when
+/// they change.
+type Cached = (Vec<usize>, Vec<EfficiencyPoint>);
 
 impl Default for Curves {
     fn default() -> Self {
@@ -190,36 +194,18 @@ fn clamp((from, to): (f64, f64), (first, last): (f64, f64)) -> (f64, f64) {
 
 /// Every key of the Curves view, for `?`.
 pub const KEYS: [(&str, &str); 6] = [
-    (
-        "v",
-        "Curves: each method's MA10 over its runs (IQM or mean) with its 95% bootstrap band, \
-         as sample_efficiency.csv",
-    ),
-    (
-        "↑ ↓, space",
-        "Curves: pick a method in the legend; show or hide it",
-    ),
+    ("v", "Curves: MA10 over runs with its 95% band"),
+    ("↑ ↓, space", "Curves: pick a method; show or hide it"),
     ("m", "Curves: IQM or mean over runs"),
-    (
-        "+ -, ← →, 0",
-        "Curves: zoom the episodes in and out, move along them, all of them",
-    ),
-    (
-        "Enter, [ ]",
-        "Curves: the picked method's runs one by one (the previous and next run); Enter \
-         again: every method",
-    ),
-    (
-        "click",
-        "a view's name in the status bar; a run (Runs), a method (Comparison, Curves' \
-         legend: shows or hides it)",
-    ),
+    ("+ -, ← →, 0", "Curves: zoom, move along the episodes, all"),
+    ("Enter, [ ]", "Curves: the picked method's runs one by one"),
+    ("click", "a view's name, a run, a method, a legend entry"),
 ];
 
 /// The Curves view's keys in the status bar.
 pub const COMMANDS: [(&str, &str); 5] = [
     ("↑↓", "method"),
-    ("space", "on/off"),
+    ("␣", "on/off"),
     ("m", "IQM/mean"),
     ("+-←→", "zoom"),
     ("⏎", "runs"),

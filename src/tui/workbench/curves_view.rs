@@ -71,7 +71,7 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
         return;
     }
     let label_width = label_width(folder);
-    let [chart, legend] = areas(inside, label_width);
+    let [chart, legend] = areas(inside, label_width, curves.run.is_some());
     match curves.run {
         Some(k) => {
             let Some(method) = methods.get(curves.cursor) else {
@@ -124,8 +124,12 @@ fn label_width(folder: &FolderState) -> usize {
 
 /// The chart and, right of it, the legend: toggle, marker, label and the value with its
 /// interval where it fits.
-fn areas(inside: Rect, label_width: usize) -> [Rect; 2] {
-    let legend_width = (label_width as u16 + 27).min(inside.width / 2);
+fn areas(inside: Rect, label_width: usize, runs: bool) -> [Rect; 2] {
+    // On a narrow terminal the values without their intervals leave the chart room; one
+    // method's runs list their status and episodes.
+    let wanted = if inside.width >= 110 { 27 } else { 13 };
+    let wanted = if runs { wanted.max(30) } else { wanted };
+    let legend_width = (label_width as u16 + wanted).min(inside.width / 2);
     let [chart, _, legend] = Layout::horizontal([
         Constraint::Fill(1),
         Constraint::Length(1),
@@ -142,7 +146,7 @@ pub fn legend_method_at(area: Rect, workbench: &Workbench, column: u16, row: u16
         return None;
     }
     let inside = inner(area);
-    let [_, legend] = areas(inside, label_width(&workbench.folder));
+    let [_, legend] = areas(inside, label_width(&workbench.folder), false);
     let first = legend.y + 1;
     if !(legend.x..legend.x + legend.width).contains(&column) || row < first {
         return None;
@@ -166,16 +170,18 @@ fn title(
         format!("partial: {finished} of {planned_runs} runs finished, running ones so far")
     };
     let zoom = if curves.zoom.is_some() {
-        format!(" · episodes {from:.0}–{to:.0} of {:.0}", planned(folder))
+        format!(" · ep {from:.0}–{to:.0} of {:.0}", planned(folder))
     } else {
         String::new()
     };
+    let what = match curves.run {
+        Some(_) => "one run's MA{window} over its method's".to_string(),
+        None => format!("MA{window} {} over runs,", curves.statistic.name()),
+    }
+    .replace("{window}", &window.to_string());
     Line::from(vec![
         Span::styled(" Curves ", theme.title()),
-        Span::raw(format!(
-            "MA{window} {} over runs, 95% bootstrap band · {over}{zoom} ",
-            curves.statistic.name()
-        )),
+        Span::raw(format!("{what} 95% band · {over}{zoom} ")),
     ])
 }
 
@@ -274,7 +280,13 @@ fn draw_chart(
                         color: colour(m),
                     });
                 }
-                for pair in estimates.windows(2) {
+                // One run shown alone: its method's band under it, not its method's line.
+                let pairs = if run.is_empty() {
+                    estimates.windows(2)
+                } else {
+                    [].windows(2)
+                };
+                for pair in pairs {
                     ctx.draw(&Segment {
                         x1: pair[0].0,
                         y1: pair[0].1.point,
@@ -343,10 +355,15 @@ fn draw_legend(
         .map(|m| value_at_end(&m.points, range))
         .collect();
     let at = ends.iter().flatten().map(|p| p.episode).max();
+    // The intervals where the legend is wide enough for them.
+    let intervals = width >= label_width + 27;
     let mut lines = vec![Line::styled(
         fit(
             &match at {
-                Some(episode) => format!("{} [95% CI] at ep {episode}", curves.statistic.name()),
+                Some(episode) if intervals => {
+                    format!("{} [95% CI] at ep {episode}", curves.statistic.name())
+                }
+                Some(episode) => format!("{} at ep {episode}", curves.statistic.name()),
                 None => curves.statistic.name().to_string(),
             },
             width,
@@ -370,9 +387,8 @@ fn draw_legend(
             |p| {
                 let e = curves.statistic.of(p);
                 // Returns, to a tenth, as the tables print them.
-                let full = crate::report::comparison::interval(&e, 1);
-                if 6 + label_width + 1 + full.chars().count() <= width {
-                    full
+                if intervals {
+                    crate::report::comparison::interval(&e, 1)
                 } else {
                     format!("{:.1}", e.point)
                 }
@@ -394,10 +410,7 @@ fn draw_legend(
             ),
         ]));
     }
-    lines.push(Line::styled(
-        fit("space: on/off · ⏎: its runs", width),
-        theme.dim(),
-    ));
+    lines.push(Line::styled(fit("␣: on/off · ⏎: runs", width), theme.dim()));
     frame.render_widget(Paragraph::new(lines), area);
 }
 

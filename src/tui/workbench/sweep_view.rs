@@ -37,10 +37,10 @@ pub fn draw(frame: &mut Frame, bench: &SweepBench, theme: Theme) {
     let list_width = bench
         .values
         .iter()
-        .map(|v| v.axis.chars().count() + v.value.chars().count() + 14)
+        .map(|v| v.axis.chars().count() + v.value.chars().count() + 8)
         .max()
-        .unwrap_or(20)
-        .clamp(20, usize::from(values.width / 3)) as u16;
+        .unwrap_or(24)
+        .clamp(24, usize::from(values.width / 3).max(24)) as u16;
     let [list, comparison] =
         Layout::horizontal([Constraint::Length(list_width), Constraint::Fill(1)]).areas(values);
     draw_values(frame, list, bench, theme);
@@ -113,12 +113,21 @@ fn draw_cells(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) {
             theme.title()
         },
     )]);
-    frame.render_widget(Block::bordered().title(title), area);
+    let cells = &bench.sweep.cells;
     let inside = inner(area);
+    let window = RowWindow::new(
+        cells.len(),
+        usize::from(inside.height.saturating_sub(1)),
+        [bench.cell_cursor],
+    );
+    // The cells the panel hides, on its bottom border (Tab, then ↑↓ reach them).
+    let block = Block::bordered().title(title).title_bottom(
+        Line::styled(window.marker().unwrap_or_default(), theme.title()).right_aligned(),
+    );
+    frame.render_widget(block, area);
     if inside.height < 2 {
         return;
     }
-    let cells = &bench.sweep.cells;
     let axes_width = cells
         .iter()
         .map(|c| c.axes.chars().count())
@@ -133,11 +142,6 @@ fn draw_cells(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) {
         ),
         theme.dim(),
     )];
-    let window = RowWindow::new(
-        cells.len(),
-        usize::from(inside.height) - 1,
-        [bench.cell_cursor],
-    );
     for i in window.rows() {
         let cell = &cells[i];
         let picked = focused && i == bench.cell_cursor;
@@ -162,7 +166,7 @@ fn draw_cells(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) {
 fn draw_values(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) {
     let focused = bench.focus == Focus::Values;
     let title = Span::styled(
-        " Axis values ",
+        " Values (done cells) ",
         if focused {
             theme.title().patch(theme.cursor())
         } else {
@@ -188,10 +192,7 @@ fn draw_values(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) 
         .rows()
         .map(|i| {
             let v = &bench.values[i];
-            let text = fit(
-                &format!("{} = {} ({} cells)", v.axis, v.value, v.cells),
-                width,
-            );
+            let text = fit(&format!("{}={} ({})", v.axis, v.value, v.cells), width);
             if i == bench.value_cursor {
                 Line::styled(text, theme.cursor())
             } else {

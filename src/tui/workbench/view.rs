@@ -35,7 +35,10 @@ pub fn draw(frame: &mut Frame, workbench: &Workbench, theme: Theme) {
         View::Comparison => comparison_view::draw(frame, body, workbench, theme),
         View::Curves => curves_view::draw(frame, body, workbench, theme),
     }
-    frame.render_widget(Paragraph::new(status_line(workbench, theme)), status);
+    frame.render_widget(
+        Paragraph::new(status_line(workbench, theme, usize::from(status.width))),
+        status,
+    );
     if workbench.help {
         screen::draw_help(frame, area, &workbench.keys(), theme);
     }
@@ -106,9 +109,10 @@ fn header_line(workbench: &Workbench, theme: Theme, width: usize) -> Line<'stati
     Line::from(spans)
 }
 
-/// The views' keys, the one shown marked, then the shown view's own keys; the keys for
-/// help and quitting stay at the end, where a narrow terminal cuts last.
-fn status_line(workbench: &Workbench, theme: Theme) -> Line<'static> {
+/// The views' keys, the one shown marked, then the shown view's own keys (left out when
+/// the line would not fit `width`: `?` lists them); the keys for help and quitting stay
+/// at the end.
+fn status_line(workbench: &Workbench, theme: Theme, width: usize) -> Line<'static> {
     let mut spans = vec![Span::raw(" ")];
     for view in View::ALL {
         let (key, name) = view.key();
@@ -122,9 +126,20 @@ fn status_line(workbench: &Workbench, theme: Theme) -> Line<'static> {
         spans.push(Span::raw("  "));
     }
     spans.push(Span::styled("│ ", theme.dim()));
+    // As many of the view's own keys as fit before the keys for help and quitting.
+    let end = "│ ? keys  q quit".chars().count();
+    let mut used: usize = spans.iter().map(Span::width).sum();
     for (key, what) in workbench.view_commands() {
-        spans.push(Span::styled(key.to_string(), theme.title()));
-        spans.push(Span::raw(format!(" {what}  ")));
+        let command = [
+            Span::styled(key.to_string(), theme.title()),
+            Span::raw(format!(" {what}  ")),
+        ];
+        let wide: usize = command.iter().map(Span::width).sum();
+        if used + wide + end > width {
+            break;
+        }
+        used += wide;
+        spans.extend(command);
     }
     spans.push(Span::styled("│ ", theme.dim()));
     spans.push(Span::styled("?", theme.title()));
