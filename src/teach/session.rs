@@ -1191,7 +1191,6 @@ impl Teach {
             }),
             decay: self.decay,
             questions: self.questions.clone(),
-            ..self.source.clone()
         }
     }
 
