@@ -107,7 +107,8 @@ pub enum WalkPanel {
 }
 
 impl WalkPanel {
-    fn next(self) -> Self {
+    /// The panel `v` shows after this one.
+    pub fn following(self) -> Self {
         match self {
             Self::Trace => Self::Tree,
             Self::Tree => Self::Chart,
@@ -327,7 +328,7 @@ impl Teach {
 
     /// `v`: the trace, the tree, the chart, A and P through time, in turn.
     pub fn next_panel(&mut self) {
-        self.panel = self.panel.next();
+        self.panel = self.panel.following();
     }
 
     /// `r`'s speed, in calls a second.
@@ -1190,7 +1191,6 @@ impl Teach {
             }),
             decay: self.decay,
             questions: self.questions.clone(),
-            ..self.source.clone()
         }
     }
 

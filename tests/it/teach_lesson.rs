@@ -464,3 +464,70 @@ fn a_lesson_saved_mid_walk_gives_the_trace_the_screen_showed() {
     let whole: serde_json::Value = serde_json::from_slice(&whole.stdout).unwrap();
     assert_eq!(whole["trace"].as_array().unwrap().len(), 21);
 }
+
+/// In tmux, opened with `--exercise`: a teacher adds a policy by `n` (π4, joined to
+/// nothing), joins it to π3 at 0.3 by `E`, saves with `w`, and quits; the file, run
+/// headless from π4, walks as `--add-policy - --add-edge 4 3 0.3` does, its first call
+/// π4 → π3 at h = 1, Ω = 0.3 with η = 𝒜/k = 1: ΔA = 1/(1×0.3) = 3.333333.
+#[test]
+fn a_teacher_adds_a_policy_and_saves_the_lesson_in_tmux() {
+    if !crate::common::tmux::available() {
+        eprintln!("tmux is not installed: the end-to-end lesson test is skipped");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let saved = dir.path().join("five.ron");
+    let command = format!(
+        "{} teach --exercise; echo SAPNET-EXITED $?; sleep 60",
+        env!("CARGO_BIN_EXE_sapnet")
+    );
+    let session = crate::common::tmux::Session::start(120, 40, &command);
+    session.wait_for(&["the call", "exercise 0/0"]);
+    session.keys("n");
+    session.wait_for(&["--add-policy - done"]);
+    session.keys("E");
+    session.wait_for(&["add edge I J W"]);
+    session.keys("4 3 0.3");
+    session.keys("Enter");
+    session.wait_for(&["--add-edge 4 3 0.3 done"]);
+    session.keys("w");
+    session.wait_for(&["save the lesson to: lesson.ron"]);
+    for _ in "lesson.ron".chars() {
+        session.keys("BSpace");
+    }
+    session.keys(saved.to_str().unwrap());
+    session.keys("Enter");
+    session.wait_for(&["wrote "]);
+    session.keys("q");
+    session.wait_for(&["SAPNET-EXITED 0"]);
+    let by_keys = sapnet(&[
+        "teach",
+        "--headless",
+        "--config",
+        saved.to_str().unwrap(),
+        "--activate",
+        "4",
+        "--json",
+    ]);
+    let by_flags = sapnet(&[
+        "teach",
+        "--add-policy",
+        "-",
+        "--add-edge",
+        "4",
+        "3",
+        "0.3",
+        "--activate",
+        "4",
+        "--headless",
+        "--json",
+    ]);
+    assert_eq!(by_keys.stdout, by_flags.stdout);
+    let json: serde_json::Value = serde_json::from_slice(&by_keys.stdout).unwrap();
+    let first = &json["trace"][0];
+    assert_eq!(
+        (first["from"].as_u64(), first["to"].as_u64()),
+        (Some(4), Some(3))
+    );
+    assert!((first["delta"].as_f64().unwrap() - 1.0 / 0.3).abs() < 1e-12);
+}

@@ -331,3 +331,161 @@ fn a_click_on_a_node_label_picks_its_policy() {
         }
     }
 }
+
+/// Two policies joined at 0.4 (the hand count is in src/teach/session.rs's
+/// `one_decay_step_between_two_activations_by_hand`), with `extra` fields.
+fn two_policies(extra: &str) -> Teach {
+    let text = format!("(policies: 2, edges: [(0, 1, 0.4)]{extra})");
+    let source = TeachConfig::lesson_from_ron(&text, "two.ron").unwrap();
+    let config = sapnet::ron_file::parse_ron::<TeachConfig>(&text, "two.ron").unwrap();
+    Teach::new(source.names, source.net).with_source(config)
+}
+
+fn text(terminal: &Terminal<TestBackend>) -> String {
+    lines(terminal).join("\n")
+}
+
+/// Fig. 2 from π1 after three calls, `v` once: each call under the call that made it, two
+/// spaces a level, with h, Ω, η and ΔA (1/3 ÷ (1 × 0.4) = 0.833333, then 1/6 ÷ (2 × 0.8) =
+/// 0.104167, then Ω = 1.2 stopped), the next call marked.
+#[test]
+fn the_walk_as_a_tree_puts_each_call_under_its_caller() {
+    let mut teach = fig2();
+    teach.move_cursor(1);
+    teach.activate();
+    for _ in 0..3 {
+        teach.step();
+    }
+    teach.next_panel();
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = text(&terminal);
+        for line in [
+            "tree (v: chart)",
+            "└ π1→π0 h 1 Ω 0.40 η 0.3333 ΔA 0.833333",
+            "  └ π0→π1 h 2 Ω 0.80 η 0.1667 ΔA 0.104167",
+            "    └ π1→π0 h 3 Ω 1.20 η 0.0556 stopped",
+            "    └ π1→π2 h 3 Ω 1.20 η 0.0556 ▶ next",
+        ] {
+            assert!(screen.contains(line), "{size:?} {line}:\n{screen}");
+        }
+        insta::assert_snapshot!(
+            format!("teach_tree_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+}
+
+/// `v` twice: A and P of every policy over the 21 calls of Fig. 2's walk from π1.
+#[test]
+fn a_chart_draws_a_and_p_over_the_calls() {
+    let mut teach = fig2();
+    teach.move_cursor(1);
+    teach.activate();
+    teach.run_to_end();
+    teach.next_panel();
+    teach.next_panel();
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = text(&terminal);
+        assert!(screen.contains("chart (v: through time)"), "{screen}");
+        // The x axis ends at the walk's last call.
+        assert!(screen.contains("21"), "{screen}");
+        insta::assert_snapshot!(
+            format!("teach_chart_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+}
+
+/// `v` thrice, after π0's walk and π1's with D = 0.5 between them: (1.625, 2.5), then
+/// (3.3125, 2.875); P(π0) after the first is 1/(1 + e^0.875) = 0.29.
+#[test]
+fn a_and_p_through_time_a_column_per_walk() {
+    let mut teach = two_policies(", decay: 0.5");
+    teach.activate();
+    teach.run_to_end();
+    teach.move_cursor(1);
+    teach.activate();
+    teach.run_to_end();
+    for _ in 0..3 {
+        teach.next_panel();
+    }
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = text(&terminal);
+        for said in [
+            "A (P) through time, D = 0.5 (v: trace)",
+            "1:π0",
+            "2:π1",
+            "1.6250 (0.29)",
+            "3.3125 (0.61)",
+        ] {
+            assert!(screen.contains(said), "{size:?} {said}:\n{screen}");
+        }
+        insta::assert_snapshot!(
+            format!("teach_through_time_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+}
+
+/// The status bar names the keys, the new ones too, and says what is on: M's clicks, the
+/// exercise's score.
+#[test]
+fn the_status_bar_names_the_new_keys_and_the_modes_on() {
+    let mut teach = fig2();
+    teach.toggle_exercise();
+    teach.toggle_linking();
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = lines(&terminal);
+        let status = screen.last().unwrap();
+        let modes = if size.0 >= 100 {
+            ["M: click two policies", "exercise 0/0"]
+        } else {
+            ["M clicks", "ex 0/0"]
+        };
+        for said in modes
+            .into_iter()
+            .chain(["E x M", "n D C", "v", "w", "X", "? q"])
+        {
+            assert!(status.contains(said), "{size:?} {said}: {status}");
+        }
+        insta::assert_snapshot!(
+            format!("teach_status_modes_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+}
+
+/// A lesson's question at the walk's end: asked in the edit panel, its answer nowhere on
+/// the screen until answered.
+#[test]
+fn a_question_is_asked_at_the_walks_end_and_its_answer_hidden() {
+    let mut teach = two_policies(
+        ", questions: [(ask: \"How much is 𝒜 × 7.25?\", answer: Number(value: 7.25, \
+         tolerance: 0.01))]",
+    );
+    teach.activate();
+    while teach.walk().is_some_and(|w| !w.done) {
+        teach.step();
+    }
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = text(&terminal);
+        assert!(screen.contains("How much is 𝒜 ×"), "{size:?}:\n{screen}");
+        assert_eq!(
+            screen.matches("7.25").count(),
+            1,
+            "only in the question:\n{screen}"
+        );
+        insta::assert_snapshot!(
+            format!("teach_question_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+    "7.25".chars().for_each(|c| teach.prompt_type(c));
+    teach.prompt_submit();
+    assert_eq!(teach.notice(), Some("right: 7.25 ± 0.01 · questions 1/1"));
+}

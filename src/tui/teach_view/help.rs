@@ -13,9 +13,18 @@ pub(crate) fn teach_help(
         ("↑↓←→ hjkl, click", "pick a policy (its node or its row)"),
         ("a", "activate the picked policy (A += 𝒜, eq. 8)"),
         ("s", "make the next spread call (eq. 9–11)"),
-        ("r", "run the spreading to its end (s, u, c stop it)"),
-        ("u", "undo the last call, then the activation"),
-        ("c", "back to the starting activations"),
+        (
+            "r / R",
+            "walk it call by call / run the spreading to its end",
+        ),
+        (
+            "< / >",
+            "r walks slower / faster (0.5 to 16 calls a second)",
+        ),
+        (
+            "u / c",
+            "undo the last call / back to the starting activations",
+        ),
     ];
     if teach.numbering().is_some() {
         keys.push(("p", "number the policies π1…πN as the paper does, or π0…"));
@@ -26,32 +35,28 @@ pub(crate) fn teach_help(
             "edit T_ω, 𝒜, τ, the path mode or the weight M of an edge",
         ),
         (
-            "+ / −",
-            "turn it a step: the walk restarts, the change is shown",
-        ),
-        ("e", "the picked policy's next edge (for 5 and x)"),
-        ("E", "add an edge I J W, or reweight it (as --add-edge)"),
-        ("x", "cut the picked policy's selected edge"),
-        (
-            "M, click, click",
-            "mouse edits M: click two policies to join them (0.4) or cut",
+            "+ / − · e",
+            "turn it a step (the walk restarts) · the next edge",
         ),
         (
-            "n",
-            "add a policy (its category asked where categories build M)",
-        ),
-        ("D", "remove the picked policy and its edges"),
-        (
-            "C",
-            "change the picked policy's category (as --set-category)",
+            "E / x",
+            "add or reweight an edge I J W / cut the selected edge",
         ),
         (
-            "w",
-            "write the lesson as it stands to a file (--config reads it)",
+            "M",
+            "clicks edit M: click two policies to join (0.4) or cut",
         ),
         (
-            "X",
-            "exercise: s asks the next call's ΔA first and scores it",
+            "n / D / C",
+            "add a policy / remove the picked / change its category",
+        ),
+        (
+            "v",
+            "show the trace, the tree, the chart, or A and P through time",
+        ),
+        (
+            "w / X",
+            "save the lesson (--config reads it) / exercise: predict ΔA",
         ),
         ("?", "this help (any key closes it)"),
     ]);

@@ -3,19 +3,23 @@
 //! out, hands each to its file, and tells what a click lands on in the same rectangles.
 
 mod call;
+mod chart;
 mod edits;
 mod figures;
 mod graph_panel;
 mod help;
 mod stack;
 mod status_bar;
+mod time_table;
 mod trace;
+mod tree;
 mod values;
 
 use ratatui::layout::{Constraint, Layout, Position, Rect};
 use ratatui::widgets::Paragraph;
 use ratatui::Frame;
 
+use crate::teach::session::WalkPanel;
 use crate::teach::Teach;
 use crate::tui::screen::{draw_help, too_small, MIN_HEIGHT, MIN_WIDTH};
 use crate::tui::theme::Theme;
@@ -47,7 +51,24 @@ pub fn draw_body(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     frame.render_widget(edits, panels.edits);
     values::draw(frame, panels.values, teach, theme);
     stack::draw(frame, panels.stack, teach, theme);
-    trace::draw(frame, panels.trace, teach, theme);
+    draw_walk_panel(frame, panels.trace, teach, theme);
+}
+
+/// The panel under the edits: the trace, the tree, the chart or A and P through time
+/// (`v` cycles), its title naming the next.
+fn draw_walk_panel(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
+    let panel = teach.panel();
+    match panel {
+        WalkPanel::Trace => trace::draw(frame, area, teach, theme),
+        WalkPanel::Tree => tree::draw(frame, area, teach, theme, &walk_title(panel)),
+        WalkPanel::Chart => chart::draw(frame, area, teach, theme, &walk_title(panel)),
+        WalkPanel::ThroughTime => time_table::draw(frame, area, teach, theme, &walk_title(panel)),
+    }
+}
+
+/// `tree (v: chart)`: what the panel shows and what `v` shows next.
+fn walk_title(panel: WalkPanel) -> String {
+    format!("{} (v: {})", panel.name(), panel.following().name())
 }
 
 /// Where teach mode's panels go.

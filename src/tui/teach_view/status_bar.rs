@@ -11,8 +11,8 @@ use crate::teach::Teach;
 use crate::tui::theme::Theme;
 
 const TEACH_HINTS: &str =
-    "↑↓ pick · a activate · s step · r run · u undo · c reset · 1–5 +/− edit · ? help · q quit";
-const TEACH_HINTS_SHORT: &str = "↑↓ a s r u c · 1–5 +/− e · ? help · q quit";
+    "↑↓ a s · r walk R run · u c · 1–5 ± · E x M edges · n D C policy · v view · w save · X exercise · ? q";
+const TEACH_HINTS_SHORT: &str = "a s r R u c · 1–5 ± · E x M n D C · v w X · ? q";
 
 /// Draws the status line of `teach` in `area`, a row as wide as the screen.
 pub(super) fn draw(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
@@ -20,11 +20,51 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         Span::styled(" teach ", theme.title().add_modifier(Modifier::REVERSED)),
         Span::raw(" "),
     ];
-    if let Some(numbering) = teach.numbering() {
+    let wide = area.width >= 100;
+    let modes_on = teach.is_linking()
+        || teach.is_animating()
+        || teach.score().is_some()
+        || teach.quiz().is_some();
+    // On a narrow screen a mode that is on says more than the numbering.
+    if let (Some(numbering), true) = (teach.numbering(), wide || !modes_on) {
         spans.push(Span::raw(format!("{numbering} (p) · ")));
     }
+    // What is on that changes what keys and clicks do, said before the keys.
+    if teach.is_linking() {
+        let said = if wide {
+            "M: click two policies · "
+        } else {
+            "M clicks · "
+        };
+        spans.push(Span::styled(said, theme.active()));
+    }
+    if teach.is_animating() {
+        spans.push(Span::styled(
+            format!("r {}/s · ", teach.speed()),
+            theme.active(),
+        ));
+    }
+    if let Some(score) = teach.score() {
+        spans.push(Span::styled(
+            if wide {
+                format!("exercise {}/{} · ", score.right, score.asked)
+            } else {
+                format!("ex {}/{} · ", score.right, score.asked)
+            },
+            theme.active(),
+        ));
+    }
+    if let Some(quiz) = teach.quiz() {
+        spans.push(Span::raw(format!(
+            "questions {}/{} · ",
+            quiz.right, quiz.asked
+        )));
+    }
     // Narrow terminals drop the keys' words, not the keys.
-    let hints = if area.width >= 100 {
+    // The keys' words where they fit beside the modes said, else the keys alone.
+    let used: usize = spans.iter().map(|s| s.content.chars().count()).sum();
+    let room = usize::from(area.width).saturating_sub(used);
+    let hints = if wide && TEACH_HINTS.chars().count() <= room {
         TEACH_HINTS
     } else {
         TEACH_HINTS_SHORT

@@ -59,7 +59,7 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
         .header(Row::new(["#", "from", "to", "h", "Ω", "η", "ΔA"]).style(theme.title()))
         .block(
             Block::bordered()
-                .title(Span::styled(" trace ", theme.title()))
+                .title(Span::styled(" trace (v: tree) ", theme.title()))
                 .title_bottom(
                     Line::styled(window.marker().unwrap_or_default(), theme.title())
                         .right_aligned(),
