@@ -234,6 +234,8 @@ fn open_shows_a_live_folders_progress_and_changes_nothing() {
         session.wait_for(&[&format!("written by PID {pid}"), "running", "queued"]);
         session.keys("c");
         session.wait_for(&["partial: over the", "P(dqn[16] > Y)"]);
+        session.keys("v");
+        session.wait_for(&["MA10 IQM over runs, 95% band · partial"]);
         session.keys("q");
         session.wait_for(&["SAPNET-EXITED 0"]);
     } else {

@@ -10,7 +10,7 @@ use std::collections::BTreeSet;
 use crossterm::event::{KeyCode, KeyEvent};
 
 use crate::report::sample_efficiency::{self, EfficiencyPoint};
-use crate::results::folder_state::{FolderState, RunProgress};
+use crate::results::folder_state::{FolderState, RunProgress, RunStatus};
 use crate::stats::Estimate;
 
 /// The fewest episodes the view zooms in to: a moving average's span or so.
@@ -56,9 +56,9 @@ pub struct Curves {
     cache: RefCell<Vec<Option<Cached>>>,
 }
 
-/// A method's curve and the episode counts of the runs it was made of: made again when
-/// they change.
-type Cached = (Vec<usize>, Vec<EfficiencyPoint>);
+/// A method's curve and what its runs were when it was made (their episodes in points'
+/// worths, whether each had ended): made again when that changes.
+type Cached = (Vec<(usize, bool)>, Vec<EfficiencyPoint>);
 
 impl Default for Curves {
     fn default() -> Self {
@@ -93,7 +93,14 @@ impl Curves {
     /// method's rows of `sample_efficiency.csv`.
     pub fn curve(&self, folder: &FolderState, index: usize) -> Vec<EfficiencyPoint> {
         let runs = runs_of(folder, index);
-        let key: Vec<usize> = runs.iter().map(|r| r.episodes()).collect();
+        // A curve is a bootstrap per point (a large protocol's, a good part of a second):
+        // made again when a run has grown by a point's worth of episodes, or ended — not
+        // at every refresh of a live folder.
+        let quantum = (folder.config.protocol.episodes as usize / sample_efficiency::POINTS).max(1);
+        let key: Vec<(usize, bool)> = runs
+            .iter()
+            .map(|r| (r.episodes() / quantum, r.status == RunStatus::Done))
+            .collect();
         let mut cache = self.cache.borrow_mut();
         if cache.len() <= index {
             cache.resize(index + 1, None);
