@@ -9,6 +9,7 @@ use anyhow::{Context, Result};
 
 use super::category;
 use super::lesson::{TeachConfig, MAX_LESSON_POLICIES};
+use super::questions::Answer;
 use crate::sapnet::Prototype;
 
 /// One edit of the graph M (its edges are undirected) or of its policies.
@@ -212,6 +213,21 @@ impl TeachConfig {
         if n == 1 {
             return Err("a lesson keeps at least one policy".into());
         }
+        // A question's hidden answer follows its policy to its new number; a question
+        // whose answer is this policy would be left without one.
+        if self.questions.iter().any(|q| q.answer == Answer::Policy(i)) {
+            return Err(format!(
+                "policy {i} is the answer to one of the lesson's questions: change the \
+                 question first"
+            ));
+        }
+        for question in &mut self.questions {
+            if let Answer::Policy(k) = &mut question.answer {
+                if *k > i {
+                    *k -= 1;
+                }
+            }
+        }
         let renumber = |k: usize| if k > i { k - 1 } else { k };
         self.edges = self
             .edges
@@ -391,8 +407,21 @@ mod tests {
         assert_eq!(built.net.graph().degree(4), 0);
         // Fig. 2's edges (0,1) (0,2) (1,2) (1,3) without π1: (0,2) is now (0,1).
         let mut removed = fig2();
+        let question = |i| crate::teach::questions::Question {
+            ask: "Which?".into(),
+            answer: Answer::Policy(i),
+        };
+        removed.questions = vec![question(3)];
         removed.apply(&GraphEdit::RemovePolicy { i: 1 }).unwrap();
         assert_eq!(removed.edges, [(0, 1, 0.4)]);
+        assert_eq!(removed.questions, [question(2)], "the answer renumbered");
+        let e = removed
+            .apply(&GraphEdit::RemovePolicy { i: 2 })
+            .unwrap_err();
+        assert!(
+            e.contains("the answer to one of the lesson's questions"),
+            "{e}"
+        );
         assert_eq!(removed.lesson().unwrap().net.len(), 3);
     }
 

@@ -368,3 +368,67 @@ fn a_bad_question_is_refused_naming_its_file_and_field() {
     );
     assert!(!said.contains("panicked"), "{said}");
 }
+
+/// Table II with policy 0 moved to the two-layer category and a three-layer policy added
+/// (π10, copying 3×100): activating π10 reaches its category's three at Ω = 0.95 with
+/// η = 𝒜/k = 1/3, ΔA = (1/3)/(1×0.95) = 0.350877 each; the saved lesson walks the same.
+/// Fig. 2, given by edges, has no category to add a policy to, and says so (exit 2).
+#[test]
+fn policies_added_and_recategorised_by_flag() {
+    let tmp = tempfile::tempdir().unwrap();
+    let saved = tmp.path().join("t2.ron");
+    let edits = [
+        "--config",
+        "assets/teach_table2.ron",
+        "--set-category",
+        "0",
+        "2",
+        "--add-policy",
+        "3",
+    ];
+    let mut save = vec!["teach"];
+    save.extend(edits);
+    save.extend(["--save", saved.to_str().unwrap()]);
+    assert!(sapnet(&save).status.success());
+    let mut direct = vec!["teach", "--headless", "--json", "--activate", "10"];
+    direct.extend(edits);
+    let direct = sapnet(&direct);
+    assert!(
+        direct.status.success(),
+        "{}",
+        String::from_utf8_lossy(&direct.stderr)
+    );
+    let from_file = sapnet(&[
+        "teach",
+        "--headless",
+        "--json",
+        "--activate",
+        "10",
+        "--config",
+        saved.to_str().unwrap(),
+    ]);
+    assert_eq!(direct.stdout, from_file.stdout);
+    let json: serde_json::Value = serde_json::from_slice(&direct.stdout).unwrap();
+    let a: Vec<f64> = json["activations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(a.len(), 11);
+    for i in 7..10 {
+        assert!((a[i] - 1.0 / 3.0 / 0.95).abs() < 1e-12, "{a:?}");
+    }
+    assert_eq!(
+        a[0], 0.0,
+        "policy 0 left the one-layer category, not joined to π10"
+    );
+
+    let out = sapnet(&["teach", "--headless", "--add-policy", "2"]);
+    assert_eq!(out.status.code(), Some(2));
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        said.contains("--add-policy 2: this lesson gives its graph by `edges`"),
+        "{said}"
+    );
+}
