@@ -134,17 +134,24 @@ fn stopped_protocol(out: &Path) -> Child {
         finished && partial_rows
     };
     let started = Instant::now();
-    while !ready() {
-        assert!(started.elapsed() < Duration::from_secs(120), "never ready");
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    signal(&child, "STOP");
-    // The process has stopped once its state says so: nothing it does is under way.
     let stat = format!("/proc/{}/stat", child.id());
-    while !std::fs::read_to_string(&stat).is_ok_and(|s| s.contains(") T ")) {
-        std::thread::sleep(Duration::from_millis(5));
+    loop {
+        while !ready() {
+            assert!(started.elapsed() < Duration::from_secs(120), "never ready");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        signal(&child, "STOP");
+        // The process has stopped once its state says so: nothing it does is under way.
+        while !std::fs::read_to_string(&stat).is_ok_and(|s| s.contains(") T ")) {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        // The run seen in progress may have ended between the look and the stop (its
+        // folder renamed, the next not begun): look again, stopped.
+        if ready() {
+            return child;
+        }
+        signal(&child, "CONT");
     }
-    child
 }
 
 fn signal(child: &Child, name: &str) {
