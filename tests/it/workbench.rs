@@ -107,6 +107,9 @@ fn listing(dir: &Path) -> BTreeMap<PathBuf, (u64, i64, i64, Vec<u8>)> {
 /// stopped by SIGSTOP once a run has finished and the next has episodes on disk: a live
 /// folder whose process holds the lock and writes nothing while the test reads it.
 fn stopped_protocol(out: &Path) -> Child {
+    // Returned to the caller, who ends it and waits for it; a test that panics here
+    // leaves it to the test harness's end.
+    #[allow(clippy::zombie_processes)]
     let child = sapnet()
         .args(["--headless", "--jobs", "1", "--episodes", "400", "--config"])
         .arg(configs("two_baselines.ron"))
