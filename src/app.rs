@@ -54,7 +54,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }
         // A sweep folder opens in the Sweep view, any other in the workbench's views.
         Some(Command::Open(args)) if tui::workbench::sweep::is_sweep(&args.dir) => {
-            tui::workbench::sweep::run(&args.dir)
+            tui::workbench::sweep_screen::run(&args.dir)
         }
         Some(Command::Open(args)) => tui::workbench::run(&args.dir),
         Some(Command::Plot(args)) => {

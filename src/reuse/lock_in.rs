@@ -14,7 +14,7 @@
 use super::MethodKind;
 
 /// The probability one source must pass for its method to have locked in.
-pub use crate::trainer::LOCK_IN as THRESHOLD;
+pub const THRESHOLD: f64 = 0.99;
 
 /// Whether lock-in means something for a method of this kind.
 pub fn measured(kind: MethodKind) -> bool {

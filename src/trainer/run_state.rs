@@ -24,8 +24,9 @@ use crate::reuse::{
 use crate::sapnet::SapNet;
 use crate::seeds;
 
-/// Probability above which one source is said to have locked selection in.
-pub const LOCK_IN: f64 = 0.99;
+/// Probability above which one source is said to have locked selection in (defined with
+/// lock-in itself, in reuse/lock_in.rs).
+pub use crate::reuse::lock_in::THRESHOLD as LOCK_IN;
 
 /// The seeds of a run's independent random streams.
 struct RunSeeds {

@@ -119,15 +119,19 @@ print(json.dumps([e.value for e in runs.Scalars("charts/episodic_return")]))
     }
 }
 
+/// The UI runs the protocol headless runs, into the same folder, so `--tensorboard` is
+/// taken there too: without a terminal, what is refused is the UI, not the flag.
 #[test]
-fn the_dashboard_refuses_tensorboard_as_it_writes_no_files() {
+fn the_ui_takes_tensorboard_and_without_a_terminal_points_at_headless() {
     let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
         .arg("--tensorboard")
         .output()
         .unwrap();
     assert_eq!(output.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(stderr.contains("--tensorboard"), "{stderr}");
+    assert!(stderr.contains("not a terminal"), "{stderr}");
+    assert!(stderr.contains("--headless"), "{stderr}");
+    assert!(!stderr.contains("--tensorboard"), "{stderr}");
 }
 
 /// The test's Python (`SAPNET_TEST_PYTHON`) if it has the `tensorboard` package; else the

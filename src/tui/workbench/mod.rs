@@ -36,6 +36,7 @@ pub mod session_view;
 pub mod state;
 mod stderr_capture;
 pub mod sweep;
+pub mod sweep_screen;
 pub mod sweep_view;
 pub mod view;
 
