@@ -24,6 +24,8 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: 
     };
     let run = dashboard.main_run();
     let finished = run.is_some_and(|r| r.ended.is_some());
+    // Ended before its episodes: stopped by the user, or by another run's failure.
+    let stopped = run.is_some_and(|r| r.ended.as_ref().is_some_and(|e| e.stopped));
     // The followed run failing is the one thing worth the whole line: its training went no
     // further. A baseline's failure is a note beside the figures; the rest goes on.
     let failure = run.and_then(|r| Some((&r.method, r.failed.as_ref()?)));
@@ -89,7 +91,14 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: 
         ]),
         None => {
             let mut spans = vec![Span::styled(
-                format!(" {} ", if finished { "DONE" } else { mode }),
+                format!(
+                    " {} ",
+                    match (stopped, finished) {
+                        (true, _) => "STOPPED",
+                        (false, true) => "DONE",
+                        _ => mode,
+                    }
+                ),
                 theme.title().add_modifier(Modifier::REVERSED),
             )];
             // First, where a narrow terminal cannot cut it off; the error itself is
