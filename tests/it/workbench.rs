@@ -20,24 +20,11 @@ use sapnet::tui::theme::Theme;
 use sapnet::tui::workbench::state::Workbench;
 use sapnet::tui::workbench::view;
 
+use crate::common::cli::{configs, sapnet, stderr};
 use crate::common::library::quick_protocol;
 use crate::common::tmux;
 
 const SIZES: [(u16, u16); 2] = [(120, 40), (80, 24)];
-
-fn sapnet() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_sapnet"))
-}
-
-fn configs(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/configs")
-        .join(name)
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
 
 /// A key as the tests spell it: `\n` is Enter.
 fn key(c: char) -> KeyEvent {

@@ -17,23 +17,10 @@ use sapnet::tui::workbench::picker::Picker;
 use sapnet::tui::workbench::session::{Overlay, Phase, Request, Screen, Session};
 use sapnet::tui::workbench::session_view;
 
+use crate::common::cli::{configs, sapnet, stderr};
 use crate::common::tmux;
 
 const SIZES: [(u16, u16); 2] = [(120, 40), (80, 24)];
-
-fn sapnet() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_sapnet"))
-}
-
-fn configs(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/configs")
-        .join(name)
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
 
 fn summary_status(out: &Path) -> String {
     let summary: serde_json::Value =

@@ -20,16 +20,21 @@ pub fn fit(text: &str, width: usize) -> String {
     }
 }
 
-/// The style of each method of the protocol, in its order: its family's hue, members
-/// of a family in turn a shade apart ([`Theme::method`]).
-pub fn method_styles(folder: &FolderState, theme: Theme) -> Vec<Style> {
-    let kinds: Vec<_> = folder
+/// The kind of each method of the folder's protocol, in its order.
+pub fn method_kinds(folder: &FolderState) -> Vec<crate::reuse::MethodKind> {
+    folder
         .config
         .protocol
         .methods
         .iter()
         .map(|m| m.kind())
-        .collect();
+        .collect()
+}
+
+/// The style of each method of the protocol, in its order: its family's hue, members
+/// of a family in turn a shade apart ([`Theme::method`]).
+pub fn method_styles(folder: &FolderState, theme: Theme) -> Vec<Style> {
+    let kinds = method_kinds(folder);
     kinds
         .iter()
         .enumerate()

@@ -39,14 +39,7 @@ struct Shown {
 pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) {
     let folder = &workbench.folder;
     let curves = &workbench.curves;
-    let kinds: Vec<_> = folder
-        .config
-        .protocol
-        .methods
-        .iter()
-        .map(|m| m.kind())
-        .collect();
-    let colours = method_colours(&kinds);
+    let colours = method_colours(&super::cells::method_kinds(folder));
     let methods: Vec<Shown> = folder
         .config
         .protocol
