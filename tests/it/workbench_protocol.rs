@@ -5,7 +5,6 @@
 //! drawn at 80×24 and 120×40 (TestBackend, insta, `NO_COLOR`'s theme).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::backend::TestBackend;
