@@ -11,6 +11,10 @@
 //! base learns by its own TD error, as a DQN, so that it stands on its own when no source
 //! helps (A2T's base "learns the task independently"). Through the softmax,
 //! `∂Q_T/∂f_k = w_k·(Q_k − Q_T)` ([`logit_gradient`]).
+//!
+//! The sources are frozen, so their values of each stored transition are computed once,
+//! when it arrives, and read by every update that samples it ([`super::source_values`]):
+//! the same bits as running the sources on each minibatch, for less (BENCHMARKS.md, issue 40).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -19,6 +23,7 @@ use rand::Rng;
 
 use super::backprop::Workspace;
 use super::kernels::Isa;
+use super::source_values::SourceValues;
 use super::{huber, Adam, Architecture, Batch, DqnConfig, DqnError, Init, QNet, ReplayBuffer};
 
 /// The attention network, its target copy and its optimiser.
@@ -39,6 +44,8 @@ pub struct AttentionLearner {
     /// first, the base last; and the mixture's target.
     values: Vec<Vec<f32>>,
     targets: Vec<f32>,
+    /// The sources' values of every stored transition, when kept (the default).
+    source_values: Option<SourceValues>,
 }
 
 impl AttentionLearner {
@@ -67,7 +74,16 @@ impl AttentionLearner {
             scratch: Workspace::default(),
             values: Vec::new(),
             targets: Vec::new(),
+            source_values: Some(SourceValues::default()),
         })
+    }
+
+    /// Runs the sources on each minibatch instead of keeping their values of the buffer:
+    /// the same numbers, at the old cost (the test of the kept values' bits).
+    #[cfg(test)]
+    fn without_kept_source_values(mut self) -> Self {
+        self.source_values = None;
+        self
     }
 
     /// A stop raised on `flag` ends nothing mid-update, but is heard between updates.
@@ -80,6 +96,12 @@ impl AttentionLearner {
         let mut weights = self.online.q_values(obs)?;
         softmax_in_place(&mut weights);
         Ok(weights)
+    }
+
+    /// The sources' Q-values `[source][action]` of `obs`, when kept: `obs` is the next
+    /// observation of the transition [`Self::observe`] saw last.
+    pub fn kept_source_values(&self, obs: &[f32]) -> Option<&[f32]> {
+        self.source_values.as_ref()?.of_latest_next(obs)
     }
 
     pub fn updates(&self) -> u64 {
@@ -98,6 +120,9 @@ impl AttentionLearner {
         base: (&QNet, &QNet),
     ) -> Result<Option<f64>, DqnError> {
         self.steps += 1;
+        if let Some(kept) = &mut self.source_values {
+            kept.follow(Isa::current(), replay, sources)?;
+        }
         if self
             .steps
             .is_multiple_of(self.config.target_update_interval)
@@ -142,7 +167,7 @@ impl AttentionLearner {
         let actions = base.0.architecture().action_count;
         // The target: max_a' of the mixture by the target attention, the sources and the
         // base's target network at s'.
-        self.forward_all(isa, batch.next_obs(), n, sources, base.1)?;
+        self.forward_all(isa, batch, true, sources, base.1)?;
         let mut next_weights = self
             .target
             .forward_with(isa, batch.next_obs(), n, &mut self.work)?
@@ -163,7 +188,7 @@ impl AttentionLearner {
             self.targets.push(batch.rewards()[b] + bootstrap);
         }
         // The mixture at (s, a), and the gradient of the Huber loss on the logits.
-        self.forward_all(isa, batch.obs(), n, sources, base.0)?;
+        self.forward_all(isa, batch, false, sources, base.0)?;
         let logits = self
             .online
             .forward_with(isa, batch.obs(), n, &mut self.work)?;
@@ -202,25 +227,35 @@ impl AttentionLearner {
         Ok(loss)
     }
 
-    /// Every source's and `base`'s Q-values of `obs` into `values`, sources first.
+    /// Every source's and `base`'s Q-values of `batch`'s observations (or its next ones)
+    /// into `values`, sources first: the sources' from the kept values when the batch says
+    /// its slots, else by running them.
     fn forward_all(
         &mut self,
         isa: Isa,
-        obs: &[f32],
-        batch: usize,
+        batch: &Batch,
+        next: bool,
         sources: &[&QNet],
         base: &QNet,
     ) -> Result<(), DqnError> {
+        let n = batch.len();
+        let obs = if next { batch.next_obs() } else { batch.obs() };
         self.values.resize_with(sources.len() + 1, Vec::new);
-        for (values, net) in self
-            .values
-            .iter_mut()
-            .zip(sources.iter().copied().chain([base]))
-        {
-            let q = net.forward_with(isa, obs, batch, &mut self.scratch)?;
-            values.clear();
-            values.extend_from_slice(q);
+        let (from_sources, from_base) = self.values.split_at_mut(sources.len());
+        let kept = self
+            .source_values
+            .as_ref()
+            .and_then(|kept| kept.gather(batch, next, from_sources));
+        if kept.is_none() {
+            for (values, net) in from_sources.iter_mut().zip(sources) {
+                let q = net.forward_with(isa, obs, n, &mut self.scratch)?;
+                values.clear();
+                values.extend_from_slice(q);
+            }
         }
+        let q = base.forward_with(isa, obs, n, &mut self.scratch)?;
+        from_base[0].clear();
+        from_base[0].extend_from_slice(q);
         Ok(())
     }
 }
@@ -258,6 +293,98 @@ mod tests {
     /// `Q_T = Σ_k w_k·q_k` of one state and action, from each network's Q-value there.
     fn mix(weights: &[f32], q: &[f32]) -> f32 {
         weights.iter().zip(q).map(|(w, q)| w * q).sum()
+    }
+
+    /// Every parameter of `net`, as bits.
+    fn bits(net: &QNet) -> Vec<u32> {
+        net.parameters()
+            .iter()
+            .flat_map(|p| {
+                p.as_tensor()
+                    .flatten_all()
+                    .unwrap()
+                    .to_vec1::<f32>()
+                    .unwrap()
+            })
+            .map(f32::to_bits)
+            .collect()
+    }
+
+    /// The kept source values change no bit of the update: two attentions from one seed,
+    /// one running the sources on every minibatch, learn the same weights and losses, over
+    /// a buffer that wraps, and from a buffer filled before the attention was made.
+    #[test]
+    fn kept_source_values_give_the_bits_of_running_the_sources() {
+        use crate::dqn::Transition;
+        use rand::{rngs::StdRng, SeedableRng};
+        let config = DqnConfig {
+            replay_start_size: 8,
+            replay_capacity: 40,
+            batch_size: 16,
+            target_update_interval: 25,
+            ..DqnConfig::default()
+        };
+        let mut rng = StdRng::seed_from_u64(5);
+        let net = |hidden: &[usize], rng: &mut StdRng| {
+            QNet::with_init(Architecture::new(3, hidden, 2), Init::LecunNormal, rng).unwrap()
+        };
+        let sources = [net(&[7], &mut rng), net(&[5, 4], &mut rng)];
+        let sources: Vec<&QNet> = sources.iter().collect();
+        let (base, base_target) = (net(&[6], &mut rng), net(&[6], &mut rng));
+        let make = || {
+            let rng = &mut StdRng::seed_from_u64(9);
+            AttentionLearner::new(3, &[8], 2, Init::LecunNormal, &config, rng).unwrap()
+        };
+        let mut replay = ReplayBuffer::new(config.replay_capacity, 3);
+        let mut obs = [0.1f32, -0.2, 0.3];
+        let mut push = |replay: &mut ReplayBuffer, i: usize| {
+            let next = [obs[1], obs[2] * 0.9, (i as f32 * 0.37).sin()];
+            replay.push(Transition {
+                obs: &obs,
+                action: i % 2,
+                reward: (i % 3) as f64,
+                next_obs: &next,
+                terminated: i % 11 == 10,
+                truncated: i % 7 == 6,
+            });
+            obs = next;
+        };
+        for i in 0..12 {
+            push(&mut replay, i);
+        }
+        let (mut kept, mut running) = (make(), make().without_kept_source_values());
+        let (mut rng_kept, mut rng_running) = (StdRng::seed_from_u64(1), StdRng::seed_from_u64(1));
+        for i in 12..120 {
+            push(&mut replay, i);
+            let a = kept
+                .observe(&replay, &mut rng_kept, &sources, (&base, &base_target))
+                .unwrap();
+            let b = running
+                .observe(&replay, &mut rng_running, &sources, (&base, &base_target))
+                .unwrap();
+            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "loss at step {i}");
+            // The values kept for the next step's action are the sources' own, bit for bit.
+            let next = replay.latest().unwrap().next_obs.to_vec();
+            let acting: Vec<u32> = sources
+                .iter()
+                .flat_map(|s| s.q_values(&next).unwrap())
+                .map(f32::to_bits)
+                .collect();
+            let kept_values = kept.kept_source_values(&next).unwrap();
+            assert_eq!(
+                kept_values.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                acting
+            );
+            assert!(kept.kept_source_values(&[9.0, 9.0, 9.0]).is_none());
+        }
+        assert!(kept.updates() > 100);
+        let followed = kept.source_values.as_ref().map(|v| v.pushes());
+        assert_eq!(
+            followed,
+            Some(replay.pushes()),
+            "the kept values followed the buffer"
+        );
+        assert_eq!(bits(&kept.online), bits(&running.online));
     }
 
     #[test]

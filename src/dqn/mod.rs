@@ -21,6 +21,7 @@ mod q_values;
 mod qnet;
 mod replay;
 mod scratch;
+mod source_values;
 
 pub use agent::{DqnAgent, TdError, UpdateReport};
 pub use attention::AttentionLearner;

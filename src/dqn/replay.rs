@@ -26,6 +26,8 @@ pub struct ReplayBuffer {
     obs_size: usize,
     /// Slot the next transition is written to once the buffer is full.
     next: usize,
+    /// Transitions pushed since the buffer was made.
+    pushes: u64,
     obs: Vec<f32>,
     next_obs: Vec<f32>,
     actions: Vec<u32>,
@@ -44,6 +46,7 @@ impl ReplayBuffer {
             capacity,
             obs_size,
             next: 0,
+            pushes: 0,
             obs: Vec::new(),
             next_obs: Vec::new(),
             actions: Vec::new(),
@@ -95,6 +98,23 @@ impl ReplayBuffer {
             self.truncated[i] = t.truncated;
         }
         self.next = (self.next + 1) % self.capacity;
+        self.pushes += 1;
+    }
+
+    /// Transitions pushed since the buffer was made, overwritten ones included.
+    pub fn pushes(&self) -> u64 {
+        self.pushes
+    }
+
+    /// The slot of the transition pushed last (0 while empty).
+    pub fn latest_slot(&self) -> usize {
+        (self.next + self.capacity - 1) % self.capacity
+    }
+
+    /// The observations and next observations of the slots `slots`, row-major.
+    pub fn observations(&self, slots: std::ops::Range<usize>) -> (&[f32], &[f32]) {
+        let span = slots.start * self.obs_size..slots.end * self.obs_size;
+        (&self.obs[span.clone()], &self.next_obs[span])
     }
 
     /// The `i`-th stored transition in slot order (not age order).
@@ -112,11 +132,11 @@ impl ReplayBuffer {
 
     /// The transition stored last, if any.
     pub fn latest(&self) -> Option<Transition<'_>> {
-        (!self.is_empty()).then(|| self.get((self.next + self.capacity - 1) % self.capacity))
+        (!self.is_empty()).then(|| self.get(self.latest_slot()))
     }
 
     /// Fills `batch` with `size` transitions drawn uniformly with replacement, reusing its
-    /// memory.
+    /// memory; the batch keeps their slots.
     ///
     /// # Panics
     /// If the buffer is empty.
@@ -127,7 +147,9 @@ impl ReplayBuffer {
         );
         batch.clear(self.obs_size);
         for _ in 0..size {
-            batch.push(self.get(rng.random_range(0..self.len())));
+            let slot = rng.random_range(0..self.len());
+            batch.push(self.get(slot));
+            batch.slots.push(slot);
         }
     }
 }
@@ -142,6 +164,8 @@ pub struct Batch {
     rewards: Vec<f32>,
     terminated: Vec<bool>,
     truncated: Vec<bool>,
+    /// The buffer's slot of each transition, when every one was sampled from a buffer.
+    slots: Vec<usize>,
 }
 
 impl Batch {
@@ -159,6 +183,7 @@ impl Batch {
         self.rewards.clear();
         self.terminated.clear();
         self.truncated.clear();
+        self.slots.clear();
     }
 
     /// # Panics
@@ -214,6 +239,12 @@ impl Batch {
 
     pub fn truncated(&self) -> &[bool] {
         &self.truncated
+    }
+
+    /// Each transition's slot in the buffer it was sampled from, unless one was pushed by
+    /// hand.
+    pub fn slots(&self) -> Option<&[usize]> {
+        (self.slots.len() == self.len()).then_some(self.slots.as_slice())
     }
 }
 

@@ -46,8 +46,17 @@ impl ValueBuffers {
     ) -> Result<Combined, DqnError> {
         self.learner = learner.q_values(obs)?;
         self.sources.resize_with(sources.len(), Vec::new);
-        for (values, source) in self.sources.iter_mut().zip(sources) {
-            *values = source.net.q_values(obs)?;
+        // A2T's attention keeps the sources' values of the state the last step led to.
+        let kept = attention.and_then(|a| a.kept_source_values(obs));
+        let actions = self.learner.len();
+        for (i, (values, source)) in self.sources.iter_mut().zip(sources).enumerate() {
+            match kept {
+                Some(kept) => {
+                    values.clear();
+                    values.extend_from_slice(&kept[i * actions..(i + 1) * actions]);
+                }
+                None => *values = source.net.q_values(obs)?,
+            }
         }
         if let Some(attention) = attention {
             self.attention = attention.weights(obs)?;
