@@ -2,6 +2,9 @@
 summary.json (`runs[].source_steps`, the library's `task` per source, as `sapnet` wrote
 them): for one task (a substring of its name), every run's share, how many runs gave it
 most of their steps, and the share over all runs' steps (comparison.csv's `share_<task>`).
+A share is of the steps that followed a source (`source_steps`' sum); "of all steps" divides
+by the run's steps instead, for the methods whose learner also acts (GPI's learner winning
+the max, the Q-switch's learner followed, A2T's base outweighing every source).
 
     python3 scripts/task_shares.py DIR TASK [METHOD ...]
 
@@ -23,14 +26,17 @@ by = collections.defaultdict(list)
 for run in summary["runs"]:
     steps = run.get("source_steps") or []
     if sum(steps):
-        by[run["method"]].append((run["run"], sum(steps[i] for i in hit), sum(steps), run.get("chosen")))
+        by[run["method"]].append(
+            (run["run"], sum(steps[i] for i in hit), sum(steps), run.get("chosen"), run["steps"]))
 for method, runs in by.items():
     if wanted and method not in wanted:
         continue
-    shares = [h / t for _, h, t, _ in runs]
+    shares = [h / t for _, h, t, _, _ in runs]
     most = sum(1 for s in shares if s > 0.5)
-    pooled = sum(h for _, h, _, _ in runs) / sum(t for _, _, t, _ in runs)
-    handed = sum(1 for *_, c in runs if c and c["index"] in hit)
-    print(f"{method:24} pooled {pooled:.0%}, runs above half {most}/{len(runs)}, "
+    pooled = sum(r[1] for r in runs) / sum(r[2] for r in runs)
+    of_all = sum(r[1] for r in runs) / sum(r[4] for r in runs)
+    handed = sum(1 for r in runs if r[3] and r[3]["index"] in hit)
+    print(f"{method:24} pooled {pooled:.0%} ({of_all:.0%} of all steps), "
+          f"runs above half {most}/{len(runs)}, "
           f"handed over a {task} source {handed}/{len(runs)}, per run "
           + " ".join(f"{s:.2f}" for s in shares))
