@@ -63,19 +63,18 @@ pub fn replot(dir: &Path) -> Result<Summary> {
     Ok(summary)
 }
 
-/// Why `sapnet plot` leaves a folder another process writes: who writes it, and how to
-/// read it meanwhile.
+/// Why `sapnet plot` leaves a folder another process writes: who writes it (its lock line,
+/// `PID 1234 on host since 10:02:07 UTC (a protocol)`, once), and how to read it meanwhile.
 fn refused_while_written(dir: &Path, holder: &crate::folder_lock::Holder) -> String {
+    let who = match holder.says.strip_prefix("running as ") {
+        Some(line) => line.to_string(),
+        None if holder.says.is_empty() => holder.describe(),
+        None => format!("{} ({})", holder.describe(), holder.says),
+    };
     format!(
-        "{dir} is being written by the sapnet process {who}{says}: `sapnet plot` would \
-         rewrite its report under it, so it changes nothing there; watch it with `sapnet \
-         open {dir}`, and plot it once that process has ended",
+        "{dir} is being written by the sapnet process {who}: `sapnet plot` would rewrite its \
+         report under it, so it changes nothing there; watch it with `sapnet open {dir}`, and \
+         plot it once that process has ended",
         dir = dir.display(),
-        who = holder.describe(),
-        says = if holder.says.is_empty() {
-            String::new()
-        } else {
-            format!(" ({})", holder.says)
-        },
     )
 }

@@ -173,12 +173,16 @@ fn plot_refuses_a_live_folder_naming_its_writer_and_changes_nothing() {
     let said = stderr(&output);
     assert_eq!(output.status.code(), Some(2), "{said}");
     for names in [
-        format!("written by the sapnet process PID {pid} since "),
-        format!("running as PID {pid} on "),
+        format!("written by the sapnet process PID {pid} on "),
         format!("sapnet open {}", out.display()),
     ] {
         assert!(said.contains(&names), "{names:?} in {said}");
     }
+    assert_eq!(
+        said.matches(&format!("PID {pid}")).count(),
+        1,
+        "the PID once: {said}"
+    );
     assert_eq!(before, after, "sapnet plot changed the live folder");
     assert!(!out.join("comparison.csv").exists());
 }
