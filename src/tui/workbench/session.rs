@@ -179,9 +179,10 @@ impl Session {
     /// Gives the workbench the session's keys for its status bar and overlay, as the
     /// phase allows them now.
     pub fn sync_host_keys(&mut self) {
-        let bar = self.bar_keys();
+        let controls = self.phase_keys();
         if let Some(workbench) = &mut self.workbench {
-            workbench.host_bar = bar;
+            workbench.host_controls = controls;
+            workbench.host_bar = vec![("⏎", "follow"), ("f", "run view")];
             workbench.host_overlay = HOST_KEYS.to_vec();
         }
     }
@@ -528,10 +529,10 @@ impl Session {
         self.followed = Some(key);
     }
 
-    /// The keys the workbench's status bar adds for a protocol run here, as the phase
-    /// allows them.
-    pub fn bar_keys(&self) -> Vec<(&'static str, &'static str)> {
-        let mut keys = vec![("⏎", "follow"), ("f", "run view")];
+    /// The protocol's controls, as the phase allows them: first in the status bar, where
+    /// a narrow terminal drops keys from the end.
+    pub fn phase_keys(&self) -> Vec<(&'static str, &'static str)> {
+        let mut keys = Vec::new();
         match self.phase {
             Phase::Running => keys.push(("S", "stop")),
             Phase::Stopping => {}

@@ -167,12 +167,7 @@ fn run_line(session: &Session, theme: Theme) -> Line<'static> {
         Span::styled("  │ ", theme.dim()),
     ];
     let mut keys = vec![("r", "runs"), ("c", "comparison"), ("m", "next run")];
-    keys.extend(
-        session
-            .bar_keys()
-            .into_iter()
-            .filter(|(k, _)| *k != "⏎" && *k != "f"),
-    );
+    keys.extend(session.phase_keys());
     for (key, what) in keys {
         spans.push(Span::styled(key, theme.title()));
         spans.push(Span::raw(format!(" {what}  ")));

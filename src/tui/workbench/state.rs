@@ -110,8 +110,11 @@ pub struct Workbench {
     /// The last refresh's failure, shown until a read succeeds again: the views keep the
     /// last good read.
     pub read_error: Option<String>,
-    /// The keys a protocol run in the UI adds (hook for [`super::session`]): for the
-    /// status bar, and for the overlay; the session handles them before the views do.
+    /// The keys a protocol run in the UI adds (hook for [`super::session`]): its controls
+    /// (stop, launch, resume), listed before the view's keys so that a narrow terminal
+    /// keeps them; the others, listed after; and the overlay's. The session handles them
+    /// before the views do.
+    pub host_controls: Vec<(&'static str, &'static str)>,
     pub host_bar: Vec<(&'static str, &'static str)>,
     pub host_overlay: Vec<(&'static str, &'static str)>,
     /// The Curves view's choices.
@@ -131,6 +134,7 @@ impl Workbench {
             run_cursor: 0,
             method_cursor: 0,
             read_error: None,
+            host_controls: Vec::new(),
             host_bar: Vec::new(),
             host_overlay: Vec::new(),
             curves: super::curves::Curves::default(),
@@ -249,14 +253,16 @@ impl Workbench {
         keys
     }
 
-    /// The keys the status bar lists for the view shown, after the views' own.
+    /// The keys the status bar lists after the views' names: a protocol's controls, the
+    /// shown view's keys, then the host's others.
     pub fn view_commands(&self) -> Vec<(&'static str, &'static str)> {
         let own: &[(&str, &str)] = match self.view {
             View::Runs => &[("↑↓", "run")],
             View::Comparison => &[("↑↓", "method"), ("a", "aggregate"), ("s", "score")],
             View::Curves => &super::curves::COMMANDS,
         };
-        let mut keys = own.to_vec();
+        let mut keys = self.host_controls.clone();
+        keys.extend(own);
         keys.extend(self.host_bar.iter().copied());
         keys
     }
