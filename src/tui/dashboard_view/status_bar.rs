@@ -17,9 +17,10 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: 
     let (mode, hints) = match dashboard.mode {
         Mode::Running => ("RUNNING", "space pause · t teach · ? keys · q quit"),
         Mode::Paused => ("PAUSED", "space resume · n step · t teach · ? keys"),
+        // Stand-alone teach mode's keys, in its short form (teach_view/status_bar.rs).
         Mode::Teach => (
             "TEACH",
-            "a · s · r · u · c · 1–5 +/− edit · Esc/t back · ? keys",
+            "a s r R u c 1–5± E x M n D C v w X · Esc/t back · ? keys",
         ),
     };
     let run = dashboard.main_run();
