@@ -181,6 +181,20 @@ fn a_run_that_fails_before_it_starts_still_shows() {
     assert!(line.contains("FAILED  sapnet: building SAP-Net"), "{line}");
 }
 
+/// A followed run that reuses no library says so once it has started, not that it is
+/// loading one.
+#[test]
+fn a_followed_run_without_a_library_says_it_reuses_none() {
+    let mut d = Dashboard::new("CartPole-v1");
+    d.follow("dqn[100]");
+    let text = screen_lines(&draw_dashboard(&d, (120, 40))).join("\n");
+    assert!(text.contains("dqn[100]: loading the library"), "{text}");
+    d.on_event(tui_script::baseline_start());
+    let text = screen_lines(&draw_dashboard(&d, (120, 40))).join("\n");
+    assert!(text.contains("dqn[100] reuses no library"), "{text}");
+    assert!(!text.contains("loading"), "{text}");
+}
+
 /// The bottom row of the screen.
 fn status_line(terminal: &Terminal<TestBackend>) -> String {
     let buffer = terminal.backend().buffer();

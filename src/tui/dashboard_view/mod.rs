@@ -150,9 +150,16 @@ fn draw_training(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
             }
         }
         None => {
-            // Before a followed run's first step it is still loading its library or
-            // starting its task (a Gymnasium worker takes a second or more).
+            // A followed run that started without a library reuses none (DQN from
+            // scratch); before it starts it is still loading its library or starting its
+            // task (a Gymnasium worker takes a second or more).
+            let started =
+                |method: &String| dashboard.runs.iter().any(|r| r.method.label() == method);
             let note = match &dashboard.followed {
+                Some(method) if started(method) => format!(
+                    "{method} reuses no library: no graph or policy table to show. Its curve \
+                     and loss are below."
+                ),
                 Some(method) => format!("{method}: loading the library and starting the task…"),
                 None => "This config runs no SAP-Net: only its baselines train.".to_string(),
             };
