@@ -20,3 +20,9 @@ pub fn configs(name: &str) -> PathBuf {
 pub fn stderr(output: &Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()
 }
+
+/// `output`, once it is sure the command succeeded (else its stderr, as the failure).
+pub fn ok(output: Output) -> Output {
+    assert!(output.status.success(), "{}", stderr(&output));
+    output
+}

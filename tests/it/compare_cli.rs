@@ -3,16 +3,8 @@
 //! make_sb3_runs.py), give the IQMs rliable gives on the same runs; a sapnet results
 //! folder's runs join them; and what it refuses.
 
+use crate::common::cli::{sapnet, stderr};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn sapnet() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_sapnet"))
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/outside/sb3")

@@ -10,6 +10,7 @@ use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::common::cli::{sapnet, stderr};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use sapnet::env::{self, EnvConfig, Environment, GymnasiumParams};
@@ -143,14 +144,6 @@ fn the_bridge_steps_the_classic_tasks_to_the_native_bits_with_their_variants() {
         assert_eq!(native.action_count(), bridge.action_count());
         same_bits(native.as_mut(), bridge.as_mut(), 3000, k as u64);
     }
-}
-
-fn sapnet() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_sapnet"))
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
 }
 
 /// `sapnet ARGS --config assets/CONFIG --library LIBRARY` in `python`'s virtualenv.

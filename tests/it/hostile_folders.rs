@@ -3,29 +3,11 @@
 //! a kill at every write point, FIFOs, NaN weights, counts that cannot be allocated — and
 //! checks that sapnet writes nothing outside, corrupts nothing, and says why with exit 2.
 
+use crate::common::cli::{configs, ok, sapnet, stderr};
 use std::os::unix::fs::symlink;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
-
-fn sapnet() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_sapnet"))
-}
-
-fn configs(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/configs")
-        .join(name)
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-fn ok(output: Output) -> Output {
-    assert!(output.status.success(), "{}", stderr(&output));
-    output
-}
 
 /// Refused with exit 2 and a message holding `says`.
 fn refused(output: Output, says: &str) {

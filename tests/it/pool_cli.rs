@@ -1,16 +1,8 @@
 //! `sapnet pool`: finished protocols on two tasks as one comparison, normalised and
 //! stratified by task; and what it refuses.
 
+use crate::common::cli::{sapnet, stderr};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn sapnet() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_sapnet"))
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
 
 /// Two DQNs from scratch, three runs each, a few episodes on `env`.
 fn protocol(tmp: &Path, env: &str, out: &str) -> std::path::PathBuf {

@@ -2,22 +2,10 @@
 //! GNU parallel, one cell killed with SIGKILL and run again, merged to what a sweep that
 //! never failed merges to.
 
+use crate::common::cli::{ok, sapnet, stderr};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
-
-fn sapnet() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_sapnet"))
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-fn ok(output: Output) -> Output {
-    assert!(output.status.success(), "{}", stderr(&output));
-    output
-}
 
 /// A grid over tiny_transfer.ron (SAP-Net and a DQN on a library of three tiny sources):
 /// two values of τ × three seeds, six cells of a second or so.
