@@ -11,7 +11,9 @@ the max, the Q-switch's learner followed, A2T's base outweighing every source).
 Only the standard library.
 """
 import collections
+import csv
 import json
+import os
 import sys
 
 directory, task = sys.argv[1], sys.argv[2]
@@ -40,3 +42,20 @@ for method, runs in by.items():
           f"runs above half {most}/{len(runs)}, "
           f"handed over a {task} source {handed}/{len(runs)}, per run "
           + " ".join(f"{s:.2f}" for s in shares))
+
+# A2T acts on a mixture, not on one source: its attention's mean weight on the task's
+# sources over each run's steps (activations.csv's A_<source> at the run's last episode).
+path = f"{directory}/activations.csv"
+if os.path.exists(path) and (not wanted or any(m.startswith("a2t") for m in wanted)):
+    last = {}
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            if row["method"].startswith("a2t"):
+                last[(row["method"], int(row["run"]))] = row
+    names = [entry.get("name", f"source-{i}") for i, entry in enumerate(summary["library"])]
+    for method in sorted({m for m, _ in last}):
+        weights = [sum(float(row[f"A_{names[i]}"]) for i in hit)
+                   for (m, _), row in sorted(last.items()) if m == method]
+        print(f"{method:24} mean attention weight on {task} sources, per run "
+              + " ".join(f"{w:.2f}" for w in weights)
+              + f" (mean {sum(weights) / len(weights):.2f})")
