@@ -4,7 +4,9 @@ them): for one task (a substring of its name), every run's share, how many runs 
 most of their steps, and the share over all runs' steps (comparison.csv's `share_<task>`).
 A share is of the steps that followed a source (`source_steps`' sum); "of all steps" divides
 by the run's steps instead, for the methods whose learner also acts (GPI's learner winning
-the max, the Q-switch's learner followed, A2T's base outweighing every source).
+the max, the Q-switch's learner followed, A2T's base outweighing every source). For A2T,
+which acts on a mixture, it also prints the attention's mean weight on the task's sources
+over each run's steps, from DIR/activations.csv when the folder has it.
 
     python3 scripts/task_shares.py DIR TASK [METHOD ...]
 
