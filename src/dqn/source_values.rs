@@ -33,8 +33,9 @@ pub(crate) struct SourceValues {
 }
 
 impl SourceValues {
-    /// Brings the cache up to `replay`'s pushes: the latest transition alone after one step,
-    /// every slot again after anything else (the first call, a buffer refilled elsewhere).
+    /// Brings the cache up to `replay`'s pushes (one buffer, followed from step to step):
+    /// the latest transition alone after one step, every slot again after anything else
+    /// (the first call, a buffer that was not followed).
     pub fn follow(
         &mut self,
         isa: Isa,
@@ -49,9 +50,10 @@ impl SourceValues {
                 ..Self::default()
             };
         }
-        match replay.pushes() - self.pushes {
-            0 => {}
-            1 if self.at_obs.len() >= replay.latest_slot() * width => {
+        // A buffer with fewer pushes than followed is another buffer: filled again.
+        match replay.pushes().checked_sub(self.pushes) {
+            Some(0) => {}
+            Some(1) if self.at_obs.len() >= replay.latest_slot() * width => {
                 self.fill_latest(isa, replay, sources)?;
             }
             _ => {
