@@ -3,7 +3,7 @@
 use std::sync::mpsc::TryRecvError;
 use std::time::Duration;
 
-use super::events::Command;
+use super::events::{Command, StreamOptions};
 use super::CommandReceiver;
 
 /// The command channel of one run and what it has asked for so far.
@@ -14,6 +14,8 @@ pub(crate) struct Control<'a> {
     granted: u32,
     delay: Duration,
     trace: bool,
+    /// What the run streams, as it began or as `Command::Stream` changed it.
+    stream: StreamOptions,
 }
 
 /// What the run does next.
@@ -24,13 +26,14 @@ pub(crate) enum Next {
 }
 
 impl<'a> Control<'a> {
-    pub fn new(commands: &'a CommandReceiver, trace: bool) -> Self {
+    pub fn new(commands: &'a CommandReceiver, stream: StreamOptions) -> Self {
         Self {
             commands,
             paused: false,
             granted: 0,
             delay: Duration::ZERO,
-            trace,
+            trace: stream.trace,
+            stream,
         }
     }
 
@@ -82,6 +85,13 @@ impl<'a> Control<'a> {
             }
             Command::Throttle(delay) => self.delay = delay,
             Command::Trace(on) => self.trace = on,
+            Command::Stream(live) => {
+                self.stream = if live {
+                    StreamOptions::live()
+                } else {
+                    StreamOptions::episodes()
+                };
+            }
         }
         Next::Step
     }
@@ -95,6 +105,10 @@ impl<'a> Control<'a> {
     pub fn trace(&self) -> bool {
         self.trace
     }
+
+    pub fn stream(&self) -> StreamOptions {
+        self.stream
+    }
 }
 
 #[cfg(test)]
@@ -105,23 +119,39 @@ mod tests {
     #[test]
     fn runs_until_stopped() {
         let (tx, rx) = super::super::command_channel();
-        let mut control = Control::new(&rx, false);
+        let mut control = Control::new(&rx, StreamOptions::episodes());
         assert_eq!(control.before_step(), Next::Step);
         tx.send(Command::Stop).unwrap();
         assert_eq!(control.before_step(), Next::Stop);
     }
 
     #[test]
+    fn a_stream_command_moves_the_live_stream() {
+        let (tx, rx) = super::super::command_channel();
+        let mut control = Control::new(&rx, StreamOptions::episodes());
+        assert!(!control.stream().steps);
+        tx.send(Command::Stream(true)).unwrap();
+        assert_eq!(control.before_step(), Next::Step);
+        assert_eq!(control.stream(), StreamOptions::live());
+        tx.send(Command::Stream(false)).unwrap();
+        assert_eq!(control.before_step(), Next::Step);
+        assert_eq!(control.stream(), StreamOptions::episodes());
+    }
+
+    #[test]
     fn a_closed_channel_stops() {
         let (tx, rx) = super::super::command_channel();
         drop(tx);
-        assert_eq!(Control::new(&rx, false).before_step(), Next::Stop);
+        assert_eq!(
+            Control::new(&rx, StreamOptions::episodes()).before_step(),
+            Next::Stop
+        );
     }
 
     #[test]
     fn paused_runs_take_only_granted_steps() {
         let (tx, rx) = super::super::command_channel();
-        let mut control = Control::new(&rx, false);
+        let mut control = Control::new(&rx, StreamOptions::episodes());
         for command in [Command::Pause, Command::Step, Command::Step] {
             tx.send(command).unwrap();
         }
@@ -137,7 +167,7 @@ mod tests {
     #[test]
     fn stop_ends_a_pause() {
         let (tx, rx) = super::super::command_channel();
-        let mut control = Control::new(&rx, false);
+        let mut control = Control::new(&rx, StreamOptions::episodes());
         tx.send(Command::Pause).unwrap();
         tx.send(Command::Stop).unwrap();
         assert_eq!(control.before_step(), Next::Stop);
@@ -146,7 +176,7 @@ mod tests {
     #[test]
     fn trace_and_throttle_are_remembered() {
         let (tx, rx) = super::super::command_channel();
-        let mut control = Control::new(&rx, false);
+        let mut control = Control::new(&rx, StreamOptions::episodes());
         tx.send(Command::Trace(true)).unwrap();
         tx.send(Command::Throttle(Duration::from_millis(2)))
             .unwrap();

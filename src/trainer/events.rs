@@ -234,6 +234,8 @@ pub struct LibraryStart {
 /// One environment step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepRecord {
+    /// The run's method, by its index in the protocol ([`MethodId::index`]), and the run.
+    pub method: usize,
     pub run: u32,
     /// Steps of the run so far, this one included.
     pub step: u64,
@@ -341,6 +343,10 @@ pub enum Command {
     Throttle(Duration),
     /// Send a `Trace` of every positive activation (SAP-Net runs).
     Trace(bool),
+    /// Stream as a run followed live ([`StreamOptions::live`]: every step, snapshots about
+    /// 30 a second), or only what results need ([`StreamOptions::episodes`]): a front end
+    /// that follows another run moves the stream to it.
+    Stream(bool),
 }
 
 /// What a run streams besides episodes, chosen by the front end.

@@ -111,6 +111,12 @@ impl CommandReceiver {
     pub fn stop_flag(&self) -> Arc<AtomicBool> {
         Arc::clone(&self.stop)
     }
+
+    /// The commands sent and not yet read (a front end's tests).
+    #[cfg(test)]
+    pub(crate) fn pending(&self) -> Vec<Command> {
+        self.receiver.try_iter().collect()
+    }
 }
 
 /// A run's command channel.

@@ -191,7 +191,7 @@ impl<'a> Run<'a> {
         let replay = ReplayBuffer::new(spec.dqn.replay_capacity, env.observation_size());
         let rng = StdRng::seed_from_u64(seeds.agent);
         let selection_rng = StdRng::seed_from_u64(seeds.selection);
-        let control = Control::new(commands, spec.stream.trace);
+        let control = Control::new(commands, spec.stream);
         let _ = events.send(Event::RunStarted {
             run: spec.run,
             method: spec.method.clone(),
@@ -290,6 +290,7 @@ impl<'a> Run<'a> {
             self.learn(actor, followed)?
         };
         self.send_step(StepRecord {
+            method: self.spec.method.index,
             run: self.spec.run,
             step: self.steps,
             episode,
@@ -498,10 +499,11 @@ impl<'a> Run<'a> {
     /// interval has passed (the clock looked at every 16 steps).
     fn send_step(&mut self, step: StepRecord) {
         let episode = step.episode;
-        if self.spec.stream.steps {
+        let stream = self.control.stream();
+        if stream.steps {
             let _ = self.events.send(Event::Step(step));
         }
-        let interval = self.spec.stream.snapshot_interval;
+        let interval = stream.snapshot_interval;
         if self.snapshots
             && (self.control.is_slow()
                 || (interval != Duration::MAX

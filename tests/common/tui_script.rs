@@ -100,6 +100,7 @@ pub fn episodes(episodes: u32) -> Vec<Event> {
         let terms: Vec<f64> = activations.iter().map(|a: &f64| (a - top).exp()).collect();
         let total: f64 = terms.iter().sum();
         events.push(Event::Step(StepRecord {
+            method: 0,
             run: 0,
             step,
             episode,

@@ -195,6 +195,23 @@ fn a_followed_run_without_a_library_says_it_reuses_none() {
     assert!(!text.contains("loading"), "{text}");
 }
 
+/// A run followed after it ended streamed no steps: its step line says so instead of
+/// waiting for one.
+#[test]
+fn a_run_followed_after_it_ended_says_it_has_no_steps() {
+    let mut d = Dashboard::new("CartPole-v1");
+    d.follow("sapnet");
+    d.on_event(tui_script::sapnet_start());
+    let lines = screen_lines(&draw_dashboard(&d, (120, 40)));
+    assert!(
+        lines[lines.len() - 2].contains("waiting for the first step"),
+        "{lines:?}"
+    );
+    d.on_event(tui_script::sapnet_end(60));
+    let lines = screen_lines(&draw_dashboard(&d, (120, 40)));
+    assert!(lines[lines.len() - 2].contains("no steps: this run ended before it was followed"));
+}
+
 /// The bottom row of the screen.
 fn status_line(terminal: &Terminal<TestBackend>) -> String {
     let buffer = terminal.backend().buffer();

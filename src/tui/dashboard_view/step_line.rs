@@ -17,7 +17,16 @@ use crate::tui::theme::Theme;
 /// its first step). Parts that do not fit are left out whole; the most telling come first.
 pub(super) fn step_line(dashboard: &Dashboard, width: u16, theme: Theme) -> Line<'static> {
     let Some(step) = &dashboard.last_step else {
-        return Line::styled(" waiting for the first step…", theme.dim());
+        // Steps stream only from the run followed: one followed after it ended sent none.
+        let ended = dashboard.main_run().is_some_and(|r| r.ended.is_some());
+        return Line::styled(
+            if ended {
+                " no steps: this run ended before it was followed (its curve is below)"
+            } else {
+                " waiting for the first step…"
+            },
+            theme.dim(),
+        );
     };
     let name = |i: usize| {
         dashboard
@@ -127,6 +136,7 @@ mod tests {
             td: None,
         });
         Event::Step(StepRecord {
+            method: 0,
             run: 0,
             step,
             episode,

@@ -6,9 +6,10 @@
 //!
 //! Every run of the protocol gets a [`Dashboard`] of its own when it starts, fed its own
 //! events: following another run (Enter on it in the Runs view, `m` in the Run view)
-//! shows its dashboard, its curve since its start. Only the run followed from the start
-//! streams every step (the step line); the others send what headless runs send, an
-//! episode's end and the sources' state then (every step while paused or slowed).
+//! shows its dashboard, its curve since its start. The followed run streams every step
+//! (the step line): following another moves the stream to it (`Command::Stream`); the
+//! others send what headless runs send, an episode's end and the sources' state then
+//! (every step while paused or slowed).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -122,8 +123,10 @@ pub struct Session {
     pub runs: BTreeMap<RunKey, LiveRun>,
     /// The run the Run view shows, and pause, step and speed steer.
     pub followed: Option<RunKey>,
-    /// The run that streams every step (the one followed from the start).
+    /// The run that streams every step: the one followed, once it trains.
     pub live: Option<RunKey>,
+    /// The protocol's methods by their index, as their runs started: whose a step is.
+    methods: BTreeMap<usize, String>,
     pub overlay: Option<Overlay>,
     /// What the last key did or why it did nothing, shown until the next key.
     pub notice: Option<String>,
@@ -146,6 +149,7 @@ impl Session {
             phase,
             runs: BTreeMap::new(),
             live: followed.clone(),
+            methods: BTreeMap::new(),
             followed,
             overlay: None,
             notice: None,
@@ -214,6 +218,11 @@ impl Session {
                 commands,
             } => {
                 let key = (method.label().to_string(), run);
+                self.methods.insert(method.index, key.0.clone());
+                // A run followed before it started takes the stream when it starts.
+                if self.followed.as_ref() == Some(&key) {
+                    self.stream_to(&key, &commands);
+                }
                 self.run_entry(&key).commands = Some(commands);
             }
             Watched::Event(event) => {
@@ -230,14 +239,14 @@ impl Session {
         }
     }
 
-    /// The run an event is of; a step's is the run that streams them.
+    /// The run an event is of.
     fn key_of(&self, event: &Event) -> Option<RunKey> {
         let key = |method: &crate::trainer::MethodId, run: u32| (method.label().to_string(), run);
         Some(match event {
             Event::RunStarted { run, method, .. } | Event::RunFailed { run, method, .. } => {
                 key(method, *run)
             }
-            Event::Step(_) => self.live.clone()?,
+            Event::Step(step) => (self.methods.get(&step.method)?.clone(), step.run),
             Event::Activations(snapshot) => key(&snapshot.method, snapshot.run),
             Event::Trace(record) => key(&record.method, record.run),
             Event::EpisodeEnded(record) => key(&record.method, record.run),
@@ -509,7 +518,8 @@ impl Session {
     }
 
     /// Follows `key`: the run followed so far is let go at full speed (a run left paused
-    /// would hold the protocol up for ever).
+    /// would hold the protocol up for ever), and the step stream moves to `key` if it
+    /// trains (else when it starts).
     pub fn follow(&mut self, key: RunKey) {
         if self.followed.as_ref() == Some(&key) {
             return;
@@ -526,7 +536,24 @@ impl Session {
                 }
             }
         }
+        if let Some(commands) = self.runs.get(&key).and_then(|r| r.commands.clone()) {
+            self.stream_to(&key, &commands);
+        }
         self.followed = Some(key);
+    }
+
+    /// Moves the step stream to the training run `key` (`commands` its own), from the run
+    /// that had it.
+    fn stream_to(&mut self, key: &RunKey, commands: &Commands) {
+        if self.live.as_ref() == Some(key) {
+            return;
+        }
+        let streaming = self.live.as_ref().and_then(|l| self.runs.get(l));
+        if let Some(old) = streaming.and_then(|r| r.commands.as_ref()) {
+            let _ = old.send(Command::Stream(false));
+        }
+        let _ = commands.send(Command::Stream(true));
+        self.live = Some(key.clone());
     }
 
     /// The protocol's controls, as the phase allows them: first in the status bar, where
@@ -615,6 +642,66 @@ mod tests {
         session.on_key(key(' '));
         session.follow(("random".to_string(), 0));
         assert_eq!(board(&session, "random"), (Mode::Paused, 0));
+    }
+
+    /// The followed run streams its steps: following another moves the stream, and each
+    /// step goes to its own run's dashboard, by its method and run, even one sent before
+    /// the move.
+    #[test]
+    fn following_a_run_moves_the_step_stream_to_it() {
+        use crate::reuse::Method;
+        use crate::trainer::{command_channel, MethodId, StepRecord};
+        let mut session = Session::new(
+            Path::new("out/x"),
+            "CartPole-v1",
+            Some(("sapnet".into(), 0)),
+            Phase::Running,
+        );
+        let mut receivers = Vec::new();
+        for (i, method) in [Method::SapNet, Method::Random].iter().enumerate() {
+            let (commands, receiver) = command_channel();
+            receivers.push(receiver);
+            session.on_watched(Watched::Started {
+                method: MethodId::new(i, method),
+                run: 0,
+                commands,
+            });
+        }
+        // The run followed from the start streams as its spec says: no command needed.
+        assert!(receivers.iter().all(|r| r.pending().is_empty()));
+        let step = |method: usize, step: u64| {
+            Watched::Event(Event::Step(StepRecord {
+                method,
+                run: 0,
+                step,
+                episode: 1,
+                policy: None,
+                action: 0,
+                reward: 1.0,
+                update: None,
+                judgment: None,
+                deposit: None,
+                warm_up: false,
+            }))
+        };
+        session.on_watched(step(0, 7));
+        session.follow(("random".to_string(), 0));
+        assert_eq!(receivers[0].pending(), [Command::Stream(false)]);
+        assert_eq!(receivers[1].pending(), [Command::Stream(true)]);
+        assert_eq!(session.live, Some(("random".to_string(), 0)));
+        // A step SAP-Net sent before it heard, then random's first.
+        session.on_watched(step(0, 8));
+        session.on_watched(step(1, 3));
+        let last = |s: &Session, label: &str| {
+            let run = &s.runs[&(label.to_string(), 0)];
+            run.dashboard.last_step.map(|s| s.step)
+        };
+        assert_eq!(last(&session, "sapnet"), Some(8));
+        assert_eq!(last(&session, "random"), Some(3));
+        // Back: the stream moves back.
+        session.follow(("sapnet".to_string(), 0));
+        assert_eq!(receivers[1].pending(), [Command::Stream(false)]);
+        assert_eq!(receivers[0].pending(), [Command::Stream(true)]);
     }
 
     #[test]
