@@ -7,8 +7,8 @@
 //! during the run: SAP-Net (the softmax over activations) and PRQ-learning (the softmax
 //! over reuse gains). It means nothing for the others, which show `-` everywhere: a rule
 //! picks (UCB1's index, GPI's max over Q-functions, the Q-switch's critic), a draw of
-//! fixed odds (random: 1/N each, never above 0.99; the oracle: 1 from its first step,
-//! which its record dates at the end of the warm-up), weights that combine rather than
+//! fixed odds (random: 1/N each, never above 0.99; the oracle: 1 from its first step, which
+//! records of older versions date at the end of the warm-up), weights that combine rather than
 //! pick (A2T's attention), or no library at all (DQN from scratch, QDagger's student).
 
 use super::MethodKind;

@@ -375,7 +375,10 @@ impl<'a> Run<'a> {
             self.send_traces();
         }
         self.selector.on_step();
+        // Only where the probabilities are learned does lock-in mean something
+        // (reuse/lock_in.rs): the oracle's one source, say, has 1 from the start.
         if self.record.lock_in_step.is_none()
+            && crate::reuse::lock_in::measured(self.spec.method.kind)
             && self.selector.top_probability().is_some_and(|p| p > LOCK_IN)
         {
             self.record.lock_in_step = Some(self.steps);
