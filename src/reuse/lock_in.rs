@@ -8,8 +8,9 @@
 //! over reuse gains). It means nothing for the others, which show `-` everywhere: a rule
 //! picks (UCB1's index, GPI's max over Q-functions, the Q-switch's critic), a draw of
 //! fixed odds (random: 1/N each, never above 0.99; the oracle: 1 from its first step, which
-//! records of older versions date at the end of the warm-up), weights that combine rather than
-//! pick (A2T's attention), or no library at all (DQN from scratch, QDagger's student).
+//! records of older versions date at the end of the warm-up), weights that combine rather
+//! than pick (A2T's attention), or no library at all (DQN from scratch, QDagger's student).
+//! The trainer records a run's lock-in step only where [`measured`] says it means something.
 
 use super::MethodKind;
 
