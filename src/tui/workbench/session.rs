@@ -606,8 +606,9 @@ mod tests {
         assert_eq!(session.on_key(ctrl_c), Request::Stop { then_quit: true });
     }
 
-    #[test]
-    fn a_run_left_is_let_go_at_full_speed() {
+    /// A session following SAP-Net's run 0, with it and random's run 0 started; the runs'
+    /// ends of their command channels.
+    fn two_runs_started() -> (Session, Vec<crate::trainer::CommandReceiver>) {
         use crate::reuse::Method;
         use crate::trainer::{command_channel, MethodId};
         let mut session = Session::new(
@@ -626,6 +627,12 @@ mod tests {
                 commands,
             });
         }
+        (session, receivers)
+    }
+
+    #[test]
+    fn a_run_left_is_let_go_at_full_speed() {
+        let (mut session, _receivers) = two_runs_started();
         // Space pauses the followed run; `-` slows it.
         session.on_key(key(' '));
         session.on_key(key('-'));
@@ -649,24 +656,8 @@ mod tests {
     /// the move.
     #[test]
     fn following_a_run_moves_the_step_stream_to_it() {
-        use crate::reuse::Method;
-        use crate::trainer::{command_channel, MethodId, StepRecord};
-        let mut session = Session::new(
-            Path::new("out/x"),
-            "CartPole-v1",
-            Some(("sapnet".into(), 0)),
-            Phase::Running,
-        );
-        let mut receivers = Vec::new();
-        for (i, method) in [Method::SapNet, Method::Random].iter().enumerate() {
-            let (commands, receiver) = command_channel();
-            receivers.push(receiver);
-            session.on_watched(Watched::Started {
-                method: MethodId::new(i, method),
-                run: 0,
-                commands,
-            });
-        }
+        use crate::trainer::StepRecord;
+        let (mut session, receivers) = two_runs_started();
         // The run followed from the start streams as its spec says: no command needed.
         assert!(receivers.iter().all(|r| r.pending().is_empty()));
         let step = |method: usize, step: u64| {
