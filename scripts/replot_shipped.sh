@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Makes a folder shipped in docs/ again with today's `sapnet plot` (its report by today's
-# rules: improvement.csv's separation rule, the figures): its episodes decompressed into a
-# copy, the copy made again from its top-level files (it ships no run records), and the
-# report, summary.json and figures copied back. episodes.csv.xz and tests.csv, the data,
+# rules: improvement.csv's separation rule, the figures): a copy made again from its
+# top-level files (it ships no run records; `sapnet plot` reads episodes.csv.xz as it is),
+# and the report, summary.json and figures copied back. episodes.csv.xz and tests.csv, the data,
 # are not changed; figures drawn from activations.csv, which did not ship, stay as shipped.
 #
 #     scripts/replot_shipped.sh DIR [SAPNET]   # SAPNET: the binary, default target/release/sapnet
@@ -11,7 +11,6 @@ dir=$1 sapnet=${2:-target/release/sapnet}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cp -r "$dir" "$tmp/folder"
-xz -dk "$tmp/folder/episodes.csv.xz"
 "$sapnet" plot "$tmp/folder" > "$tmp/table.txt"
 for f in comparison.csv improvement.csv scores.csv summary.json sample_efficiency.csv \
     intervals.png profiles.png improvement.png learning_curve.png sample_efficiency.png \

@@ -119,13 +119,90 @@ pub fn read_text(path: &Path, links: Links, limit: u64) -> io::Result<String> {
 /// hundreds of megabytes; this bounds what a doctored folder can make sapnet read.
 pub const MAX_CSV_BYTES: u64 = 16 << 30;
 
-/// A CSV reader over `path`, a file inside a folder (see [`open`]).
-pub fn csv_reader(path: &Path) -> io::Result<csv::Reader<File>> {
-    Ok(csv::Reader::from_reader(open(
-        path,
-        Links::Refuse,
-        MAX_CSV_BYTES,
-    )?))
+/// The most a compressed CSV file ([`open_csv`]) may decompress to: it is held in memory.
+/// The docs' largest `episodes.csv` is 23 MB.
+pub const MAX_DECOMPRESSED_CSV_BYTES: u64 = 1 << 30;
+
+/// A CSV file inside a folder (see [`open`]), or, if it is absent, its xz-compressed twin
+/// `<name>.xz` decompressed in memory: `docs/`'s folders ship their `episodes.csv` so. The
+/// twin is read as the file is (a regular file, never through a link) and may decompress to
+/// at most [`MAX_DECOMPRESSED_CSV_BYTES`].
+pub fn open_csv(path: &Path) -> io::Result<Box<dyn Read>> {
+    match open(path, Links::Refuse, MAX_CSV_BYTES) {
+        Ok(file) => Ok(Box::new(file)),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            let compressed = xz_twin(path);
+            match open(&compressed, Links::Refuse, MAX_CSV_BYTES) {
+                Ok(file) => decompress_xz(file, MAX_DECOMPRESSED_CSV_BYTES)
+                    .map(|bytes| Box::new(io::Cursor::new(bytes)) as Box<dyn Read>)
+                    .map_err(|why| {
+                        io::Error::new(why.kind(), format!("{}: {why}", compressed.display()))
+                    }),
+                // Neither: the error names the file asked for.
+                Err(twin) if twin.kind() == io::ErrorKind::NotFound => Err(e),
+                Err(twin) => Err(io::Error::new(
+                    twin.kind(),
+                    format!("{}: {twin}", compressed.display()),
+                )),
+            }
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// Whether `path` or its compressed twin ([`open_csv`]) is a regular file.
+pub fn csv_exists(path: &Path) -> bool {
+    [path.to_path_buf(), xz_twin(path)]
+        .iter()
+        .any(|p| std::fs::symlink_metadata(p).is_ok_and(|m| m.is_file()))
+}
+
+fn xz_twin(path: &Path) -> PathBuf {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(".xz");
+    path.with_file_name(name)
+}
+
+/// The bytes an xz stream decompresses to, refused past `limit`: a few kilobytes of xz can
+/// stand for gigabytes.
+fn decompress_xz(file: File, limit: u64) -> io::Result<Vec<u8>> {
+    struct Bounded {
+        bytes: Vec<u8>,
+        limit: u64,
+    }
+    impl Write for Bounded {
+        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+            if (self.bytes.len() + buf.len()) as u64 > self.limit {
+                return Err(refused(&format!(
+                    "decompresses to more than the {} bytes sapnet reads into memory: \
+                     decompress it yourself (xz -dk)",
+                    self.limit
+                )));
+            }
+            self.bytes.extend_from_slice(buf);
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+    let mut out = Bounded {
+        bytes: Vec::new(),
+        limit,
+    };
+    lzma_rs::xz_decompress(&mut io::BufReader::new(file), &mut out).map_err(|e| match e {
+        lzma_rs::error::Error::IoError(e) => e,
+        other => refused(&format!(
+            "not an xz file this reader can decompress: {other}"
+        )),
+    })?;
+    Ok(out.bytes)
+}
+
+/// A CSV reader over `path`, a file inside a folder, or its compressed twin (see
+/// [`open_csv`]).
+pub fn csv_reader(path: &Path) -> io::Result<csv::Reader<Box<dyn Read>>> {
+    Ok(csv::Reader::from_reader(open_csv(path)?))
 }
 
 /// A new file at `path`, whatever was there: a stale file or a planted link is removed
@@ -235,6 +312,71 @@ mod tests {
         assert!(err.to_string().contains("more than the 3"), "{err}");
         let dir = read(tmp.path(), Links::Refuse, 3).unwrap_err();
         assert!(dir.to_string().contains("a directory"), "{dir}");
+    }
+
+    fn xz(bytes: &[u8]) -> Vec<u8> {
+        let mut out = Vec::new();
+        lzma_rs::xz_compress(&mut &bytes[..], &mut out).unwrap();
+        out
+    }
+
+    fn read_csv(path: &Path) -> io::Result<String> {
+        let mut text = String::new();
+        open_csv(path)?.read_to_string(&mut text)?;
+        Ok(text)
+    }
+
+    #[test]
+    fn a_csv_file_is_read_from_itself_or_its_compressed_twin() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("episodes.csv");
+        assert!(!csv_exists(&path));
+        let err = read_csv(&path).unwrap_err();
+        assert_eq!(err.kind(), io::ErrorKind::NotFound);
+        std::fs::write(
+            tmp.path().join("episodes.csv.xz"),
+            xz(b"run,reward\n0,1.5\n"),
+        )
+        .unwrap();
+        assert!(csv_exists(&path));
+        assert_eq!(read_csv(&path).unwrap(), "run,reward\n0,1.5\n");
+        // The file itself, where both are, as a protocol's own folder after `xz -dk`.
+        std::fs::write(&path, "run,reward\n0,2.5\n").unwrap();
+        assert_eq!(read_csv(&path).unwrap(), "run,reward\n0,2.5\n");
+    }
+
+    #[test]
+    fn a_compressed_twin_is_refused_through_a_link_damaged_or_past_its_bound() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("episodes.csv");
+        let twin = tmp.path().join("episodes.csv.xz");
+        let elsewhere = tmp.path().join("elsewhere.xz");
+        std::fs::write(&elsewhere, xz(b"secret\n")).unwrap();
+        symlink(&elsewhere, &twin).unwrap();
+        assert!(!csv_exists(&path));
+        let err = read_csv(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("episodes.csv.xz") && err.contains("symbolic link"),
+            "{err}"
+        );
+        std::fs::remove_file(&twin).unwrap();
+        let whole = xz(b"run,reward\n0,1.5\n");
+        std::fs::write(&twin, &whole[..whole.len() - 9]).unwrap();
+        let err = read_csv(&path).unwrap_err().to_string();
+        assert!(err.contains("episodes.csv.xz"), "{err}");
+        // A megabyte of zeros, read with a kilobyte's bound.
+        let bomb = xz(&vec![0; 1 << 20]);
+        let err = decompress_xz(File::open(write_tmp(&tmp, &bomb)).unwrap(), 1024).unwrap_err();
+        assert!(
+            err.to_string().contains("more than the 1024 bytes"),
+            "{err}"
+        );
+    }
+
+    fn write_tmp(tmp: &tempfile::TempDir, bytes: &[u8]) -> PathBuf {
+        let path = tmp.path().join("bomb.xz");
+        std::fs::write(&path, bytes).unwrap();
+        path
     }
 
     #[test]

@@ -74,9 +74,6 @@ pub enum OutsideRunError {
         method: String,
         found: Vec<String>,
     },
-    #[error("{}: the folder's episodes are compressed; decompress them beside it first \
-             (`xz -dk {}`)", path.display(), path.display())]
-    Compressed { path: PathBuf },
     #[error("{}: {error}", path.display())]
     Csv { path: PathBuf, error: csv::Error },
     #[error(transparent)]

@@ -1,7 +1,7 @@
 //! A CSV file read by its header's column names, each cell turned into a number with an
 //! error that names the file, the line and the column.
 
-use std::fs::File;
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use super::error::{Location, OutsideRunError};
@@ -10,7 +10,7 @@ use super::error::{Location, OutsideRunError};
 pub struct Table {
     path: PathBuf,
     names: Vec<String>,
-    rows: csv::StringRecordsIntoIter<File>,
+    rows: csv::StringRecordsIntoIter<Box<dyn Read>>,
 }
 
 /// Whether lines starting with `#` are comments (a monitor file's first line is one).
@@ -22,11 +22,15 @@ pub enum Comments {
 
 impl Table {
     /// Reads the header of `file`, opened from `path`. Cells are trimmed: exports pad them.
-    pub fn read(file: File, path: &Path, comments: Comments) -> Result<Self, OutsideRunError> {
+    pub fn read(
+        file: impl Read + 'static,
+        path: &Path,
+        comments: Comments,
+    ) -> Result<Self, OutsideRunError> {
         let mut reader = csv::ReaderBuilder::new()
             .comment((comments == Comments::Skipped).then_some(b'#'))
             .trim(csv::Trim::All)
-            .from_reader(file);
+            .from_reader(Box::new(file) as Box<dyn Read>);
         let names = reader
             .headers()
             .map_err(|error| csv_error(path, error))?

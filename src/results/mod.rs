@@ -36,20 +36,12 @@ pub(crate) fn require_records(dir: &Path, header: &SummaryHeader) -> Result<()> 
         anyhow::bail!(
             "{}: summary.json lists {} runs but the folder holds none of their records \
              ({}/{}/<run>/run.json): a report shipped without them is made again by \
-             `sapnet plot` from its episodes.csv ({}), but not pooled or resumed; use the \
+             `sapnet plot` from its episodes.csv, but not pooled or resumed; use the \
              protocol's own output folder",
             dir.display(),
             header.listed_runs.len(),
             dir.display(),
             records::RUNS,
-            if dir.join("episodes.csv.xz").exists() {
-                format!(
-                    "decompress it first: xz -dk {}",
-                    dir.join("episodes.csv.xz").display()
-                )
-            } else {
-                "absent here".to_string()
-            }
         );
     }
     Ok(())

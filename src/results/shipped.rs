@@ -27,12 +27,12 @@ struct ListedRuns {
 /// Whether `dir` is a shipped folder this module can make again: no run records, but the
 /// episodes of the runs its summary lists.
 pub fn can_replot(dir: &Path) -> bool {
-    std::fs::symlink_metadata(dir.join("episodes.csv")).is_ok_and(|m| m.is_file())
+    safe_io::csv_exists(&dir.join("episodes.csv"))
 }
 
 /// Every run `dir`'s `summary.json` lists, with its training returns from `episodes.csv`:
-/// what its report is made of. Refused for a protocol that did not finish, and, naming
-/// what is missing, for a folder whose episodes shipped compressed only.
+/// what its report is made of (`episodes.csv` or, as `docs/` ships it, `episodes.csv.xz`).
+/// Refused for a protocol that did not finish.
 pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
     if !matches!(header.status, None | Some(Status::Complete)) {
         bail!(
@@ -46,19 +46,10 @@ pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
     if !can_replot(dir) {
         bail!(
             "{}: summary.json lists {} runs, the folder holds none of their records \
-             (runs/<run>/run.json) and no episodes.csv, whose training returns the report is \
-             made of{}",
+             (runs/<run>/run.json) and no episodes.csv (nor episodes.csv.xz), whose training returns the report is \
+             made of",
             dir.display(),
             header.listed_runs.len(),
-            if dir.join("episodes.csv.xz").exists() {
-                format!(
-                    " (it ships compressed: decompress it first, xz -dk {}, or in a copy of \
-                     the folder)",
-                    dir.join("episodes.csv.xz").display()
-                )
-            } else {
-                String::new()
-            }
         );
     }
     let path = dir.join("summary.json");
