@@ -333,6 +333,7 @@ fn protocol(
                 name: s.name.clone(),
                 hidden: s.description.hidden.clone(),
                 task: s.description.source_task.clone(),
+                activation: s.description.activation.clone(),
                 final_score: s.final_score,
             })
             .collect()

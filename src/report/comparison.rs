@@ -447,6 +447,7 @@ mod tests {
             name: String::new(),
             hidden: vec![],
             task: String::new(),
+            activation: String::new(),
             final_score: s,
         };
         let library = [

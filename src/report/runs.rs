@@ -13,7 +13,27 @@ pub struct LibraryEntry {
     /// The task it was trained on, with what differs from the task's defaults.
     #[serde(default)]
     pub task: String,
+    /// Its hidden layers' activation function: with `hidden` and `task`, the categories its
+    /// place in SAP-Net's graph is made of. Folders older than the field held ReLU
+    /// networks only.
+    #[serde(default = "relu")]
+    pub activation: String,
     pub final_score: Option<f64>,
+}
+
+fn relu() -> String {
+    "relu".to_string()
+}
+
+impl LibraryEntry {
+    /// The description its graph's categories come from (eq. 3–5).
+    pub fn description(&self) -> crate::sapnet::PolicyDescription {
+        crate::sapnet::PolicyDescription {
+            hidden: self.hidden.clone(),
+            activation: self.activation.clone(),
+            source_task: self.task.clone(),
+        }
+    }
 }
 
 /// One run in `summary.json` (and in `runs/<run>/run.json`); `M` as in [`RunRecord`].

@@ -122,6 +122,13 @@ impl FolderState {
             .count()
     }
 
+    /// The record of run `run` of `method`, if it finished (or was stopped).
+    pub fn finished(&self, method: &MethodId, run: u32) -> Option<&RunSummary> {
+        self.finished
+            .iter()
+            .find(|r| r.record.method == *method && r.record.run == run)
+    }
+
     /// What identifies the finished runs: the report changes only when this does.
     pub fn finished_key(&self) -> BTreeSet<(String, u32)> {
         self.finished

@@ -8,6 +8,7 @@ pub mod files;
 pub mod folder_state;
 pub mod plot_data;
 pub mod pool;
+pub mod recorded_run;
 pub mod records;
 pub mod replot;
 pub mod shipped;

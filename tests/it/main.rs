@@ -29,6 +29,7 @@ mod other_agents;
 mod pinned_numbers;
 mod pool_cli;
 mod received_folders;
+mod recorded_runs;
 mod resume_cli;
 mod sapnet_properties;
 mod sapnet_selection;

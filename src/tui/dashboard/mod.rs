@@ -86,6 +86,18 @@ pub struct Dashboard {
     /// Why the last key did nothing, or what it left (training still paused after teach
     /// mode): shown in the status line in place of the keys until the next key.
     pub notice: Option<&'static str>,
+    /// Made from a finished run's files ([`crate::results::recorded_run`]), not followed
+    /// while it trained.
+    pub from_files: Option<FromFiles>,
+}
+
+/// What the files of a run shown after it ended kept.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FromFiles {
+    /// Whether its selector's scores and probabilities were on file (`activations.csv`).
+    pub activations: bool,
+    /// Whether each episode's ε and losses were (`docs/` ships `episodes.csv` without).
+    pub learner: bool,
 }
 
 impl Dashboard {
@@ -110,6 +122,7 @@ impl Dashboard {
             teach: None,
             followed: None,
             reference: Vec::new(),
+            from_files: None,
         }
     }
 

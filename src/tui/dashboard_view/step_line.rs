@@ -10,8 +10,24 @@
 use ratatui::text::{Line, Span};
 
 use crate::trainer::StepRecord;
-use crate::tui::dashboard::Dashboard;
+use crate::tui::dashboard::{Dashboard, FromFiles};
 use crate::tui::theme::Theme;
+
+/// What a dashboard made from a finished run's files shows, and what its files lacked.
+fn from_files(files: FromFiles, reuses: bool) -> String {
+    let mut lacked = Vec::new();
+    if reuses && !files.activations {
+        lacked.push("activations.csv (the scores are the library's start)");
+    }
+    if !files.learner {
+        lacked.push("each episode's ε and losses (shown as 0)");
+    }
+    if lacked.is_empty() {
+        " read from its files: a run that has ended keeps no steps".into()
+    } else {
+        format!(" read from its files, which lack {}", lacked.join(" and "))
+    }
+}
 
 /// The step line of `dashboard`'s followed run in `width` columns (a waiting note before
 /// its first step). Parts that do not fit are left out whole; the most telling come first.
@@ -20,10 +36,12 @@ pub(super) fn step_line(dashboard: &Dashboard, width: u16, theme: Theme) -> Line
         // Steps stream only from the run followed: one followed after it ended sent none.
         let ended = dashboard.main_run().is_some_and(|r| r.ended.is_some());
         return Line::styled(
-            if ended {
-                " no steps: this run ended before it was followed (its curve is below)"
-            } else {
-                " waiting for the first step…"
+            match dashboard.from_files {
+                Some(files) => from_files(files, dashboard.library.is_some()),
+                None if ended => {
+                    " no steps: this run ended before it was followed (its curve is below)".into()
+                }
+                None => " waiting for the first step…".into(),
             },
             theme.dim(),
         );

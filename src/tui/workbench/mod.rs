@@ -28,8 +28,10 @@ pub mod curves;
 pub mod curves_view;
 pub mod live;
 pub mod mouse;
+pub mod opened;
 pub mod picker;
 pub mod protocol;
+pub mod recorded;
 pub mod runs_view;
 pub mod session;
 pub mod session_view;
@@ -45,12 +47,14 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 use anyhow::{Context, Result};
-use crossterm::event::{self as term, KeyEventKind};
+use crossterm::event::{self as term, KeyEventKind, MouseButton, MouseEventKind};
+use ratatui::layout::Rect;
 
 use crate::report::Report;
 use crate::results::folder_state::{FolderReader, FolderState};
 use state::{Action, Workbench};
 
+use super::dashboard_view;
 use super::theme::Theme;
 use super::FRAME;
 
@@ -73,6 +77,7 @@ pub fn run(dir: &Path) -> Result<()> {
     let computing = !folder.finished_key().is_empty();
     let mut workbench = Workbench::new(folder, None);
     workbench.computing = computing;
+    let mut opened = opened::Opened::new(workbench);
     let theme = Theme::from_env();
     let (reads_tx, reads) = mpsc::channel();
     // Dropping `_stop` (however the UI ends) wakes the thread and ends it.
@@ -86,8 +91,8 @@ pub fn run(dir: &Path) -> Result<()> {
     loop {
         for read in reads.try_iter() {
             match read {
-                Ok((folder, report)) => workbench.refreshed(folder, report),
-                Err(error) => workbench.read_error = Some(error),
+                Ok((folder, report)) => opened.workbench.refreshed(folder, report),
+                Err(error) => opened.workbench.read_error = Some(error),
             }
             dirty = true;
         }
@@ -96,7 +101,7 @@ pub fn run(dir: &Path) -> Result<()> {
         }
         if dirty {
             terminal
-                .draw(|frame| view::draw(frame, &workbench, theme))
+                .draw(|frame| opened::draw(frame, &opened, theme))
                 .context("drawing the workbench")?;
             dirty = false;
         }
@@ -106,14 +111,31 @@ pub fn run(dir: &Path) -> Result<()> {
         dirty = true;
         let event = term::read().context("reading the keyboard")?;
         if let term::Event::Mouse(mouse) = event {
-            let size = terminal.size().context("reading the terminal's size")?;
-            mouse::on_mouse(&mut workbench, mouse, size.into());
+            let size: Rect = terminal
+                .size()
+                .context("reading the terminal's size")?
+                .into();
+            match opened.dashboard_mut() {
+                Some(dashboard) => {
+                    let below = session_view::dashboard_area(size);
+                    if mouse.kind == MouseEventKind::Down(MouseButton::Left) {
+                        if let Some(clicked) =
+                            dashboard_view::clicked(dashboard, below, mouse.column, mouse.row)
+                        {
+                            dashboard.on_click(clicked);
+                        }
+                    }
+                }
+                None => {
+                    mouse::on_mouse(&mut opened.workbench, mouse, size);
+                }
+            }
             continue;
         }
         let term::Event::Key(key) = event else {
             continue; // a resize redraws
         };
-        if key.kind == KeyEventKind::Press && workbench.on_key(key) == Action::Quit {
+        if key.kind == KeyEventKind::Press && opened.on_key(key) == Action::Quit {
             return Ok(());
         }
     }

@@ -18,6 +18,7 @@ use std::time::{Duration, Instant};
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
 use super::picker::{Picked, Picker};
+use super::recorded;
 use super::state::{View, Workbench};
 use crate::headless::Watched;
 use crate::report::Report;
@@ -32,7 +33,8 @@ const HOST_KEYS: [(&str, &str); 5] = [
     (
         "Enter",
         "Runs: follow the run under the cursor in the Run view (pause, step and speed act \
-         on it; the others train at full speed)",
+         on it; the others train at full speed); a run that ended before, its dashboard \
+         read from its files",
     ),
     (
         "f",
@@ -188,6 +190,7 @@ impl Session {
             workbench.host_controls = controls;
             workbench.host_bar = vec![("⏎", "follow"), ("f", "run view")];
             workbench.host_overlay = HOST_KEYS.to_vec();
+            workbench.host_runs_protocols = true;
         }
     }
 
@@ -485,14 +488,42 @@ impl Session {
             self.screen = Screen::Run;
             return;
         }
-        self.notice = Some(match row.status {
-            RunStatus::Queued => format!("{} run {} has not started yet", key.0, key.1),
-            RunStatus::Done => format!(
-                "{} run {} finished before this session: its row says its figures",
-                key.0, key.1
-            ),
-            status => format!("{} run {} is {}", key.0, key.1, status.name()),
-        });
+        let method = row.method.clone();
+        self.notice = match row.status {
+            RunStatus::Queued => Some(format!("{} run {} has not started yet", key.0, key.1)),
+            RunStatus::Done | RunStatus::Stopped
+                if workbench.folder.finished(&method, key.1).is_some() =>
+            {
+                match recorded::dashboard(
+                    &workbench.folder,
+                    &method,
+                    key.1,
+                    &self.task,
+                    &self.reference,
+                ) {
+                    Ok(dashboard) => {
+                        self.show_recorded(key, dashboard);
+                        None
+                    }
+                    Err(error) => Some(format!("{error:#}")),
+                }
+            }
+            status => Some(format!("{} run {} is {}", key.0, key.1, status.name())),
+        };
+    }
+
+    /// Shows a run that ended before this session, its dashboard made from its files.
+    fn show_recorded(&mut self, key: RunKey, dashboard: Dashboard) {
+        // Made afresh each time: the files of a finished run do not change.
+        self.runs.insert(
+            key.clone(),
+            LiveRun {
+                dashboard,
+                commands: None,
+            },
+        );
+        self.follow(key);
+        self.screen = Screen::Run;
     }
 
     /// `m`: the next run that trains now, after the followed one.

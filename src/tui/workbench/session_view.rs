@@ -14,7 +14,7 @@ use super::picker::Picker;
 use super::session::{Overlay, Phase, Screen, Session};
 use super::view;
 use crate::results::Status;
-use crate::tui::dashboard::Clicked;
+use crate::tui::dashboard::{Clicked, Dashboard};
 use crate::tui::dashboard_view;
 use crate::tui::screen;
 use crate::tui::theme::Theme;
@@ -35,16 +35,21 @@ pub fn draw(frame: &mut Frame, session: &Session, theme: Theme) {
         None => {}
     }
     if let Some(notice) = &session.notice {
-        let bar = Rect::new(area.x, area.bottom() - 1, area.width, 1);
-        frame.render_widget(Clear, bar);
-        frame.render_widget(
-            Paragraph::new(Line::from(Span::styled(
-                format!(" {notice}"),
-                theme.active(),
-            ))),
-            bar,
-        );
+        draw_notice(frame, area, notice, theme);
     }
+}
+
+/// What the last key did or why it did nothing, over the status bar.
+pub fn draw_notice(frame: &mut Frame, area: Rect, notice: &str, theme: Theme) {
+    let bar = Rect::new(area.x, area.bottom() - 1, area.width, 1);
+    frame.render_widget(Clear, bar);
+    frame.render_widget(
+        Paragraph::new(Line::from(Span::styled(
+            format!(" {notice}"),
+            theme.active(),
+        ))),
+        bar,
+    );
 }
 
 /// The area the followed run's dashboard takes in the Run view: all but the top line; on
@@ -117,9 +122,15 @@ fn draw_dashboard_in(frame: &mut Frame, below: Rect, session: &Session, theme: T
         );
         return;
     };
+    draw_dashboard_at(frame, below, &run.dashboard, theme);
+}
+
+/// `dashboard` in `below`, drawn off screen at that size and copied in (the dashboard fills
+/// whatever frame it is given).
+pub fn draw_dashboard_at(frame: &mut Frame, below: Rect, dashboard: &Dashboard, theme: Theme) {
     let Ok(mut off_screen) = Terminal::new(TestBackend::new(below.width, below.height));
     if off_screen
-        .draw(|f| dashboard_view::draw_dashboard(f, &run.dashboard, theme))
+        .draw(|f| dashboard_view::draw_dashboard(f, dashboard, theme))
         .is_err()
     {
         return;

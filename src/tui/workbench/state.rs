@@ -117,6 +117,9 @@ pub struct Workbench {
     pub host_controls: Vec<(&'static str, &'static str)>,
     pub host_bar: Vec<(&'static str, &'static str)>,
     pub host_overlay: Vec<(&'static str, &'static str)>,
+    /// The host runs protocols (a session), so that quitting may stop one; else the
+    /// folder is only read (`sapnet open`).
+    pub host_runs_protocols: bool,
     /// The Curves view's choices.
     pub curves: super::curves::Curves,
 }
@@ -137,6 +140,7 @@ impl Workbench {
             host_controls: Vec::new(),
             host_bar: Vec::new(),
             host_overlay: Vec::new(),
+            host_runs_protocols: false,
             curves: super::curves::Curves::default(),
         }
     }
@@ -238,7 +242,7 @@ impl Workbench {
         keys.extend(super::curves::KEYS);
         keys.extend(self.host_overlay.iter().copied());
         keys.push(("?", "every key"));
-        keys.push(if self.host_overlay.is_empty() {
+        keys.push(if !self.host_runs_protocols {
             (
                 "q, Esc, Ctrl-C",
                 "quit (the folder is only read: nothing in it changes)",
