@@ -285,7 +285,7 @@ impl Running {
                 .map(|r| (r.method.label().to_string(), r.run))
         };
         let followed = unfinished(preferred.as_ref()).or_else(|| unfinished(None));
-        let (dir, task) = (folder.dir.clone(), folder.task());
+        let (dir, task) = (folder.dir.clone(), folder.config.env.gym_id());
         match ProtocolRun::resume(
             &dir,
             settings.python.clone(),
