@@ -6,8 +6,9 @@
 //!
 //! Read from the run's record (`runs/<run>/`: `run.json`, `episodes.csv`,
 //! `activations.csv`) or, in a folder shipped without records, from the run's rows of the
-//! top-level files. What no file keeps is not made up: no step is streamed, and the
-//! judgments are the run's totals (`run.json`), not each episode's. A folder shipped
+//! top-level files. What no file keeps is not made up: no step is streamed, the
+//! judgments are the run's totals (`run.json`), not each episode's, and which sources an
+//! exclusion left out (`SapNetWith(exclusion: …)`) is not shown. A folder shipped
 //! without `activations.csv` has no selector state to show ([`Recorded::activations`]).
 
 use std::collections::BTreeMap;
