@@ -1013,3 +1013,66 @@ fn the_sweep_view_shows_the_cells_and_the_merges_comparisons() {
     // Two methods × two runs.
     assert_eq!(live.cells[4].progress.map(|(_, all)| all), Some(4));
 }
+
+/// The Curves view's legend with more methods (24) than it has lines: the picked one is
+/// kept in view, the footer says how many lines are hidden above and below, and a click
+/// lands on the method drawn where it clicks.
+#[test]
+fn the_curves_legend_scrolls_to_the_picked_method() {
+    let tmp = tempfile::tempdir().unwrap();
+    let methods: Vec<String> = (4..28)
+        .map(|units| format!("Dqn(hidden: [{units}])"))
+        .collect();
+    let config = tmp.path().join("twelve.ron");
+    std::fs::write(
+        &config,
+        format!(
+            "(env: CartPole(), dqn: (replay_start_size: 20), protocol: (episodes: 12, moving_average: 3, runs: 1, \
+             test_episodes: 1, methods: [{}]), seed: 0)",
+            methods.join(", ")
+        ),
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    let output = sapnet()
+        .args(["--headless", "--jobs", "2", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    let size = (80, 24);
+    let mut workbench = workbench(&out, "v");
+    let drawn = text(&screen(&workbench, size));
+    assert!(drawn.contains("dqn[4]"), "{drawn}");
+    assert!(!drawn.contains("dqn[27]"), "{drawn}");
+    assert!(drawn.contains("▼"), "{drawn}");
+    for _ in 0..23 {
+        workbench.on_key(key('j'));
+    }
+    let terminal = screen(&workbench, size);
+    let drawn = text(&terminal);
+    assert!(drawn.contains("dqn[27]"), "{drawn}");
+    assert!(!drawn.contains("dqn[4] "), "{drawn}");
+    assert!(drawn.contains("▲"), "{drawn}");
+    // A click on the last line hides the method drawn there, the 24th.
+    let (column, row) = drawn_at(&terminal, "dqn[27]");
+    let event = crossterm::event::MouseEvent {
+        kind: crossterm::event::MouseEventKind::Down(crossterm::event::MouseButton::Left),
+        column,
+        row,
+        modifiers: KeyModifiers::NONE,
+    };
+    let screen_area = ratatui::layout::Rect::new(0, 0, size.0, size.1);
+    assert!(sapnet::tui::workbench::mouse::on_mouse(
+        &mut workbench,
+        event,
+        screen_area
+    ));
+    assert!(
+        workbench.curves.hidden.contains(&23),
+        "{:?}",
+        workbench.curves.hidden
+    );
+}

@@ -20,6 +20,7 @@ use crate::report::plots::palette::method_colours;
 use crate::report::sample_efficiency::EfficiencyPoint;
 use crate::results::folder_state::FolderState;
 use crate::stats::Estimate;
+use crate::tui::row_window::RowWindow;
 use crate::tui::theme::Theme;
 
 /// Without colour, each method's line carries its own marker (the legend's too).
@@ -144,8 +145,18 @@ pub fn legend_method_at(area: Rect, workbench: &Workbench, column: u16, row: u16
     if !(legend.x..legend.x + legend.width).contains(&column) || row < first {
         return None;
     }
-    let index = usize::from(row - first);
-    (index < workbench.methods()).then_some(index)
+    legend_window(legend, workbench.methods(), workbench.curves.cursor)
+        .row_at(usize::from(row - first))
+}
+
+/// The methods' lines the legend in `area` shows: as many as fit between its heading and
+/// its footer, the picked one kept in view.
+fn legend_window(area: Rect, methods: usize, cursor: usize) -> RowWindow {
+    RowWindow::new(
+        methods,
+        usize::from(area.height).saturating_sub(2),
+        [cursor],
+    )
 }
 
 /// What the view shows, over how many runs, and where on the episodes.
@@ -363,7 +374,13 @@ fn draw_legend(
         ),
         theme.dim(),
     )];
-    for (m, end) in methods.iter().zip(&ends) {
+    let window = legend_window(area, methods.len(), curves.cursor);
+    for (m, end) in methods
+        .iter()
+        .zip(&ends)
+        .skip(window.first)
+        .take(window.shown)
+    {
         let on = !curves.hidden.contains(&m.index);
         let style = if theme.color {
             Style::new().fg(m.colour)
@@ -403,7 +420,11 @@ fn draw_legend(
             ),
         ]));
     }
-    lines.push(Line::styled(fit("␣: on/off · ⏎: runs", width), theme.dim()));
+    let footer = match window.marker() {
+        Some(more) => format!("{} ↑↓", more.trim()),
+        None => "␣: on/off · ⏎: runs".to_string(),
+    };
+    lines.push(Line::styled(fit(&footer, width), theme.dim()));
     frame.render_widget(Paragraph::new(lines), area);
 }
 
@@ -434,7 +455,13 @@ fn draw_runs_legend(
             theme.dim(),
         ),
     ];
-    for (k, run) in runs.iter().enumerate() {
+    // Between the two heading lines and the footer, the shown run kept in view.
+    let rows = RowWindow::new(
+        runs.len(),
+        usize::from(area.height).saturating_sub(3),
+        [shown],
+    );
+    for (k, run) in runs.iter().enumerate().skip(rows.first).take(rows.shown) {
         let last = moving_average(&run.returns, window)
             .last()
             .map_or_else(|| "-".to_string(), |a| format!("{a:.1}"));
@@ -455,9 +482,10 @@ fn draw_runs_legend(
     if runs.is_empty() {
         lines.push(Line::styled("no run with episodes yet", theme.dim()));
     }
-    lines.push(Line::styled(
-        fit("[ ]: run · ⏎: every method", width),
-        theme.dim(),
-    ));
+    let footer = match rows.marker() {
+        Some(more) => format!("{} [ ]", more.trim()),
+        None => "[ ]: run · ⏎: every method".to_string(),
+    };
+    lines.push(Line::styled(fit(&footer, width), theme.dim()));
     frame.render_widget(Paragraph::new(lines), area);
 }
