@@ -42,16 +42,19 @@ const AB_STEPS: u64 = 40_000;
 fn sources(n: u64) -> Arc<Vec<SourcePolicy>> {
     Arc::new(
         (0..n)
-            .map(|i| SourcePolicy {
-                name: format!("source-{i}"),
-                net: QNet::new(
-                    Architecture::new(4, &[100], 2),
-                    &mut StdRng::seed_from_u64(i),
+            .map(|i| {
+                SourcePolicy::new(
+                    format!("source-{i}"),
+                    QNet::new(
+                        Architecture::new(4, &[100], 2),
+                        &mut StdRng::seed_from_u64(i),
+                    )
+                    .expect("network"),
+                    PolicyDescription::new(vec![100], "cartpole"),
+                    // Scores for the selectors that read them (BestSource picks source-3).
+                    Some(if i == 3 { 500.0 } else { 10.0 + i as f64 }),
                 )
-                .expect("network"),
-                description: PolicyDescription::new(vec![100], "cartpole"),
-                // Scores for the selectors that read them (BestSource picks source-3).
-                final_score: Some(if i == 3 { 500.0 } else { 10.0 + i as f64 }),
+                .expect("network")
             })
             .collect(),
     )

@@ -210,7 +210,7 @@ impl Gradients {
 impl QNet {
     /// Calls `f` with layer `l`'s weights and bias, read in place (locking two parameters,
     /// not all of them: nothing is collected, so a pass allocates nothing).
-    fn with_layer<R>(&self, l: usize, f: impl FnOnce(&[f32], &[f32]) -> R) -> Result<R> {
+    pub(super) fn with_layer<R>(&self, l: usize, f: impl FnOnce(&[f32], &[f32]) -> R) -> Result<R> {
         let parameters = self.parameters();
         let (weight, bias) = (&parameters[2 * l], &parameters[2 * l + 1]);
         let (weight, weight_layout) = weight.storage_and_layout();

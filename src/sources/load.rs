@@ -249,16 +249,16 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
                 .translate(&stored.net, target)
                 .with_context(|| format!("mapping {} to the target", metadata_path.display()))?;
         }
-        sources.push(SourcePolicy {
-            description: PolicyDescription {
+        sources.push(SourcePolicy::new(
+            entry.name.clone(),
+            stored.net,
+            PolicyDescription {
                 hidden: stored.metadata.architecture.hidden.clone(),
                 activation: stored.metadata.activation.clone(),
                 source_task: task.label.clone(),
             },
-            final_score: stored.metadata.final_score,
-            net: stored.net,
-            name: entry.name.clone(),
-        });
+            stored.metadata.final_score,
+        )?);
     }
     // An imported policy's category is the task it was imported for, named as the config
     // names that task.
@@ -270,16 +270,16 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
             .iter()
             .find(|t| &t.env.as_recorded() == recorded)
             .map_or_else(|| recorded.label(), |t| t.label.clone());
-        sources.push(SourcePolicy {
-            description: PolicyDescription {
+        sources.push(SourcePolicy::new(
+            entry.name.clone(),
+            stored.net,
+            PolicyDescription {
                 hidden: stored.metadata.architecture.hidden.clone(),
                 activation: stored.metadata.activation.clone(),
                 source_task: label,
             },
-            final_score: stored.metadata.final_score,
-            net: stored.net,
-            name: entry.name.clone(),
-        });
+            stored.metadata.final_score,
+        )?);
     }
     Ok(sources)
 }

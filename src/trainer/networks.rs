@@ -55,7 +55,7 @@ impl ValueBuffers {
                     values.clear();
                     values.extend_from_slice(&kept[i * actions..(i + 1) * actions]);
                 }
-                None => *values = source.net.q_values(obs)?,
+                None => *values = source.acting().q_values(obs)?,
             }
         }
         if let Some(attention) = attention {
@@ -154,7 +154,7 @@ impl<'a> RunNetworks<'a> {
         };
         match actor {
             Actor::Source(i) => self.agents[i].act(obs, rng).map(own),
-            Actor::SourceGreedy(i) => self.sources[i].net.greedy_action(obs).map(own),
+            Actor::SourceGreedy(i) => self.sources[i].acting().greedy_action(obs).map(own),
             Actor::Learner => self.learner().act(obs, rng).map(own),
             Actor::Combined => {
                 let learner = self
@@ -174,7 +174,7 @@ impl<'a> RunNetworks<'a> {
     pub fn value(&self, actor: Actor, obs: &[f32]) -> Result<f64, DqnError> {
         match actor {
             Actor::Source(i) => self.agents[i].value(obs),
-            Actor::SourceGreedy(i) => self.sources[i].net.max_q(obs).map(f64::from),
+            Actor::SourceGreedy(i) => self.sources[i].acting().max_q(obs).map(f64::from),
             Actor::Learner | Actor::Combined => self.learner().value(obs),
         }
     }
@@ -182,7 +182,10 @@ impl<'a> RunNetworks<'a> {
     /// `max_a Q_j(obs, a)` of every source: its learning copy, if sources learn.
     pub fn source_values(&self, obs: &[f32]) -> Result<Vec<f64>, DqnError> {
         if self.agents.is_empty() {
-            let values = self.sources.iter().map(|s| s.net.max_q(obs).map(f64::from));
+            let values = self
+                .sources
+                .iter()
+                .map(|s| s.acting().max_q(obs).map(f64::from));
             values.collect()
         } else {
             self.agents.iter().map(|a| a.value(obs)).collect()

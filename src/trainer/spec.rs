@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use super::events::{MethodId, StreamOptions};
 use super::TrainerError;
-use crate::dqn::{DqnConfig, QNet};
+use crate::dqn::{DqnConfig, DqnError, FrozenNet, QNet};
 use crate::env::EnvConfig;
 use crate::reuse::{self, Method};
 use crate::sapnet::{PolicyDescription, SapNetParams};
@@ -19,6 +19,31 @@ pub struct SourcePolicy {
     pub net: QNet,
     pub description: PolicyDescription,
     pub final_score: Option<f64>,
+    /// `net` laid out for acting on one observation (the same bits, a sixteenth of the
+    /// work): a source as recorded never changes.
+    acting: FrozenNet,
+}
+
+impl SourcePolicy {
+    pub fn new(
+        name: String,
+        net: QNet,
+        description: PolicyDescription,
+        final_score: Option<f64>,
+    ) -> Result<Self, DqnError> {
+        Ok(Self {
+            acting: FrozenNet::of(&net)?,
+            name,
+            net,
+            description,
+            final_score,
+        })
+    }
+
+    /// The recorded network, for one observation's Q-values.
+    pub fn acting(&self) -> &FrozenNet {
+        &self.acting
+    }
 }
 
 /// What one run trains, how, and for how long.

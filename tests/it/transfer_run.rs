@@ -19,15 +19,18 @@ fn sources() -> Arc<Vec<SourcePolicy>> {
     let sources = layouts
         .iter()
         .enumerate()
-        .map(|(i, hidden)| SourcePolicy {
-            name: format!("source-{i}"),
-            net: QNet::new(
-                Architecture::new(4, hidden, 2),
-                &mut StdRng::seed_from_u64(i as u64),
+        .map(|(i, hidden)| {
+            SourcePolicy::new(
+                format!("source-{i}"),
+                QNet::new(
+                    Architecture::new(4, hidden, 2),
+                    &mut StdRng::seed_from_u64(i as u64),
+                )
+                .unwrap(),
+                PolicyDescription::new(hidden.to_vec(), "cartpole"),
+                None,
             )
-            .unwrap(),
-            description: PolicyDescription::new(hidden.to_vec(), "cartpole"),
-            final_score: None,
+            .unwrap()
         })
         .collect();
     Arc::new(sources)

@@ -46,9 +46,18 @@ unsafe fn tile<const R: usize>(
     let (lr, lk) = (p.left.row_stride, p.left.column_stride);
     let right = p.right.as_ptr().add(j);
     let mut acc = [[_mm256_setzero_ps(); 2]; R];
-    if let Start::Bias(bias) = p.start {
-        for (r, row) in acc.iter_mut().enumerate() {
-            *row = [_mm256_set1_ps(*bias.get_unchecked(r0 + r)); 2];
+    match p.start {
+        Start::Zero => {}
+        Start::Bias(bias) => {
+            for (r, row) in acc.iter_mut().enumerate() {
+                *row = [_mm256_set1_ps(*bias.get_unchecked(r0 + r)); 2];
+            }
+        }
+        Start::ColumnBias(bias) => {
+            let at = bias.as_ptr().add(j);
+            for row in acc.iter_mut() {
+                *row = [_mm256_loadu_ps(at), _mm256_loadu_ps(at.add(WIDTH))];
+            }
         }
     }
     for k in 0..p.depth {

@@ -99,9 +99,22 @@ unsafe fn tile<const R: usize, const V: usize>(
                 *a = _mm512_loadu_ps(at.add(v * WIDTH));
             }
         }
-    } else if let Start::Bias(bias) = p.start {
-        for (r, row) in acc.iter_mut().enumerate() {
-            *row = [_mm512_set1_ps(*bias.get_unchecked(r0 + r)); V];
+    } else {
+        match p.start {
+            Start::Zero => {}
+            Start::Bias(bias) => {
+                for (r, row) in acc.iter_mut().enumerate() {
+                    *row = [_mm512_set1_ps(*bias.get_unchecked(r0 + r)); V];
+                }
+            }
+            Start::ColumnBias(bias) => {
+                let at = bias.as_ptr().add(j);
+                for row in acc.iter_mut() {
+                    for (v, a) in row.iter_mut().enumerate() {
+                        *a = _mm512_loadu_ps(at.add(v * WIDTH));
+                    }
+                }
+            }
         }
     }
     let last = k1 >= p.depth;

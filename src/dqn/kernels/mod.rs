@@ -134,13 +134,17 @@ pub(crate) enum Start<'a> {
     Zero,
     /// `bias[r]` for every element of row `r`.
     Bias(&'a [f32]),
+    /// `bias[j]` for every element of column `j`: a layer's pass over one observation laid
+    /// out with the units along the columns ([`crate::dqn::FrozenNet`]).
+    ColumnBias(&'a [f32]),
 }
 
 impl Start<'_> {
-    fn at(&self, r: usize) -> f32 {
+    fn at(&self, r: usize, j: usize) -> f32 {
         match self {
             Start::Zero => 0.0,
             Start::Bias(bias) => bias[r],
+            Start::ColumnBias(bias) => bias[j],
         }
     }
 }
@@ -218,8 +222,12 @@ impl Product<'_> {
             let last = (self.rows - 1) * l.row_stride + (self.depth - 1) * l.column_stride;
             assert!(l.data.len() > last, "left operand too short");
         }
-        if let Start::Bias(bias) = self.start {
-            assert!(bias.len() >= self.rows, "one bias per row");
+        match self.start {
+            Start::Zero => {}
+            Start::Bias(bias) => assert!(bias.len() >= self.rows, "one bias per row"),
+            Start::ColumnBias(bias) => {
+                assert!(bias.len() >= self.columns, "one bias per column")
+            }
         }
         if let Finish::MaskBy(by) = self.finish {
             assert!(
@@ -316,6 +324,7 @@ mod tests {
         let left = random(rows * depth + 3, &mut rng);
         let right = random(depth * (columns + 16) + 1, &mut rng);
         let bias = random(rows, &mut rng);
+        let column_bias = random(columns, &mut rng);
         let mask = random(rows * columns, &mut rng);
         let mut results = Vec::new();
         for isa in supported() {
@@ -324,6 +333,7 @@ mod tests {
                 (Start::Zero, Finish::Keep, (depth, 1)),
                 (Start::Bias(&bias), Finish::Relu, (depth, 1)),
                 (Start::Zero, Finish::MaskBy(&mask), (1, rows)),
+                (Start::ColumnBias(&column_bias), Finish::Relu, (depth, 1)),
             ];
             for (start, finish, (row_stride, column_stride)) in kinds {
                 let mut out = vec![f32::NAN; rows * columns];

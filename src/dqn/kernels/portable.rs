@@ -7,7 +7,9 @@ use super::{Finish, Product};
 pub(super) fn product(p: &Product, out: &mut [f32], out_stride: usize) {
     for r in 0..p.rows {
         let row = &mut out[r * out_stride..][..p.columns];
-        row.fill(p.start.at(r));
+        for (j, acc) in row.iter_mut().enumerate() {
+            *acc = p.start.at(r, j);
+        }
         for k in 0..p.depth {
             let l = p.left.at(r, k);
             let right = &p.right[k * p.right_stride..][..p.columns];
