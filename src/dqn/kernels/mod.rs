@@ -192,7 +192,12 @@ impl Product<'_> {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx512 => {
                 assert!(isa.supported(), "AVX-512 kernels on a CPU without AVX-512");
-                unsafe { avx512::product(self, out, out_stride) }
+                match self.start {
+                    Start::ColumnBias(bias) => unsafe {
+                        avx512::column_bias_product(self, bias, out, out_stride)
+                    },
+                    _ => unsafe { avx512::product(self, out, out_stride) },
+                }
             }
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => {
@@ -200,7 +205,12 @@ impl Product<'_> {
                     isa.supported(),
                     "AVX2 kernels on a CPU without AVX2 and FMA"
                 );
-                unsafe { avx2::product(self, out, out_stride) }
+                match self.start {
+                    Start::ColumnBias(bias) => unsafe {
+                        avx2::column_bias_product(self, bias, out, out_stride)
+                    },
+                    _ => unsafe { avx2::product(self, out, out_stride) },
+                }
             }
             #[cfg(not(target_arch = "x86_64"))]
             Isa::Avx512 | Isa::Avx2 => panic!("{} kernels on a non-x86 CPU", isa.name()),
@@ -334,6 +344,7 @@ mod tests {
                 (Start::Bias(&bias), Finish::Relu, (depth, 1)),
                 (Start::Zero, Finish::MaskBy(&mask), (1, rows)),
                 (Start::ColumnBias(&column_bias), Finish::Relu, (depth, 1)),
+                (Start::ColumnBias(&column_bias), Finish::Keep, (1, rows)),
             ];
             for (start, finish, (row_stride, column_stride)) in kinds {
                 let mut out = vec![f32::NAN; rows * columns];
