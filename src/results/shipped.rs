@@ -46,8 +46,8 @@ pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
     if !can_replot(dir) {
         bail!(
             "{}: summary.json lists {} runs, the folder holds none of their records \
-             (runs/<run>/run.json) and no episodes.csv (nor episodes.csv.xz), whose training returns the report is \
-             made of",
+             (runs/<run>/run.json) and no episodes.csv (nor episodes.csv.xz), whose \
+             training returns the report is made of",
             dir.display(),
             header.listed_runs.len(),
         );

@@ -169,7 +169,7 @@ fn enter_in_the_runs_view_shows_a_finished_runs_dashboard() {
     let screen = drawn(&opened);
     assert!(screen.contains("▶ sapnet run 0"), "{screen}");
     assert!(
-        screen.contains("read from its files: a run that has ended keeps no steps"),
+        screen.contains("\n from its files, no steps kept  "),
         "{screen}"
     );
     assert!(screen.contains("ep 60/60"), "{screen}");
@@ -215,8 +215,14 @@ fn enter_in_the_runs_view_shows_a_finished_runs_dashboard() {
     let mut opened = open(&shipped);
     opened.on_key(key(KeyCode::Enter));
     let screen = drawn(&opened);
-    assert!(screen.contains("which lack activations.csv"), "{screen}");
-    assert!(screen.contains("ε and losses"), "{screen}");
+    assert!(
+        screen.contains("no activations.csv: scores shown as at the start"),
+        "{screen}"
+    );
+    assert!(
+        screen.contains("no ε, losses on file: shown as 0"),
+        "{screen}"
+    );
     // What the record keeps is shown: the steps each source acted.
     let record = &opened.workbench.folder.runs[0];
     assert_eq!(record.method.label(), "sapnet");

@@ -13,20 +13,23 @@ use crate::trainer::StepRecord;
 use crate::tui::dashboard::{Dashboard, FromFiles};
 use crate::tui::theme::Theme;
 
-/// What a dashboard made from a finished run's files shows, and what its files lacked.
-fn from_files(files: FromFiles, reuses: bool) -> String {
-    let mut lacked = Vec::new();
+/// What a dashboard made from a finished run's files says: that, and what its files lacked,
+/// each part left out whole where `width` has no room for it.
+fn from_files(files: FromFiles, reuses: bool, width: u16) -> String {
+    let mut parts = vec![" from its files, no steps kept"];
     if reuses && !files.activations {
-        lacked.push("activations.csv (the scores are the library's start)");
+        parts.push(" · no activations.csv: scores shown as at the start");
     }
     if !files.learner {
-        lacked.push("each episode's ε and losses (shown as 0)");
+        parts.push(" · no ε, losses on file: shown as 0");
     }
-    if lacked.is_empty() {
-        " read from its files: a run that has ended keeps no steps".into()
-    } else {
-        format!(" read from its files, which lack {}", lacked.join(" and "))
+    let mut line = String::new();
+    for part in parts {
+        if line.chars().count() + part.chars().count() <= usize::from(width) {
+            line.push_str(part);
+        }
     }
+    line
 }
 
 /// The step line of `dashboard`'s followed run in `width` columns (a waiting note before
@@ -37,7 +40,7 @@ pub(super) fn step_line(dashboard: &Dashboard, width: u16, theme: Theme) -> Line
         let ended = dashboard.main_run().is_some_and(|r| r.ended.is_some());
         return Line::styled(
             match dashboard.from_files {
-                Some(files) => from_files(files, dashboard.library.is_some()),
+                Some(files) => from_files(files, dashboard.library.is_some(), width),
                 None if ended => {
                     " no steps: this run ended before it was followed (its curve is below)".into()
                 }

@@ -47,14 +47,13 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 use anyhow::{Context, Result};
-use crossterm::event::{self as term, KeyEventKind, MouseButton, MouseEventKind};
+use crossterm::event::{self as term, KeyEventKind};
 use ratatui::layout::Rect;
 
 use crate::report::Report;
 use crate::results::folder_state::{FolderReader, FolderState};
 use state::{Action, Workbench};
 
-use super::dashboard_view;
 use super::theme::Theme;
 use super::FRAME;
 
@@ -115,21 +114,7 @@ pub fn run(dir: &Path) -> Result<()> {
                 .size()
                 .context("reading the terminal's size")?
                 .into();
-            match opened.dashboard_mut() {
-                Some(dashboard) => {
-                    let below = session_view::dashboard_area(size);
-                    if mouse.kind == MouseEventKind::Down(MouseButton::Left) {
-                        if let Some(clicked) =
-                            dashboard_view::clicked(dashboard, below, mouse.column, mouse.row)
-                        {
-                            dashboard.on_click(clicked);
-                        }
-                    }
-                }
-                None => {
-                    mouse::on_mouse(&mut opened.workbench, mouse, size);
-                }
-            }
+            opened.on_mouse(mouse, size);
             continue;
         }
         let term::Event::Key(key) = event else {

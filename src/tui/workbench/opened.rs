@@ -2,7 +2,7 @@
 //! its finished runs (Enter in the Runs view; `r`, `c`, `v` come back), made from the
 //! run's files ([`super::recorded`]). Nothing is written: the folder is only read.
 
-use crossterm::event::{KeyCode, KeyEvent};
+use crossterm::event::{KeyCode, KeyEvent, MouseButton, MouseEvent, MouseEventKind};
 use ratatui::layout::Rect;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Clear, Paragraph};
@@ -11,8 +11,9 @@ use ratatui::Frame;
 use super::session::RunKey;
 use super::session_view;
 use super::state::{Action, View, Workbench};
-use super::{recorded, view};
+use super::{mouse, recorded, view};
 use crate::tui::dashboard::{Action as DashboardAction, Dashboard, Mode};
+use crate::tui::dashboard_view;
 use crate::tui::screen;
 use crate::tui::theme::Theme;
 
@@ -86,9 +87,20 @@ impl Opened {
         }
     }
 
-    /// The dashboard shown, for a click.
-    pub fn dashboard_mut(&mut self) -> Option<&mut Dashboard> {
-        self.run.as_mut().map(|(_, dashboard)| dashboard)
+    /// A mouse event on a `screen`-sized terminal: a left click on the dashboard's panels,
+    /// or whatever the workbench's views do with it.
+    pub fn on_mouse(&mut self, mouse: MouseEvent, screen: Rect) {
+        let Some((_, dashboard)) = &mut self.run else {
+            mouse::on_mouse(&mut self.workbench, mouse, screen);
+            return;
+        };
+        if mouse.kind != MouseEventKind::Down(MouseButton::Left) {
+            return;
+        }
+        let below = session_view::dashboard_area(screen);
+        if let Some(clicked) = dashboard_view::clicked(dashboard, below, mouse.column, mouse.row) {
+            dashboard.on_click(clicked);
+        }
     }
 }
 
