@@ -1,6 +1,7 @@
 //! `sapnet open`'s screen: the workbench's views of a folder, or the dashboard of one of
-//! its finished runs (Enter in the Runs view; `r`, `c`, `v` come back), made from the
-//! run's files ([`super::recorded`]). Nothing is written: the folder is only read.
+//! its finished runs, made from the run's files ([`super::recorded`]): Enter in the Runs
+//! view shows it; `r` and `c` come back, as from a session's Run view (the dashboard keeps
+//! its own keys, `v` among them). Nothing is written: the folder is only read.
 
 use crossterm::event::{KeyCode, KeyEvent, MouseButton, MouseEvent, MouseEventKind};
 use ratatui::layout::Rect;
@@ -20,8 +21,8 @@ use crate::tui::theme::Theme;
 /// The keys `sapnet open` adds to the workbench's.
 const OPEN_KEYS: [(&str, &str); 1] = [(
     "Enter",
-    "Runs: the finished run under the cursor on its dashboard, made from its files (r, c \
-     and v come back)",
+    "Runs: the finished run under the cursor on its dashboard, made from its files (r and c \
+     come back)",
 )];
 
 /// The workbench, and the finished run shown on its dashboard, if one is.
@@ -47,7 +48,7 @@ impl Opened {
         self.notice = None;
         if let Some((_, dashboard)) = &mut self.run {
             let teaching = dashboard.mode == Mode::Teach || dashboard.help;
-            if !teaching && matches!(key.code, KeyCode::Char('r' | 'c' | 'v')) {
+            if !teaching && matches!(key.code, KeyCode::Char('r' | 'c')) {
                 self.run = None;
                 return self.workbench.on_key(key);
             }
@@ -128,7 +129,7 @@ pub fn draw(frame: &mut Frame, opened: &Opened, theme: Theme) {
                 )),
                 Span::styled("  │ ", theme.dim()),
             ];
-            for (key, what) in [("r", "runs"), ("c", "comparison"), ("v", "curves")] {
+            for (key, what) in [("r", "runs"), ("c", "comparison")] {
                 spans.push(Span::styled(key, theme.title()));
                 spans.push(Span::raw(format!(" {what}  ")));
             }
