@@ -14,7 +14,7 @@
 use std::cell::RefCell;
 
 use super::kernels::{padded, Finish, Isa, Product, Start, Strided};
-use super::q_values::argmax;
+use super::q_values::{argmax, highest};
 use super::{DqnError, QNet};
 
 /// A frozen copy of a network's weights in the layout of one observation's pass.
@@ -76,7 +76,7 @@ impl FrozenNet {
 
     /// The highest Q-value of one observation, folded as [`QNet::max_q`] folds it.
     pub fn max_q(&self, obs: &[f32]) -> Result<f32, DqnError> {
-        self.with_q_values(obs, |q| q.iter().copied().fold(f32::MIN, f32::max))
+        self.with_q_values(obs, highest)
     }
 
     /// The action of highest Q-value; ties go to the lowest index.

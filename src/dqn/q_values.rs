@@ -27,7 +27,7 @@ impl QNet {
 
     /// The highest Q-value of one observation, folded as the update's TD targets fold a row.
     pub fn max_q(&self, obs: &[f32]) -> Result<f32, DqnError> {
-        self.with_q_values(obs, |q| q.iter().copied().fold(f32::MIN, f32::max))
+        self.with_q_values(obs, highest)
     }
 
     /// The action of highest Q-value; ties go to the lowest index, as `argmax` does.
@@ -50,6 +50,11 @@ impl QNet {
         }
         ACTING.with_borrow_mut(|work| Ok(f(self.forward_with(Isa::current(), obs, 1, work)?)))
     }
+}
+
+/// The highest of `values`, folded as the update's TD targets fold a row.
+pub(crate) fn highest(values: &[f32]) -> f32 {
+    values.iter().copied().fold(f32::MIN, f32::max)
 }
 
 /// Index of the first maximum; NaN never wins.

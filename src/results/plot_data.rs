@@ -139,19 +139,21 @@ fn rows<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {
         .collect()
 }
 
-/// What `activations.csv` holds for the plots.
+/// What `activations.csv` holds: for the plots, and for a finished run's dashboard
+/// ([`super::recorded_run`]).
 #[derive(Default)]
-struct Activations {
+pub(super) struct Activations {
     /// The sources' names (the `A_<name>` columns).
-    names: Vec<String>,
-    /// Per (method, run), each episode's scores and steps acted.
-    runs: BTreeMap<(String, u32), SelectionHistory>,
+    pub names: Vec<String>,
+    /// Per (method, run), each episode's scores, probabilities and steps acted.
+    pub runs: BTreeMap<(String, u32), SelectionHistory>,
 }
 
 /// No file (a config without a reusing method) is no activations. A file without the
-/// `method` column (before the comparison of methods) is SAP-Net's.
-fn read_activations(path: &Path) -> Result<Activations> {
-    if !path.exists() {
+/// `method` column (before the comparison of methods) is SAP-Net's; one without the
+/// `episode` column numbers each run's rows from 1.
+pub(super) fn read_activations(path: &Path) -> Result<Activations> {
+    if !crate::safe_io::csv_exists(path) {
         return Ok(Activations::default());
     }
     let mut reader =
@@ -168,8 +170,14 @@ fn read_activations(path: &Path) -> Result<Activations> {
             .collect()
     };
     let (scores, acted) = (prefixed("A_"), prefixed("selected_"));
+    let probabilities = prefixed("P_");
     let method_column = headers.iter().position(|h| h == "method");
-    if headers.get(0) != Some("run") || scores.is_empty() || acted.len() != scores.len() {
+    let episode_column = headers.iter().position(|h| h == "episode");
+    if headers.get(0) != Some("run")
+        || scores.is_empty()
+        || acted.len() != scores.len()
+        || !(probabilities.is_empty() || probabilities.len() == scores.len())
+    {
         bail!(
             "{}: expected the columns run, method, episode, A_<policy>…, P_<policy>…, \
              selected_<policy>…, found {:?}",
@@ -200,9 +208,21 @@ fn read_activations(path: &Path) -> Result<Activations> {
             .iter()
             .map(|&(c, _)| number(c).map(|v| v as u64))
             .collect::<Result<Vec<u64>>>()?;
+        let chances = probabilities
+            .iter()
+            .map(|&(c, _)| number(c))
+            .collect::<Result<Vec<f64>>>()?;
         let entry = runs.entry((method, run)).or_default();
+        let episode = match episode_column {
+            Some(c) => number(c)? as u32,
+            None => entry.episodes.len() as u32 + 1,
+        };
         entry.scores.push(values);
         entry.acted.push(steps);
+        if !chances.is_empty() {
+            entry.probabilities.push(chances);
+        }
+        entry.episodes.push(episode);
     }
     Ok(Activations {
         names: scores.into_iter().map(|(_, name)| name).collect(),

@@ -18,6 +18,7 @@ use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 
 use super::folder_state::FolderState;
+use super::plot_data;
 use super::records::{run_name, RUNS};
 use crate::reuse::{self, Library};
 use crate::safe_io;
@@ -58,7 +59,7 @@ pub fn read(folder: &FolderState, method: &MethodId, run: u32) -> Result<Recorde
         None
     };
     let rows = match &library {
-        Some(start) => read_activations(&files.activations, method.label(), run, start.net.len())?,
+        Some(start) => run_activations(&files.activations, method.label(), run, start.net.len())?,
         None => Vec::new(),
     };
     let activations = !rows.is_empty();
@@ -270,79 +271,45 @@ struct ActivationRow {
     selected: Vec<u64>,
 }
 
-/// The run's rows of `activations.csv` (`run, method, episode, A_<name>…, P_<name>…,
-/// selected_<name>…`), each with `sources` values of each kind; none if the file is
-/// absent (a folder shipped without it). A file without the `method` column (before the
-/// comparison of methods) is SAP-Net's.
-fn read_activations(
+/// The run's rows of `activations.csv`, read as the plots read it
+/// ([`plot_data::read_activations`]), each with a value per source of `sources`; none if the
+/// file is absent (a folder shipped without it).
+fn run_activations(
     path: &Path,
     method: &str,
     run: u32,
     sources: usize,
 ) -> Result<Vec<ActivationRow>> {
-    if !safe_io::csv_exists(path) {
+    let read = plot_data::read_activations(path)?;
+    let Some(history) = read.runs.get(&(method.to_string(), run)) else {
         return Ok(Vec::new());
-    }
-    let mut reader =
-        safe_io::csv_reader(path).with_context(|| format!("reading {}", path.display()))?;
-    let headers = reader
-        .headers()
-        .with_context(|| format!("reading {}", path.display()))?
-        .clone();
-    let columns = |prefix: &str| -> Vec<usize> {
-        headers
-            .iter()
-            .enumerate()
-            .filter(|(_, h)| h.starts_with(prefix))
-            .map(|(i, _)| i)
-            .collect()
     };
-    let (scores, probabilities, selected) = (columns("A_"), columns("P_"), columns("selected_"));
-    let position = |name: &str| headers.iter().position(|h| h == name);
-    let (Some(run_column), Some(episode_column)) = (position("run"), position("episode")) else {
-        bail!("{}: no `run` and `episode` columns", path.display());
-    };
-    if [&scores, &probabilities, &selected]
-        .iter()
-        .any(|c| c.len() != sources)
-    {
+    if read.names.len() != sources || history.probabilities.len() != history.scores.len() {
         bail!(
             "{}: expected {sources} columns each of A_<policy>, P_<policy> and \
-             selected_<policy> (one per source of summary.json's library), found {}, {} and {}",
+             selected_<policy> (one per source of summary.json's library), found {} sources{}",
             path.display(),
-            scores.len(),
-            probabilities.len(),
-            selected.len()
+            read.names.len(),
+            if history.probabilities.is_empty() {
+                " and no P_ columns"
+            } else {
+                ""
+            }
         );
     }
-    let method_column = position("method");
-    let mut rows = Vec::new();
-    for (i, record) in reader.records().enumerate() {
-        let at = || format!("{}: row {}", path.display(), i + 2);
-        let record = record.with_context(at)?;
-        let text = |column: usize| record.get(column).unwrap_or("");
-        let label = method_column.map_or("sapnet", text);
-        let number = |column: usize| -> Result<f64> {
-            let field = text(column);
-            field.parse().with_context(|| {
-                format!("{}, column {}: {field:?} is not a number", at(), column + 1)
-            })
-        };
-        if label != method || number(run_column)? != f64::from(run) {
-            continue;
-        }
-        let all = |columns: &[usize]| {
-            columns
-                .iter()
-                .map(|&c| number(c))
-                .collect::<Result<Vec<f64>>>()
-        };
-        rows.push(ActivationRow {
-            episode: number(episode_column)? as u32,
-            scores: all(&scores)?,
-            probabilities: all(&probabilities)?,
-            selected: all(&selected)?.into_iter().map(|v| v as u64).collect(),
-        });
-    }
-    Ok(rows)
+    Ok(history
+        .episodes
+        .iter()
+        .zip(&history.scores)
+        .zip(&history.probabilities)
+        .zip(&history.acted)
+        .map(
+            |(((&episode, scores), probabilities), selected)| ActivationRow {
+                episode,
+                scores: scores.clone(),
+                probabilities: probabilities.clone(),
+                selected: selected.clone(),
+            },
+        )
+        .collect())
 }

@@ -37,9 +37,14 @@ fn key(c: char) -> KeyEvent {
 
 /// A finished protocol of tests/configs/two_baselines.ron in `out`.
 fn finished_folder(out: &Path) {
+    protocol_into(&configs("two_baselines.ron"), out);
+}
+
+/// The protocol of `config` run headless into `out`, on two jobs.
+fn protocol_into(config: &Path, out: &Path) {
     let output = sapnet()
         .args(["--headless", "--jobs", "2", "--config"])
-        .arg(configs("two_baselines.ron"))
+        .arg(config)
         .arg("--out")
         .arg(out)
         .output()
@@ -1034,14 +1039,7 @@ fn the_curves_legend_scrolls_to_the_picked_method() {
     )
     .unwrap();
     let out = tmp.path().join("out");
-    let output = sapnet()
-        .args(["--headless", "--jobs", "2", "--config"])
-        .arg(&config)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(output.status.success(), "{}", stderr(&output));
+    protocol_into(&config, &out);
     let size = (80, 24);
     let mut workbench = workbench(&out, "v");
     let drawn = text(&screen(&workbench, size));

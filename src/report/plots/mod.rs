@@ -81,6 +81,11 @@ pub struct SelectionHistory {
     pub scores: Vec<Vec<f64>>,
     /// Steps each source acted in each episode.
     pub acted: Vec<Vec<u64>>,
+    /// The probability of picking each source next, at the end of each episode (empty in
+    /// a file without the `P_` columns).
+    pub probabilities: Vec<Vec<f64>>,
+    /// Each row's episode (1-based).
+    pub episodes: Vec<u32>,
 }
 
 /// Writes `learning_curve.png`, `learning_curve.svg`, `sample_efficiency.csv`, `.png` and
