@@ -4,7 +4,6 @@
 //!
 //! Run: `cargo bench --bench report_stats`.
 
-use std::collections::BTreeMap;
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
@@ -12,13 +11,13 @@ use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
 use sapnet::config::Config;
-use sapnet::report::{Report, RunSummary, TaskRuns};
+use sapnet::report::{Report, RunSummary, TaskRuns, TrainingEpisodes, TrainingRuns};
 use sapnet::trainer::{MethodId, RunRecord};
 
 /// The reuse comparison's methods with `runs` runs each: returns and test scores drawn at
 /// random (the statistics cost the same whatever the numbers), 1,000 episodes a run.
 /// What a report reads of a protocol: its config, its runs and their training returns.
-type Protocol = (Config, Vec<RunSummary>, BTreeMap<(MethodId, u32), Vec<f64>>);
+type Protocol = (Config, Vec<RunSummary>, TrainingRuns);
 
 fn protocol(runs: u32) -> Protocol {
     let mut config = Config::from_ron(
@@ -29,7 +28,7 @@ fn protocol(runs: u32) -> Protocol {
     config.protocol.runs = runs;
     let mut rng = StdRng::seed_from_u64(1);
     let mut summaries = Vec::new();
-    let mut rewards = BTreeMap::new();
+    let mut rewards = TrainingRuns::new();
     for method in MethodId::all(&config.protocol.methods) {
         for run in 0..runs {
             let returns: Vec<f64> = (0..1000).map(|_| rng.random_range(0.0..500.0)).collect();
@@ -40,6 +39,8 @@ fn protocol(runs: u32) -> Protocol {
                 episodes: 1000,
                 steps: 0,
                 updates: 0,
+                cut_episode: None,
+                non_greedy_steps: None,
                 chosen: None,
                 source_steps: vec![1; 10],
                 lock_in_step: Some(600),
@@ -51,7 +52,7 @@ fn protocol(runs: u32) -> Protocol {
                 wall_s: 0.0,
             };
             summaries.push(RunSummary::new(record, &returns, 10));
-            rewards.insert((method.clone(), run), returns);
+            rewards.insert((method.clone(), run), TrainingEpisodes::uniform(&returns, 20));
         }
     }
     (config, summaries, rewards)
@@ -67,7 +68,7 @@ fn report(c: &mut Criterion) {
             config: &config,
             library: &[],
             runs: &summaries,
-            rewards: &rewards,
+            episodes: &rewards,
         };
         group.bench_with_input(
             BenchmarkId::new("of", format!("11_methods_x_{runs}_runs")),

@@ -143,7 +143,7 @@ fn specs(stream: StreamOptions, steps: u64) -> (RunSpec, RunSpec) {
         0,
         1,
     );
-    dqn.max_steps = Some(steps + warm_up);
+    dqn.budget = sapnet::config::Budget::Steps(steps + warm_up);
     let transfer = RunSpec {
         run: 0,
         method: MethodId::new(0, &Method::SapNet),
@@ -152,8 +152,7 @@ fn specs(stream: StreamOptions, steps: u64) -> (RunSpec, RunSpec) {
         dqn: config.dqn.clone(),
         sapnet: config.sapnet.clone(),
         sources: sources(10),
-        episodes: u32::MAX,
-        max_steps: Some(steps + warm_up),
+        budget: sapnet::config::Budget::Steps(steps + warm_up),
         test_episodes: 0,
         seed: 1,
         stream,

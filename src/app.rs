@@ -7,7 +7,7 @@ use std::sync::mpsc;
 use anyhow::{Context, Result};
 
 use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, SourcesCommand, SweepCommand, TeachArgs};
-use crate::config::Config;
+use crate::config::{Budget, Config};
 use crate::experiment;
 use crate::headless::{self, OutputOptions, RunOptions};
 use crate::results;
@@ -176,7 +176,10 @@ fn apply_flags(cli: &Cli, config: &mut Config) {
         config.seed = seed;
     }
     if let Some(episodes) = cli.run.episodes {
-        config.protocol.episodes = episodes;
+        config.protocol.budget = Budget::Episodes(episodes);
+    }
+    if let Some(steps) = cli.run.steps {
+        config.protocol.budget = Budget::Steps(steps);
     }
     if let Some(runs) = cli.run.runs {
         config.protocol.runs = runs;

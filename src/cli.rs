@@ -59,7 +59,7 @@ pub struct RunArgs {
     #[arg(
         long,
         requires = "out",
-        conflicts_with_all = ["config", "seed", "quick", "episodes", "force", "trace"]
+        conflicts_with_all = ["config", "seed", "quick", "episodes", "steps", "force", "trace"]
     )]
     pub resume: bool,
 
@@ -71,9 +71,9 @@ pub struct RunArgs {
     pub add_methods: Option<PathBuf>,
 
     /// A smoke run (seconds for the paper's protocol, about ten for the comparison of
-    /// assets/reuse_cartpole.ron, on 2 cores): the protocol cut to 1/20 of its episodes and
-    /// at most 2 runs per method (on the same source library). With --episodes, its N
-    /// episodes.
+    /// assets/reuse_cartpole.ron, on 2 cores): the protocol cut to 1/20 of its budget
+    /// (episodes or steps) and at most 2 runs per method (on the same source library). With
+    /// --episodes or --steps, that budget.
     #[arg(long)]
     pub quick: bool,
 
@@ -96,10 +96,16 @@ pub struct RunArgs {
     #[arg(long, value_name = "DIR")]
     pub compare: Option<PathBuf>,
 
-    /// Training episodes per run, overriding the config's `protocol.episodes`: the first N
-    /// episodes of every run are exactly those of the full protocol (the same seeds).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    /// Training episodes per run, overriding the config's `protocol.budget` with
+    /// `Episodes(N)`: the first N episodes of every run are exactly those of the full
+    /// protocol (the same seeds).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=crate::limits::MAX_EPISODES as i64))]
     pub episodes: Option<u32>,
+
+    /// Environment steps per run, overriding the config's `protocol.budget` with
+    /// `Steps(N)`: every method is given the same experience, scored on the step axis.
+    #[arg(long, value_name = "N", conflicts_with = "episodes", value_parser = clap::value_parser!(u64).range(1..=crate::limits::MAX_STEPS))]
+    pub steps: Option<u64>,
 
     /// Runs per method, overriding the config's `protocol.runs`. Run r's seeds do not
     /// depend on how many runs there are, so the first N runs of a longer protocol are
@@ -376,6 +382,7 @@ impl RunArgs {
             ("--follow-run", self.follow_run.is_some()),
             ("--compare", self.compare.is_some()),
             ("--episodes", self.episodes.is_some()),
+            ("--steps", self.steps.is_some()),
             ("--runs", self.runs.is_some()),
             ("--trace", self.trace),
             ("--jobs", self.jobs.is_some()),
@@ -541,6 +548,15 @@ pub struct CompareArgs {
     /// The moving average's window, in episodes, for the curves.
     #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
     pub window: u32,
+    /// Put the runs side by side by environment step up to N (each run's curve there the
+    /// mean return of its last episodes ended by it; a run shorter than N holds its last
+    /// value). Default, when every run says where its episodes ended: the steps every run
+    /// reached.
+    #[arg(long, value_name = "N", conflicts_with = "by_episode", value_parser = clap::value_parser!(u64).range(1..=crate::limits::MAX_STEPS))]
+    pub steps: Option<u64>,
+    /// Put the runs side by side by episode even when their files give steps.
+    #[arg(long)]
+    pub by_episode: bool,
     /// The task's name in titles. Default: a results folder's task, else `runs`.
     #[arg(long, value_name = "NAME")]
     pub task: Option<String>,

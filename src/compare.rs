@@ -4,13 +4,20 @@
 //! with their 95% intervals, every pair by the separation rule, the sample-efficiency
 //! curves and the plots (issue 38, item 4).
 //!
-//! Scores are as for sapnet's own runs: a run's **training return** is the mean return of
-//! all its episodes, its **final score** the mean of its last `--last` episodes (in the
-//! report's `test` columns, `tested` = `last-episodes`). Runs of unequal length are each
-//! scored over their own episodes; the curves at an episode are over the runs that reach
-//! it. The bounds that normalise scores (the optimality gap, the profiles) are fixed by
-//! `--range`, else taken from the results folders' task, else from the data, with a
-//! warning: then adding a run can move every normalised score.
+//! Runs are put side by side **by environment step** whenever every run's file says where
+//! its episodes ended (a monitor file's lengths, a step column, an event file's steps, a
+//! results folder's episode lengths), up to `--steps N` or else the steps every run
+//! reached: methods that finish episodes at different rates are read on the same
+//! experience, as sapnet scores a step-budget protocol ([`crate::report::step_axis`]). A
+//! run's **training return** is then its step curve's area, its **final score** the mean
+//! of its last `--last` episodes ended by the budget. Without steps for every run (or with
+//! `--by-episode`) they are put side by side by episode: the training return is the mean
+//! return of all a run's episodes, the final score the mean of its last `--last`; runs of
+//! unequal length are each scored over their own episodes. Either way the final score
+//! stands in the report's `test` columns (`tested` = `last-episodes`). The bounds that
+//! normalise scores (the optimality gap, the profiles) are fixed by `--range`, else taken
+//! from the results folders' task, else from the data, with a warning: then adding a run
+//! can move every normalised score.
 
 use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
@@ -18,10 +25,11 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 
 use crate::cli::CompareArgs;
+use crate::config::Budget;
 use crate::outside_runs::{self, results_folder, OutsideRun, PositionColumn, ReadOptions};
 use crate::report::plots::{Curve, PlotData};
 use crate::report::scored::{ScoredMethod, ScoredRun};
-use crate::report::{self, Report};
+use crate::report::{self, sample_efficiency, step_axis, Report, TrainingEpisodes};
 use crate::reuse::{MethodKind, Tested};
 
 /// One `--method`: its name and the runs read for it.
@@ -65,20 +73,20 @@ pub fn compare(args: &CompareArgs) -> Result<Report> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
 
     let kinds = kinds(methods.len());
+    let (budget, episodes) = alignment(args, &methods)?;
+    let window = args.window as usize;
     let scored: Vec<ScoredMethod> = methods
         .iter()
         .zip(&kinds)
-        .map(|(m, &kind)| ScoredMethod {
+        .zip(&episodes)
+        .map(|((m, &kind), episodes)| ScoredMethod {
             label: m.name.clone(),
             kind,
             runs: m
                 .runs
                 .iter()
-                .map(|r| ScoredRun {
-                    training_return: r.training_return(),
-                    final_score: r.final_score(last),
-                    episodes: r.episodes.len(),
-                })
+                .zip(episodes)
+                .map(|(r, episodes)| score(r, episodes, budget, window, last))
                 .collect(),
         })
         .collect();
@@ -88,14 +96,16 @@ pub fn compare(args: &CompareArgs) -> Result<Report> {
         task: task.clone(),
         subject: None,
         return_range: Some(range),
-        window: args.window as usize,
+        window,
+        budget,
         curves: methods
             .iter()
             .zip(&kinds)
-            .map(|(m, &kind)| Curve {
+            .zip(episodes)
+            .map(|((m, &kind), runs)| Curve {
                 label: m.name.clone(),
                 kind,
-                returns: m.runs.iter().map(|r| r.returns().collect()).collect(),
+                runs,
                 tests: Vec::new(),
             })
             .collect(),
@@ -104,8 +114,105 @@ pub fn compare(args: &CompareArgs) -> Result<Report> {
         acted: Vec::new(),
     };
     report::write_plots(out, &data)?;
-    write_runs(&out.join("runs.csv"), &methods, last)?;
+    write_runs(&out.join("runs.csv"), &methods, &scored)?;
     Ok(report)
+}
+
+/// How the runs are put side by side, and each method's runs as sapnet's own: by step up to
+/// `--steps` or the steps every run reached, when every run says where its episodes ended
+/// (and `--by-episode` does not ask otherwise); else by episode.
+fn alignment(
+    args: &CompareArgs,
+    methods: &[Method],
+) -> Result<(Budget, Vec<Vec<TrainingEpisodes>>)> {
+    let by_step: Option<Vec<Vec<TrainingEpisodes>>> = methods
+        .iter()
+        .map(|m| m.runs.iter().map(OutsideRun::training_episodes).collect())
+        .collect();
+    let most_episodes = methods
+        .iter()
+        .flat_map(|m| &m.runs)
+        .map(|r| r.episodes.len())
+        .max()
+        .unwrap_or(1);
+    let by_episode = || {
+        let runs = methods
+            .iter()
+            .map(|m| {
+                m.runs
+                    .iter()
+                    .map(|r| TrainingEpisodes {
+                        returns: r.returns().collect(),
+                        lengths: r
+                            .episodes
+                            .iter()
+                            .map(|e| e.length.unwrap_or(0) as u32)
+                            .collect(),
+                    })
+                    .collect()
+            })
+            .collect();
+        (Budget::Episodes(most_episodes as u32), runs)
+    };
+    match (by_step, args.by_episode, args.steps) {
+        (_, true, _) => Ok(by_episode()),
+        (Some(runs), false, given) => {
+            let reached = runs
+                .iter()
+                .flatten()
+                .map(|r| r.ends().last().copied().unwrap_or(0))
+                .min()
+                .unwrap_or(0);
+            match given.unwrap_or(reached) {
+                0 => Ok(by_episode()),
+                budget => Ok((Budget::Steps(budget), runs)),
+            }
+        }
+        (None, false, Some(_)) => {
+            let run = methods
+                .iter()
+                .flat_map(|m| &m.runs)
+                .find(|r| r.training_episodes().is_none())
+                .map_or_else(String::new, |r| r.path.display().to_string());
+            bail!(
+                "--steps: expected every run to say where its episodes ended (a step column, \
+                 episode lengths, event files' steps); {run} gives neither"
+            )
+        }
+        (None, false, None) => Ok(by_episode()),
+    }
+}
+
+/// What run `run` scored, read as `episodes` under `budget` (`window` the step curve's
+/// moving average, `last` the episodes of the final score).
+fn score(
+    run: &OutsideRun,
+    episodes: &TrainingEpisodes,
+    budget: Budget,
+    window: usize,
+    last: NonZeroUsize,
+) -> ScoredRun {
+    match budget {
+        Budget::Episodes(_) => ScoredRun {
+            training_return: run.training_return(),
+            final_score: run.final_score(last),
+            episodes: run.episodes.len(),
+            steps: run.steps(),
+        },
+        Budget::Steps(budget) => {
+            let points = step_axis::points(budget, sample_efficiency::POINTS);
+            let curve = step_axis::curve(episodes, window, &points);
+            let ended = episodes.ends().partition_point(|&end| end <= budget);
+            ScoredRun {
+                // Every run has an episode ended by the steps every run reached.
+                training_return: step_axis::area(&curve).unwrap_or(f64::NAN),
+                final_score: step_axis::curve(episodes, last.get(), &[budget])[0]
+                    .unwrap_or(f64::NAN),
+                episodes: ended,
+                steps: Some(budget),
+            }
+        }
+    }
 }
 
 /// The longest method name: a legend's line.
@@ -241,29 +348,36 @@ fn kinds(count: usize) -> Vec<MethodKind> {
         .collect()
 }
 
-/// `runs.csv`: where each run came from and what it scored, one row per run.
-fn write_runs(path: &Path, methods: &[Method], last: NonZeroUsize) -> Result<()> {
+/// `runs.csv`: where each run came from and what it scored (as the report does: on the step
+/// axis when the runs were aligned by step), one row per run.
+fn write_runs(path: &Path, methods: &[Method], scored: &[ScoredMethod]) -> Result<()> {
     let header: Vec<String> = [
-        "method", "run", "path", "format", "series", "axis", "episodes", "return", "final",
+        "method", "run", "path", "format", "series", "axis", "episodes", "steps", "return", "final",
     ]
     .map(String::from)
     .to_vec();
     let records: Vec<Vec<String>> = methods
         .iter()
-        .flat_map(|m| {
-            m.runs.iter().enumerate().map(move |(r, run)| {
-                vec![
-                    m.name.clone(),
-                    r.to_string(),
-                    run.path.to_string_lossy().into_owned(),
-                    format!("{:?}", run.format),
-                    run.series.clone(),
-                    format!("{:?}", run.axis),
-                    run.episodes.len().to_string(),
-                    format!("{:?}", run.training_return()),
-                    format!("{:?}", run.final_score(last)),
-                ]
-            })
+        .zip(scored)
+        .flat_map(|(m, scored)| {
+            m.runs
+                .iter()
+                .zip(&scored.runs)
+                .enumerate()
+                .map(move |(r, (run, score))| {
+                    vec![
+                        m.name.clone(),
+                        r.to_string(),
+                        run.path.to_string_lossy().into_owned(),
+                        format!("{:?}", run.format),
+                        run.series.clone(),
+                        format!("{:?}", run.axis),
+                        score.episodes.to_string(),
+                        score.steps.map_or(String::new(), |s| s.to_string()),
+                        format!("{:?}", score.training_return),
+                        format!("{:?}", score.final_score),
+                    ]
+                })
         })
         .collect();
     report::write_rows(path, &header, &records)

@@ -14,7 +14,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-pub use protocol::ProtocolConfig;
+pub use protocol::{Budget, ProtocolConfig};
 pub use sources::{SourceTaskConfig, SourcesConfig};
 
 use crate::dqn::DqnConfig;
@@ -155,12 +155,11 @@ impl Config {
         said
     }
 
-    /// Cuts the protocol for a smoke run: 1/20 of the episodes, at most 2 runs per method.
+    /// Cuts the protocol for a smoke run: 1/20 of the budget, at most 2 runs per method.
     /// The source library is the real one (a library trained on a cut budget would be
     /// reused by later full runs).
     pub fn quick(&mut self) {
-        self.protocol.episodes = (self.protocol.episodes / 20).max(1);
-        self.protocol.max_steps = self.protocol.max_steps.map(|s| (s / 20).max(1));
+        self.protocol.budget = self.protocol.budget.cut(20);
         self.protocol.runs = self.protocol.runs.min(2);
     }
 
@@ -185,6 +184,44 @@ mod tests {
     use super::*;
     use crate::dqn::Exploration;
     use crate::reuse::Method;
+
+    /// The budget reads as written, and as configs and results folders wrote it before
+    /// there was one; written back, it reads the same.
+    #[test]
+    fn the_budget_reads_in_either_form_and_round_trips() {
+        let read = |text: &str| Config::from_ron(text, "test.ron").map(|c| c.protocol.budget);
+        assert_eq!(
+            read("(protocol: (budget: Steps(1000)))").unwrap(),
+            Budget::Steps(1000)
+        );
+        assert_eq!(
+            read("(protocol: (budget: Episodes(7)))").unwrap(),
+            Budget::Episodes(7)
+        );
+        assert_eq!(
+            read("(protocol: (episodes: 7))").unwrap(),
+            Budget::Episodes(7)
+        );
+        let zoo = "(protocol: (episodes: 100000, max_steps: Some(50000)))";
+        assert_eq!(read(zoo).unwrap(), Budget::Steps(50000));
+        assert_eq!(
+            read("(protocol: (runs: 3))").unwrap(),
+            Budget::Episodes(5000)
+        );
+        let both = read("(protocol: (budget: Steps(10), episodes: 5))")
+            .unwrap_err()
+            .to_string();
+        assert!(both.contains("protocol.budget"), "{both}");
+        for budget in [Budget::Steps(123), Budget::Episodes(45)] {
+            let mut config = Config::default();
+            config.protocol.budget = budget;
+            let ron = crate::ron_file::ron_options().to_string(&config).unwrap();
+            assert_eq!(read(&ron).unwrap(), budget, "{ron}");
+            let json = serde_json::to_string(&config).unwrap();
+            let back: Config = serde_json::from_str(&json).unwrap();
+            assert_eq!(back.protocol.budget, budget, "{json}");
+        }
+    }
 
     #[test]
     fn a_syntax_error_between_fields_names_the_field_around_it() {
@@ -228,7 +265,7 @@ mod tests {
         assert_eq!(c.sapnet.threshold, 1.0);
         assert_eq!(c.sapnet.coefficient, 1.0);
         assert_eq!(c.sapnet.prototypes[0].omega, 0.1);
-        assert_eq!(c.protocol.episodes, 5000);
+        assert_eq!(c.protocol.budget, Budget::Episodes(5000));
         assert_eq!(c.protocol.runs, 5);
         assert_eq!(c.protocol.test_episodes, 5);
         assert_eq!(c.sources.count, 10);

@@ -8,15 +8,68 @@ use crate::limits::{MAX_EPISODES, MAX_HIDDEN_LAYERS, MAX_RUNS, MAX_STEPS, MAX_TE
 use crate::reuse::Method;
 use crate::ron_file::check;
 
+/// How much experience each run of a protocol is given.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Budget {
+    /// Training episodes per run: the paper's protocol (Table I: 5000 CartPole, 10000
+    /// MountainCar). A method whose episodes last longer is given more experience.
+    Episodes(u32),
+    /// Environment steps per run, the episode in progress cut at the budget: the field's
+    /// sample-efficiency protocol (rliable, openrlbenchmark, rl-baselines3-zoo), where
+    /// every method sees the same number of transitions. Scores and curves of such a
+    /// protocol are taken on the environment-step axis ([`crate::report::scores`]).
+    Steps(u64),
+}
+
+impl Budget {
+    /// The episodes a run may run: all it is given, or unbounded under a step budget.
+    pub fn episodes(self) -> u32 {
+        match self {
+            Budget::Episodes(n) => n,
+            Budget::Steps(_) => MAX_EPISODES,
+        }
+    }
+
+    /// The steps a run may take: its budget, or unbounded under an episode budget.
+    pub fn steps(self) -> Option<u64> {
+        match self {
+            Budget::Episodes(_) => None,
+            Budget::Steps(n) => Some(n),
+        }
+    }
+
+    /// What the budget counts, as a column or an axis names it: `episode` or `step`.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Budget::Episodes(_) => "episode",
+            Budget::Steps(_) => "step",
+        }
+    }
+
+    /// `1/divisor` of the budget, at least 1: a smoke run's.
+    pub fn cut(self, divisor: u64) -> Budget {
+        match self {
+            Budget::Episodes(n) => Budget::Episodes((n / divisor as u32).max(1)),
+            Budget::Steps(n) => Budget::Steps((n / divisor).max(1)),
+        }
+    }
+}
+
+impl std::fmt::Display for Budget {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Budget::Episodes(n) => write!(f, "{n} episodes"),
+            Budget::Steps(n) => write!(f, "{n} environment steps"),
+        }
+    }
+}
+
 /// What an experiment runs and how often (paper III-B).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[serde(try_from = "ProtocolFields", into = "ProtocolFields")]
 pub struct ProtocolConfig {
-    /// Training episodes per run (Table I: 5000 CartPole, 10000 MountainCar).
-    pub episodes: u32,
-    /// Also stop a run after this many environment steps, cutting the episode in progress
-    /// (rl-baselines3-zoo budgets in steps). `None`: episodes only.
-    pub max_steps: Option<u64>,
+    /// Each run's budget: `Episodes(5000)` (the paper's) or `Steps(n)`.
+    pub budget: Budget,
     /// Independent runs per method, averaged (paper: 5).
     pub runs: u32,
     /// Greedy test episodes after training (Table I "Number of test": 5).
@@ -39,11 +92,111 @@ impl ProtocolConfig {
     }
 }
 
+/// The `protocol` section as a file writes it: `budget`, or the fields that said it before
+/// there was one (`episodes: N`, with `max_steps: Some(n)` for a step budget), so that
+/// every config and results folder written before still reads.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+struct ProtocolFields {
+    #[serde(
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "bare",
+        deserialize_with = "present"
+    )]
+    budget: Option<Budget>,
+    // Written bare (`episodes: 5000`), as before `budget`.
+    #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "present")]
+    episodes: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    max_steps: Option<u64>,
+    runs: u32,
+    test_episodes: u32,
+    moving_average: usize,
+    thresholds: Option<Vec<f64>>,
+    methods: Vec<Method>,
+}
+
+/// A field present, written bare (`budget: Steps(1000)`, not `Some(…)`), as [`present`]
+/// reads it back.
+fn bare<S: serde::Serializer, T: Serialize>(
+    value: &Option<T>,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    match value {
+        Some(value) => value.serialize(serializer),
+        None => serializer.serialize_none(),
+    }
+}
+
+/// A field written bare (`budget: Steps(1000)`, not `Some(…)`), present.
+fn present<'de, D, T>(deserializer: D) -> Result<Option<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    T::deserialize(deserializer).map(Some)
+}
+
+impl Default for ProtocolFields {
+    /// The defaults, the budget left for [`TryFrom`] to tell from what the file wrote.
+    fn default() -> Self {
+        Self {
+            budget: None,
+            ..ProtocolConfig::default().into()
+        }
+    }
+}
+
+impl TryFrom<ProtocolFields> for ProtocolConfig {
+    type Error = String;
+
+    fn try_from(f: ProtocolFields) -> Result<Self, String> {
+        let budget = match (f.budget, f.episodes, f.max_steps) {
+            (Some(budget), None, None) => budget,
+            (Some(_), _, _) => {
+                return Err(
+                    "field `protocol.budget`: expected the budget once, as `budget: \
+                     Steps(n)` or `budget: Episodes(n)`, got it beside the older `episodes` or \
+                     `max_steps`"
+                        .into(),
+                )
+            }
+            // Before `budget`, a step budget was `max_steps` beside an episode count set
+            // beyond reach.
+            (None, _, Some(steps)) => Budget::Steps(steps),
+            (None, Some(episodes), None) => Budget::Episodes(episodes),
+            (None, None, None) => ProtocolConfig::default().budget,
+        };
+        Ok(Self {
+            budget,
+            runs: f.runs,
+            test_episodes: f.test_episodes,
+            moving_average: f.moving_average,
+            thresholds: f.thresholds,
+            methods: f.methods,
+        })
+    }
+}
+
+impl From<ProtocolConfig> for ProtocolFields {
+    fn from(p: ProtocolConfig) -> Self {
+        Self {
+            budget: Some(p.budget),
+            episodes: None,
+            max_steps: None,
+            runs: p.runs,
+            test_episodes: p.test_episodes,
+            moving_average: p.moving_average,
+            thresholds: p.thresholds,
+            methods: p.methods,
+        }
+    }
+}
+
 impl Default for ProtocolConfig {
     fn default() -> Self {
         Self {
-            episodes: 5000,
-            max_steps: None,
+            budget: Budget::Episodes(5000),
             runs: 5,
             test_episodes: 5,
             moving_average: 10,
@@ -73,12 +226,20 @@ impl ProtocolConfig {
             &format!("1 to {MAX_RUNS}"),
             p.runs,
         )?;
-        check(
-            (1..=MAX_EPISODES).contains(&p.episodes),
-            "protocol.episodes",
-            &format!("1 to {MAX_EPISODES}"),
-            p.episodes,
-        )?;
+        match p.budget {
+            Budget::Episodes(n) => check(
+                (1..=MAX_EPISODES).contains(&n),
+                "protocol.budget",
+                &format!("Episodes(n) with 1 ≤ n ≤ {MAX_EPISODES}"),
+                format!("Episodes({n})"),
+            )?,
+            Budget::Steps(n) => check(
+                (1..=MAX_STEPS).contains(&n),
+                "protocol.budget",
+                &format!("Steps(n) with 1 ≤ n ≤ {MAX_STEPS}"),
+                format!("Steps({n})"),
+            )?,
+        }
         check(
             p.test_episodes <= MAX_TEST_EPISODES,
             "protocol.test_episodes",
@@ -91,14 +252,6 @@ impl ProtocolConfig {
                 "protocol.thresholds",
                 "None or Some([...]) of at most 16 finite returns",
                 format!("{thresholds:?}"),
-            )?;
-        }
-        if let Some(steps) = p.max_steps {
-            check(
-                (1..=MAX_STEPS).contains(&steps),
-                "protocol.max_steps",
-                &format!("None or Some(n) with 1 ≤ n ≤ {MAX_STEPS}"),
-                format!("Some({steps})"),
             )?;
         }
         check(

@@ -67,9 +67,13 @@ pub struct DqnAgent {
     interrupt: Option<Arc<AtomicBool>>,
     /// The teacher whose Q-values every update distils, if any (QDagger).
     teacher: Option<Teacher>,
+    /// The policy whose value the learner estimates, if not its own greedy one: its
+    /// network's greedy action at `s′` is the bootstrap's (GPI's evaluation of a source).
+    evaluated_policy: Option<QNet>,
     /// Reused between updates.
     batch: Batch,
     targets: Vec<f32>,
+    next_actions: Vec<usize>,
 }
 
 /// A teacher network distilled into the learner: `L = L_TD + weight · L_distil` at
@@ -97,9 +101,18 @@ impl DqnAgent {
             measure_td: false,
             interrupt: None,
             teacher: None,
+            evaluated_policy: None,
             batch: Batch::new(),
             targets: Vec::new(),
+            next_actions: Vec::new(),
         })
+    }
+
+    /// From now on the learner estimates the value of `policy`'s greedy policy, not of its
+    /// own: every target bootstraps on `Q_target(s′, argmax_a policy(s′, a))` — TD
+    /// evaluation of a fixed policy (GPI's `Q^{π_i}` on the target task).
+    pub fn evaluate_policy_of(&mut self, policy: QNet) {
+        self.evaluated_policy = Some(policy);
     }
 
     /// The ε-greedy action for `obs` at this policy's current step.
@@ -134,13 +147,38 @@ impl DqnAgent {
         }
     }
 
+    /// One gradient update on a minibatch of `replay`, the target network copied after
+    /// every `target_interval`-th of the learner's updates: a learner that learns without
+    /// acting (GPI's evaluation of a source). Returns the loss; none from an empty buffer.
+    pub fn learn_once(
+        &mut self,
+        replay: &ReplayBuffer,
+        target_interval: u64,
+        rng: &mut impl Rng,
+    ) -> Result<Option<f64>, DqnError> {
+        if replay.len() < self.config.replay_start_size.max(1) {
+            return Ok(None);
+        }
+        let mut batch = std::mem::take(&mut self.batch);
+        replay.sample_into(self.config.batch_size, &mut batch, rng);
+        let result = self.update(&batch);
+        self.batch = batch;
+        let loss = result?;
+        if self.updates.is_multiple_of(target_interval.max(1)) {
+            self.sync_target()?;
+        }
+        Ok(Some(loss))
+    }
+
     /// `updates` gradient updates on minibatches of `replay` without acting (QDagger's
-    /// offline phase), the target network copied every `target_update_interval` of them;
-    /// returns the last loss. A stop ends the round early, its learning kept.
+    /// offline phase), the target network copied every `target_interval` of them (CleanRL's
+    /// `target_network_frequency`); returns the last loss. A stop ends the round early,
+    /// its learning kept.
     pub fn offline_round(
         &mut self,
         replay: &ReplayBuffer,
         updates: u64,
+        target_interval: u64,
         rng: &mut impl Rng,
     ) -> Result<Option<f64>, DqnError> {
         let mut loss = None;
@@ -160,7 +198,7 @@ impl DqnAgent {
             let result = self.update(&batch);
             self.batch = batch;
             loss = Some(result?);
-            if k.is_multiple_of(self.config.target_update_interval) {
+            if k.is_multiple_of(target_interval.max(1)) {
                 self.sync_target()?;
             }
         }
@@ -332,14 +370,24 @@ impl DqnAgent {
         Ok(loss)
     }
 
-    /// `y = r + γ·max_a' Q_target(s', a')` for every transition of `batch`, without the
+    /// `y = r + γ·max_a' Q_target(s', a')` for every transition of `batch` (or, for a
+    /// learner that evaluates another policy, `γ·Q_target(s′, π(s′))`), without the
     /// bootstrap after a terminal state (or a truncation, if `truncation_as_terminal`).
     fn compute_td_targets(&mut self, batch: &Batch, work: &mut Workspace) -> Result<(), DqnError> {
+        if let Some(policy) = &self.evaluated_policy {
+            let q = policy.forward_with(Isa::current(), batch.next_obs(), batch.len(), work)?;
+            self.next_actions.clear();
+            self.next_actions.extend(
+                q.chunks_exact(q.len() / batch.len())
+                    .map(super::q_values::argmax),
+            );
+        }
         let next_q =
             self.target
                 .forward_with(Isa::current(), batch.next_obs(), batch.len(), work)?;
         let gamma = self.config.gamma as f32;
         let truncation_is_terminal = self.config.truncation_as_terminal;
+        let evaluated = self.evaluated_policy.is_some();
         self.targets.clear();
         let rows = next_q.chunks_exact(next_q.len() / batch.len());
         for (b, row) in rows.enumerate() {
@@ -347,6 +395,8 @@ impl DqnAgent {
                 batch.terminated()[b] || (truncation_is_terminal && batch.truncated()[b]);
             let bootstrap = if terminal {
                 0.0
+            } else if evaluated {
+                gamma * row[self.next_actions[b]]
             } else {
                 gamma * row.iter().copied().fold(f32::MIN, f32::max)
             };

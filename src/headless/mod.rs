@@ -49,7 +49,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 
-use crate::config::Config;
+use crate::config::{Budget, Config};
 use crate::env::PythonSettings;
 use crate::experiment::{self, LibraryCopies};
 use crate::folder_lock::FolderLock;
@@ -397,11 +397,11 @@ fn protocol(
         .copy_chosen
         .then(|| LibraryCopies::new(config, out, &options.library.path));
     // A step budget bounds runs in steps, else their episodes do.
-    let (unit, planned) = match config.protocol.max_steps {
-        Some(steps) => (Unit::Steps, steps * plan.specs.len() as u64),
-        None => (
+    let (unit, planned) = match config.protocol.budget {
+        Budget::Steps(steps) => (Unit::Steps, steps * plan.specs.len() as u64),
+        Budget::Episodes(episodes) => (
             Unit::Episodes,
-            plan.specs.iter().map(|s| u64::from(s.episodes)).sum(),
+            u64::from(episodes) * plan.specs.len() as u64,
         ),
     };
     let tensorboard = if options.tensorboard {

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
-use crate::config::Config;
+use crate::config::{Budget, Config};
 use crate::experiment::{policy_info, LibraryCopies};
 use crate::policy_store::{self, PolicyInfo, TrainingBudget};
 use crate::progress::Progress;
@@ -91,14 +91,13 @@ impl Observer for ResultFiles {
             Event::RunStarted {
                 run,
                 method,
-                planned_episodes,
+                budget,
                 ..
             } => {
-                let planned = self
-                    .config
-                    .protocol
-                    .max_steps
-                    .unwrap_or(u64::from(planned_episodes));
+                let planned = match budget {
+                    Budget::Episodes(n) => u64::from(n),
+                    Budget::Steps(n) => n,
+                };
                 if let Some(progress) = &mut self.progress {
                     progress.run_started(method.label(), run, planned);
                 }

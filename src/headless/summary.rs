@@ -71,11 +71,12 @@ pub fn print_comparison(summary: &results::Summary) -> Result<()> {
         .filter(|r| r.record.stopped)
         .map(|r| {
             format!(
-                "{} run {} at episode {}/{}",
+                "{} run {} at episode {} (step {}) of {}",
                 r.record.method.label(),
                 r.record.run,
                 r.record.episodes,
-                summary.config.protocol.episodes
+                r.record.steps,
+                summary.config.protocol.budget
             )
         })
         .collect();

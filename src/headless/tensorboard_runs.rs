@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
-use crate::config::Config;
+use crate::config::{Budget, Config};
 use crate::results::records::run_name;
 use crate::tensorboard::{EventWriter, HParamValue, SessionStatus};
 use crate::trainer::{ActivationSnapshot, EpisodeRecord, MethodId, RunSpec};
@@ -171,8 +171,14 @@ fn hparams(
         // As text: a 64-bit seed does not fit the f64 a number is shown as.
         ("seed", HParamValue::Text(seed)),
         (
-            "episodes",
-            HParamValue::Number(f64::from(config.protocol.episodes)),
+            match config.protocol.budget {
+                Budget::Episodes(_) => "episodes",
+                Budget::Steps(_) => "steps",
+            },
+            HParamValue::Number(match config.protocol.budget {
+                Budget::Episodes(n) => f64::from(n),
+                Budget::Steps(n) => n as f64,
+            }),
         ),
         ("gamma", HParamValue::Number(dqn.gamma)),
         ("learning_rate", HParamValue::Number(dqn.learning_rate)),

@@ -28,10 +28,26 @@ pub struct MethodComparison {
     pub runs: usize,
     /// What its runs hand over to be tested ([`crate::reuse::Tested`]).
     pub tested: &'static str,
+    /// What the thresholds are reached at: `episode`, or `step` under a step budget.
+    pub unit: &'static str,
     /// Per threshold of the moving average (one task only: tasks have their own levels).
     pub thresholds: Vec<ThresholdReached>,
-    /// The training return: mean over episodes, aggregated over runs.
+    /// The training return: mean over episodes (or, under a step budget, the step curve's
+    /// area), aggregated over runs.
     pub training: Option<Aggregates>,
+    /// Under a step budget, the step curve's last point, aggregated over runs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub final_score: Option<Aggregates>,
+    /// What each run was given: its environment steps of training (mean over runs), and
+    /// gradient updates per environment step (over all its runs); `None` for runs of other
+    /// tools.
+    pub env_steps: Option<f64>,
+    pub updates_per_step: Option<f64>,
+    /// For a method with a learner of its own, the share of a run's steps whose action was
+    /// not its learner's greedy action (its exploration, and what the library changed),
+    /// mean over runs with its 95% interval.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub non_greedy_share: Option<Estimate>,
     /// The greedy test score: mean over a run's test episodes, aggregated over runs.
     pub test: Option<Aggregates>,
     /// The sample standard deviation of the runs' test scores.
@@ -66,8 +82,8 @@ pub struct Aggregates {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ThresholdReached {
     pub threshold: f64,
-    /// The median episode at which the moving average first reached the threshold, runs
-    /// that never did counted as beyond their last episode; `None` when half or more never
+    /// The median episode (or step) at which the moving average first reached the
+    /// threshold, runs that never did counted as beyond their end; `None` when half or more never
     /// did. `lo` and `hi` bound it (`hi` is `None` when the interval reaches past the end).
     pub median_episode: Option<f64>,
     pub median_lo: Option<f64>,
@@ -127,13 +143,21 @@ fn measures(m: &MethodRuns, units: Units) -> MethodComparison {
         .as_ref()
         .map(|(raw, _)| raw.pooled())
         .unwrap_or_default();
+    let steps: u64 = m.steps.iter().sum();
     MethodComparison {
         method: m.label.clone(),
         kind: m.kind,
         runs: m.runs,
         tested: m.kind.tested.name(),
+        unit: m.unit,
         thresholds,
         training: aggregates(&m.training, "training"),
+        final_score: aggregates(&m.final_return, "final"),
+        env_steps: (!m.steps.is_empty()).then(|| steps as f64 / m.steps.len() as f64),
+        updates_per_step: (m.updates.len() == m.steps.len() && steps > 0)
+            .then(|| m.updates.iter().sum::<u64>() as f64 / steps as f64),
+        non_greedy_share: Scores::one_task(m.non_greedy.clone())
+            .map(|s| bootstrap::interval(&s, aggregate::mean, seed("non-greedy mean"))),
         test: aggregates(&m.test, "test"),
         test_std: std_dev(&tests),
         source_shares: m.source_shares.clone(),
@@ -218,6 +242,17 @@ fn std_dev(values: &[f64]) -> Option<f64> {
     Some((ss / (values.len() - 1) as f64).sqrt())
 }
 
+/// A count of steps as a table shows it: `950`, `304k`, `1.50M`.
+fn steps_count(steps: f64) -> String {
+    if steps >= 999_500.0 {
+        format!("{:.2}M", steps / 1e6)
+    } else if steps >= 10_000.0 {
+        format!("{:.0}k", steps / 1e3)
+    } else {
+        format!("{steps:.0}")
+    }
+}
+
 fn median(values: &[f64]) -> Option<f64> {
     (!values.is_empty()).then(|| aggregate::median(values))
 }
@@ -228,18 +263,21 @@ fn cell(x: Option<f64>) -> String {
 
 /// The header and the rows of `comparison.csv`. The columns a script looks for are named
 /// `<score>_<aggregate>[_lo|_hi]`: `test_iqm`, `test_iqm_lo`, `return_mean_hi`, … (`return`
-/// is the training return), `units` saying whether they are returns or normalised; per
-/// threshold `episodes_to_<t>` (the censored median) with `_lo`/`_hi`, `reached_<t>` (a
-/// count) and `reached_<t>_share` with `_lo`/`_hi`.
+/// is the training return, `final` under a step budget the curve's last point), `units`
+/// saying whether they are returns or normalised; per threshold `episodes_to_<t>` (or
+/// `steps_to_<t>`: the censored median) with `_lo`/`_hi`, `reached_<t>` (a count) and
+/// `reached_<t>_share` with `_lo`/`_hi`; `env_steps` (per run) and `updates_per_step`, what
+/// each method was given.
 pub fn csv_records(rows: &[MethodComparison], units: Units) -> (Vec<String>, Vec<Vec<String>>) {
     let mut header: Vec<String> = vec!["method".into(), "runs".into(), "tested".into()];
     if let Some(first) = rows.first() {
+        let unit = first.unit;
         for t in &first.thresholds {
             let t = t.threshold;
             header.extend([
-                format!("episodes_to_{t}"),
-                format!("episodes_to_{t}_lo"),
-                format!("episodes_to_{t}_hi"),
+                format!("{unit}s_to_{t}"),
+                format!("{unit}s_to_{t}_lo"),
+                format!("{unit}s_to_{t}_hi"),
                 format!("reached_{t}"),
                 format!("reached_{t}_share"),
                 format!("reached_{t}_share_lo"),
@@ -248,7 +286,13 @@ pub fn csv_records(rows: &[MethodComparison], units: Units) -> (Vec<String>, Vec
         }
     }
     header.push("units".into());
-    for score in ["return", "test"] {
+    let finals = rows.iter().any(|r| r.final_score.is_some());
+    let scores: &[&str] = if finals {
+        &["return", "final", "test"]
+    } else {
+        &["return", "test"]
+    };
+    for score in scores {
         for aggregate in ["mean", "median", "iqm", "optimality_gap"] {
             for end in ["", "_lo", "_hi"] {
                 header.push(format!("{score}_{aggregate}{end}"));
@@ -263,6 +307,11 @@ pub fn csv_records(rows: &[MethodComparison], units: Units) -> (Vec<String>, Vec
             "lock_in_median_step",
             "locked_runs",
             "source_shares",
+            "env_steps",
+            "updates_per_step",
+            "non_greedy_share",
+            "non_greedy_share_lo",
+            "non_greedy_share_hi",
         ]
         .map(String::from),
     );
@@ -283,7 +332,12 @@ pub fn csv_records(rows: &[MethodComparison], units: Units) -> (Vec<String>, Vec
             ]);
         }
         record.push(units.name().into());
-        for score in [&row.training, &row.test] {
+        let scores = if finals {
+            vec![&row.training, &row.final_score, &row.test]
+        } else {
+            vec![&row.training, &row.test]
+        };
+        for score in scores {
             for e in aggregates(score.as_ref()) {
                 record.extend([
                     cell(e.map(|e| e.point)),
@@ -310,6 +364,11 @@ pub fn csv_records(rows: &[MethodComparison], units: Units) -> (Vec<String>, Vec
                 String::new()
             },
             shares.join(" "),
+            cell(row.env_steps),
+            cell(row.updates_per_step),
+            cell(row.non_greedy_share.map(|e| e.point)),
+            cell(row.non_greedy_share.map(|e| e.lo)),
+            cell(row.non_greedy_share.map(|e| e.hi)),
         ]);
         for task in &tasks {
             let share = row.task_shares.iter().find(|(t, _)| t == task);
@@ -352,14 +411,29 @@ pub fn table(rows: &[MethodComparison], units: Units, test_score: TestScore) -> 
     let digits = units.digits();
     let mut header = vec!["method".to_string(), "runs".to_string()];
     if let Some(first) = rows.first() {
+        let arrow = if first.unit == "step" {
+            "steps→"
+        } else {
+            "ep→"
+        };
         for t in &first.thresholds {
-            header.push(format!("ep→{}", t.threshold));
+            header.push(format!("{arrow}{}", t.threshold));
         }
     }
+    let finals = rows.iter().any(|r| r.final_score.is_some());
+    header.push(if finals {
+        "return AUC IQM [95% CI]".to_string()
+    } else {
+        "return IQM [95% CI]".to_string()
+    });
+    if finals {
+        header.push("final IQM [95% CI]".to_string());
+    }
     header.extend([
-        "return IQM [95% CI]".to_string(),
         format!("{} IQM [95% CI]", test_score.short()),
         "tested".to_string(),
+        "steps/run".to_string(),
+        "upd/step".to_string(),
         "ranks".to_string(),
         "lock-in step".to_string(),
     ]);
@@ -376,11 +450,21 @@ pub fn table(rows: &[MethodComparison], units: Units, test_score: TestScore) -> 
                 None => format!("- ({}/{})", t.reached, row.runs),
             });
         }
-        for score in [&row.training, &row.test] {
+        let scores = if finals {
+            vec![&row.training, &row.final_score, &row.test]
+        } else {
+            vec![&row.training, &row.test]
+        };
+        for score in scores {
             line.push(score.map_or("-".into(), |a| interval(&a.iqm, digits)));
         }
         // A test score is the method and its handover rule together: said beside it.
         line.push(row.tested.to_string());
+        line.push(row.env_steps.map_or("-".into(), steps_count));
+        line.push(
+            row.updates_per_step
+                .map_or("-".into(), |u| format!("{u:.2}")),
+        );
         let ranks: Vec<String> = row.ranks.iter().map(ToString::to_string).collect();
         line.push(if ranks.is_empty() {
             "-".into()

@@ -13,8 +13,8 @@ pub mod runs;
 pub mod sample_efficiency;
 pub mod scored;
 pub mod scores;
+pub mod step_axis;
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, Result};
@@ -22,12 +22,11 @@ use anyhow::{Context, Result};
 use crate::config::Config;
 use crate::reuse::{Method, MethodKind};
 use crate::stats::{profile, Estimate, Scores};
-use crate::trainer::MethodId;
 
 pub use comparison::{Aggregates, MethodComparison, ThresholdReached};
 pub use improvement::Improvement;
 pub use plots::{write_all as write_plots, Curve, PlotData, SelectionHistory};
-pub use runs::{moving_average, LibraryEntry, RunSummary};
+pub use runs::{moving_average, LibraryEntry, RunSummary, TrainingEpisodes, TrainingRuns};
 pub use scores::RunScores;
 
 /// Every file a report writes into a results folder (with the CSV files of the runs and
@@ -57,8 +56,8 @@ pub struct TaskRuns<'a> {
     pub config: &'a Config,
     pub library: &'a [LibraryEntry],
     pub runs: &'a [RunSummary],
-    /// Each run's training returns.
-    pub rewards: &'a BTreeMap<(MethodId, u32), Vec<f64>>,
+    /// Each run's training episodes.
+    pub episodes: &'a TrainingRuns,
 }
 
 /// What the aggregates of a report are in.
@@ -155,12 +154,23 @@ pub(crate) struct MethodRuns {
     pub label: String,
     pub kind: MethodKind,
     pub runs: usize,
-    /// Test scores and training returns per task, as (shown, normalised): shown in the
-    /// task's returns on one task, normalised when pooled.
+    /// Test scores, training returns and (step budgets) final returns per task, as (shown,
+    /// normalised): shown in the task's returns on one task, normalised when pooled.
     pub test: Option<(Scores, Scores)>,
     pub training: Option<(Scores, Scores)>,
-    /// Per threshold (one task only): each run's episode of first reaching it, ∞ if never.
+    pub final_return: Option<(Scores, Scores)>,
+    /// What `reached` counts: `episode` or `step` (one task only).
+    pub unit: &'static str,
+    /// Per threshold (one task only): each run's episode (or step) of first reaching it,
+    /// ∞ if never.
     pub reached: Vec<(f64, Vec<f64>)>,
+    /// Each run's environment steps and gradient updates of training; empty for runs of
+    /// other tools, whose updates are not known.
+    pub steps: Vec<u64>,
+    pub updates: Vec<u64>,
+    /// Per run of a method with a learner of its own, the share of its steps whose action
+    /// was not that learner's greedy action.
+    pub non_greedy: Vec<f64>,
     pub source_shares: Vec<f64>,
     pub task_shares: Vec<(String, f64)>,
     pub ranks: Vec<usize>,
@@ -282,17 +292,26 @@ impl Report {
 /// end is left out: its mean return is over fewer episodes and it has no test, so beside
 /// finished runs it would be a different measurement (the closing table lists it apart).
 fn run_scores<'a>(task: &TaskRuns<'a>, label: &str) -> Vec<(&'a RunSummary, RunScores)> {
-    let thresholds = task.config.protocol.thresholds(&task.config.env);
-    let window = task.config.protocol.moving_average;
+    let protocol = &task.config.protocol;
+    let thresholds = protocol.thresholds(&task.config.env);
+    let none = TrainingEpisodes::default();
     task.runs
         .iter()
         .filter(|r| r.record.method.label() == label && !r.record.stopped)
         .map(|r| {
-            let returns = task
-                .rewards
+            let episodes = task
+                .episodes
                 .get(&(r.record.method.clone(), r.record.run))
-                .map_or(&[][..], Vec::as_slice);
-            (r, RunScores::of(r, task.task, returns, &thresholds, window))
+                .unwrap_or(&none);
+            let scores = RunScores::of(
+                r,
+                task.task,
+                episodes,
+                &thresholds,
+                protocol.moving_average,
+                protocol.budget,
+            );
+            (r, scores)
         })
         .collect()
 }
@@ -325,6 +344,7 @@ fn method_runs(
         Some((shown, Scores::per_task(normalised)?))
     };
     let one_task = tasks.len() == 1;
+    let unit = tasks[0].config.protocol.budget.unit();
     let reached = if one_task {
         let thresholds = tasks[0].config.protocol.thresholds(&tasks[0].config.env);
         thresholds
@@ -333,7 +353,7 @@ fn method_runs(
             .map(|(k, &t)| {
                 let episodes = per_task[0]
                     .iter()
-                    .map(|(_, s)| s.reached[k].1.map_or(f64::INFINITY, |e| e as f64))
+                    .map(|(_, s)| s.reached[k].1.map_or(f64::INFINITY, |at| at as f64))
                     .collect();
                 (t, episodes)
             })
@@ -369,7 +389,18 @@ fn method_runs(
         runs: runs.len(),
         test: gather(&|s| s.test),
         training: gather(&|s| s.training_return),
+        final_return: gather(&|s| s.final_return),
+        unit: if one_task { unit } else { "episode" },
         reached,
+        steps: runs.iter().map(|r| r.record.steps).collect(),
+        updates: runs.iter().map(|r| r.record.updates).collect(),
+        non_greedy: runs
+            .iter()
+            .filter_map(|r| {
+                let steps = r.record.steps.max(1) as f64;
+                r.record.non_greedy_steps.map(|n| n as f64 / steps)
+            })
+            .collect(),
         source_shares,
         task_shares,
         ranks,
@@ -431,17 +462,24 @@ pub fn write_rows(path: &Path, header: &[String], records: &[Vec<String>]) -> Re
 
 /// `scores.csv`: one row per run, `method, run, task, test, return, episodes` and, when
 /// every task has the same thresholds, `episodes_to_<t>` per threshold (the episode whose
-/// moving average first reached it; empty if none did: censored at `episodes`).
+/// moving average first reached it; empty if none did: censored at `episodes`). Under a
+/// step budget `return` is the step curve's area, `final` its last point, `steps` and
+/// `updates` what the run was given, and the thresholds are `steps_to_<t>`.
 fn write_scores(path: &Path, scores: &[RunScores]) -> Result<()> {
     let levels = |s: &RunScores| s.reached.iter().map(|(t, _)| *t).collect::<Vec<f64>>();
     let thresholds = match scores.first() {
         Some(first) if scores.iter().all(|s| levels(s) == levels(first)) => levels(first),
         _ => Vec::new(),
     };
+    let steps = scores.iter().any(|s| s.unit == "step");
     let mut header: Vec<String> = ["method", "run", "task", "test", "return", "episodes"]
         .map(String::from)
         .to_vec();
-    header.extend(thresholds.iter().map(|t| format!("episodes_to_{t}")));
+    if steps {
+        header.extend(["final", "steps", "updates"].map(String::from));
+    }
+    let unit = if steps { "steps" } else { "episodes" };
+    header.extend(thresholds.iter().map(|t| format!("{unit}_to_{t}")));
     let records: Vec<Vec<String>> = scores
         .iter()
         .map(|s| {
@@ -454,6 +492,11 @@ fn write_scores(path: &Path, scores: &[RunScores]) -> Result<()> {
                 number(s.training_return),
                 s.episodes.to_string(),
             ];
+            if steps {
+                record.push(number(s.final_return));
+                record.push(s.steps.to_string());
+                record.push(s.updates.to_string());
+            }
             if !thresholds.is_empty() {
                 record.extend(
                     s.reached

@@ -24,6 +24,9 @@ pub struct ScoredRun {
     /// The mean return of its last episodes.
     pub final_score: f64,
     pub episodes: usize,
+    /// The environment steps its episodes took, when the file says (a monitor file's
+    /// lengths, a step column).
+    pub steps: Option<u64>,
 }
 
 impl Report {
@@ -45,7 +48,11 @@ impl Report {
                 task: task.to_string(),
                 test: Some(run.final_score),
                 training_return: Some(run.training_return),
+                final_return: None,
                 episodes: run.episodes,
+                steps: run.steps.unwrap_or(0),
+                updates: 0,
+                unit: "episode",
                 reached: Vec::new(),
             }));
             measured.push(runs);
@@ -77,7 +84,18 @@ fn method_runs(method: &ScoredMethod, range: (f64, f64)) -> Option<MethodRuns> {
         runs: method.runs.len(),
         test: Some(both(|r| r.final_score)?),
         training: Some(both(|r| r.training_return)?),
+        final_return: None,
+        unit: "episode",
         reached: Vec::new(),
+        // What each run was given, where every run's file says (its updates never).
+        steps: method
+            .runs
+            .iter()
+            .map(|r| r.steps)
+            .collect::<Option<Vec<u64>>>()
+            .unwrap_or_default(),
+        updates: Vec::new(),
+        non_greedy: Vec::new(),
         source_shares: Vec::new(),
         task_shares: Vec::new(),
         ranks: Vec::new(),
@@ -112,6 +130,7 @@ mod tests {
                     training_return: r,
                     final_score: 2.0 * r,
                     episodes: 10,
+                    steps: None,
                 })
                 .collect(),
         }

@@ -18,8 +18,7 @@ use super::plot_data;
 use super::records::{self, RunFolder};
 use super::summary::{self, Status, Summary};
 use crate::config::Config;
-use crate::report::{plots, LibraryEntry, Report, TaskRuns};
-use crate::trainer::MethodId;
+use crate::report::{plots, LibraryEntry, Report, TaskRuns, TrainingEpisodes, TrainingRuns};
 
 /// How the protocol ended, for `summary.json`.
 pub struct Ending {
@@ -65,7 +64,7 @@ pub fn assemble(
     }
 
     crate::failpoint::point("csv-assembled");
-    let rewards = rewards(&folders)?;
+    let episodes = training_episodes(&folders)?;
     let mut summary = Summary::new(config, trace);
     summary.status = ending.status;
     summary.error = ending.error;
@@ -79,7 +78,7 @@ pub fn assemble(
         config,
         library: &library,
         runs: &summary.runs,
-        rewards: &rewards,
+        episodes: &episodes,
     }]);
     summary.comparison = report.comparison.clone();
     summary.pairs = report.improvement.clone();
@@ -132,27 +131,25 @@ fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// Each run's training returns, from its own `episodes.csv`.
-pub fn rewards(folders: &[RunFolder]) -> Result<BTreeMap<(MethodId, u32), Vec<f64>>> {
+/// Each run's training episodes, from its own `episodes.csv`.
+pub fn training_episodes(folders: &[RunFolder]) -> Result<TrainingRuns> {
     #[derive(Deserialize)]
     struct Row {
         reward: f64,
+        steps: u32,
     }
-    let mut rewards = BTreeMap::new();
+    let mut runs = BTreeMap::new();
     for folder in folders {
         let path = folder.dir.join("episodes.csv");
         let mut reader = crate::safe_io::csv_reader(&path)
             .with_context(|| format!("reading {}", path.display()))?;
-        let returns = reader
-            .deserialize::<Row>()
-            .enumerate()
-            .map(|(i, row)| {
-                row.map(|r| r.reward)
-                    .with_context(|| format!("{}: row {}", path.display(), i + 2))
-            })
-            .collect::<Result<Vec<f64>>>()?;
+        let mut episodes = TrainingEpisodes::default();
+        for (i, row) in reader.deserialize::<Row>().enumerate() {
+            let row = row.with_context(|| format!("{}: row {}", path.display(), i + 2))?;
+            episodes.push(row.reward, row.steps);
+        }
         let record = &folder.summary.record;
-        rewards.insert((record.method.clone(), record.run), returns);
+        runs.insert((record.method.clone(), record.run), episodes);
     }
-    Ok(rewards)
+    Ok(runs)
 }

@@ -18,9 +18,9 @@ use serde::Deserialize;
 
 use super::records::{self, run_name, RunFolder};
 use super::summary::{read_header, Status};
-use crate::config::Config;
+use crate::config::{Budget, Config};
 use crate::folder_lock::{self, Holder};
-use crate::report::{LibraryEntry, Report, RunSummary, TaskRuns};
+use crate::report::{LibraryEntry, Report, RunSummary, TaskRuns, TrainingEpisodes, TrainingRuns};
 use crate::safe_io::{self, Links};
 use crate::trainer::MethodId;
 
@@ -62,10 +62,10 @@ pub struct RunProgress {
     pub method: MethodId,
     pub run: u32,
     pub status: RunStatus,
-    /// Training returns so far, episode 1 first.
-    pub returns: Vec<f64>,
-    /// The episodes the protocol plans per run.
-    pub planned: u32,
+    /// Training episodes so far, episode 1 first.
+    pub training: TrainingEpisodes,
+    /// The episodes or steps the protocol gives each run.
+    pub planned: Budget,
     /// The source it handed over (a finished run's chosen one), else the one that acted
     /// in most of its episodes so far; `None` for a method that reuses no library.
     pub source: Option<String>,
@@ -75,16 +75,39 @@ pub struct RunProgress {
 
 impl RunProgress {
     pub fn episodes(&self) -> usize {
-        self.returns.len()
+        self.training.len()
     }
 
-    /// Seconds until its planned episodes are done, at its pace so far (a running run
-    /// only).
+    /// Its progress through its budget: episodes done, or steps of its ended episodes.
+    pub fn done(&self) -> u64 {
+        match self.planned {
+            Budget::Episodes(_) => self.episodes() as u64,
+            Budget::Steps(_) => self.training.lengths.iter().map(|&l| u64::from(l)).sum(),
+        }
+    }
+
+    /// Its progress as a table shows it: `312/5000` episodes, or `52k/100k` steps.
+    pub fn progress_text(&self) -> String {
+        match self.planned {
+            Budget::Episodes(n) => format!("{}/{n}", self.episodes()),
+            Budget::Steps(n) => format!("{}/{}", short_count(self.done()), short_count(n)),
+        }
+    }
+
+    /// Its budget in the budget's unit.
+    pub fn planned_amount(&self) -> u64 {
+        match self.planned {
+            Budget::Episodes(n) => u64::from(n),
+            Budget::Steps(n) => n,
+        }
+    }
+
+    /// Seconds until its budget is spent, at its pace so far (a running run only).
     pub fn eta_s(&self) -> Option<f64> {
-        let done = self.episodes();
+        let done = self.done();
         let wall = self.wall_s?;
         (self.status == RunStatus::Running && done > 0)
-            .then(|| wall / done as f64 * (self.planned as f64 - done as f64).max(0.0))
+            .then(|| wall / done as f64 * (self.planned_amount() as f64 - done as f64).max(0.0))
     }
 }
 
@@ -102,10 +125,10 @@ pub struct FolderState {
     pub library: Vec<LibraryEntry>,
     /// Every planned run, by method as the protocol lists them, then run.
     pub runs: Vec<RunProgress>,
-    /// The finished (and stopped) runs' records and training returns: what the report
+    /// The finished (and stopped) runs' records and training episodes: what the report
     /// is computed from.
     finished: Vec<RunSummary>,
-    rewards: BTreeMap<(MethodId, u32), Vec<f64>>,
+    episodes: TrainingRuns,
 }
 
 impl FolderState {
@@ -147,7 +170,7 @@ impl FolderState {
             config: &self.config,
             library: &self.library,
             runs: &self.finished,
-            rewards: &self.rewards,
+            episodes: &self.episodes,
         }])
     }
 }
@@ -156,7 +179,7 @@ impl FolderState {
 /// returns once: a record in `runs/` never changes while its folder is there.
 pub struct FolderReader {
     dir: PathBuf,
-    finished_returns: BTreeMap<(String, u32), Vec<f64>>,
+    finished_returns: BTreeMap<(String, u32), TrainingEpisodes>,
 }
 
 impl FolderReader {
@@ -182,7 +205,7 @@ impl FolderReader {
         let live = writer.is_some();
         let failed = header.status == Some(Status::Failed);
         let mut runs = Vec::new();
-        let mut rewards = BTreeMap::new();
+        let mut episodes = TrainingRuns::new();
         for method in MethodId::all(&config.protocol.methods) {
             for run in 0..config.protocol.runs {
                 let record = folders
@@ -191,15 +214,15 @@ impl FolderReader {
                 let progress = match record {
                     Some(folder) => {
                         let returns = self.finished_returns(folder)?;
-                        rewards.insert((method.clone(), run), returns.clone());
-                        finished_run(&folder.summary, returns, &names, config.protocol.episodes)
+                        episodes.insert((method.clone(), run), returns.clone());
+                        finished_run(&folder.summary, returns, &names, config.protocol.budget)
                     }
                     None => {
                         let partial = records::partial_dir(dir, &run_name(method.label(), run));
-                        let (status, episodes) = match read_partial(&partial)? {
-                            Some(episodes) if live => (RunStatus::Running, episodes),
-                            Some(episodes) if failed => (RunStatus::Failed, episodes),
-                            Some(episodes) => (RunStatus::Stopped, episodes),
+                        let (status, partial) = match read_partial(&partial)? {
+                            Some(partial) if live => (RunStatus::Running, partial),
+                            Some(partial) if failed => (RunStatus::Failed, partial),
+                            Some(partial) => (RunStatus::Stopped, partial),
                             None if live => (RunStatus::Queued, PartialEpisodes::default()),
                             None => (RunStatus::NotRun, PartialEpisodes::default()),
                         };
@@ -207,10 +230,10 @@ impl FolderReader {
                             method: method.clone(),
                             run,
                             status,
-                            source: episodes.most_acting(),
-                            wall_s: episodes.wall_s,
-                            returns: episodes.returns,
-                            planned: config.protocol.episodes,
+                            source: partial.most_acting(),
+                            wall_s: partial.wall_s,
+                            training: partial.training,
+                            planned: config.protocol.budget,
                         }
                     }
                 };
@@ -226,17 +249,17 @@ impl FolderReader {
             library,
             runs,
             finished: folders.into_iter().map(|f| f.summary).collect(),
-            rewards,
+            episodes,
         })
     }
 
-    fn finished_returns(&mut self, folder: &RunFolder) -> Result<Vec<f64>> {
+    fn finished_returns(&mut self, folder: &RunFolder) -> Result<TrainingEpisodes> {
         let record = &folder.summary.record;
         let key = (record.method.label().to_string(), record.run);
         if let Some(returns) = self.finished_returns.get(&key) {
             return Ok(returns.clone());
         }
-        let returns = super::assemble::rewards(std::slice::from_ref(folder))?
+        let returns = super::assemble::training_episodes(std::slice::from_ref(folder))?
             .into_values()
             .next()
             .unwrap_or_default();
@@ -264,18 +287,18 @@ fn shipped(dir: &Path, header: super::SummaryHeader) -> Result<FolderState> {
             runs.push(match listed {
                 Some(summary) => {
                     let returns = shipped
-                        .rewards
+                        .episodes
                         .get(&(method.clone(), run))
                         .cloned()
                         .unwrap_or_default();
-                    finished_run(summary, returns, &names, config.protocol.episodes)
+                    finished_run(summary, returns, &names, config.protocol.budget)
                 }
                 None => RunProgress {
                     method: method.clone(),
                     run,
                     status: RunStatus::NotRun,
-                    returns: Vec::new(),
-                    planned: config.protocol.episodes,
+                    training: TrainingEpisodes::default(),
+                    planned: config.protocol.budget,
                     source: None,
                     wall_s: None,
                 },
@@ -292,15 +315,24 @@ fn shipped(dir: &Path, header: super::SummaryHeader) -> Result<FolderState> {
         library,
         runs,
         finished: shipped.runs,
-        rewards: shipped.rewards,
+        episodes: shipped.episodes,
     })
+}
+
+/// A count as a narrow column shows it: `950`, `52k`, `1.5M`.
+pub fn short_count(n: u64) -> String {
+    match n {
+        0..=9_999 => n.to_string(),
+        10_000..=999_999 => format!("{}k", n / 1000),
+        _ => format!("{:.1}M", n as f64 / 1e6),
+    }
 }
 
 fn finished_run(
     summary: &RunSummary,
-    returns: Vec<f64>,
+    training: TrainingEpisodes,
     names: &[&str],
-    planned: u32,
+    planned: Budget,
 ) -> RunProgress {
     let record = &summary.record;
     let source = match &record.chosen {
@@ -317,7 +349,7 @@ fn finished_run(
         } else {
             RunStatus::Done
         },
-        returns,
+        training,
         planned,
         source,
         wall_s: Some(record.wall_s),
@@ -327,7 +359,7 @@ fn finished_run(
 /// What a run's partial `episodes.csv` says so far.
 #[derive(Debug, Default)]
 struct PartialEpisodes {
-    returns: Vec<f64>,
+    training: TrainingEpisodes,
     /// Per episode, the source that acted most in it (empty in the warm-up, or for a
     /// method without a library).
     policies: Vec<Option<String>>,
@@ -355,6 +387,7 @@ impl PartialEpisodes {
 #[derive(Deserialize)]
 struct PartialRow {
     reward: f64,
+    steps: u32,
     policy: Option<String>,
     wall_s: f64,
 }
@@ -391,7 +424,7 @@ fn read_partial(partial: &Path) -> Result<Option<PartialEpisodes>> {
                 super::files::EPISODES_HEADER.join(", ")
             )
         })?;
-        episodes.returns.push(row.reward);
+        episodes.training.push(row.reward, row.steps);
         episodes.policies.push(row.policy.filter(|p| !p.is_empty()));
         episodes.wall_s = Some(row.wall_s);
     }
@@ -419,7 +452,7 @@ mod tests {
         .unwrap();
         let episodes = read_partial(&partial).unwrap().unwrap();
         assert_eq!(
-            episodes.returns,
+            episodes.training.returns,
             [12.0, 20.0, 31.0, 40.0],
             "the cut row waits"
         );
@@ -431,8 +464,8 @@ mod tests {
             method: MethodId::new(0, &crate::reuse::Method::the_papers()),
             run: 0,
             status: RunStatus::Running,
-            returns: episodes.returns,
-            planned: 10,
+            training: episodes.training,
+            planned: Budget::Episodes(10),
             source: None,
             wall_s: episodes.wall_s,
         };

@@ -14,14 +14,12 @@ pub mod replot;
 pub mod shipped;
 pub mod summary;
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::Result;
 
 use crate::config::Config;
-use crate::report::{LibraryEntry, RunSummary};
-use crate::trainer::MethodId;
+use crate::report::{LibraryEntry, RunSummary, TrainingRuns};
 
 pub use assemble::{assemble, Ending};
 pub use plot_data::read as read_plot_data;
@@ -54,7 +52,7 @@ pub struct Results {
     pub config: Config,
     pub library: Option<Vec<LibraryEntry>>,
     pub runs: Vec<RunSummary>,
-    pub rewards: BTreeMap<(MethodId, u32), Vec<f64>>,
+    pub episodes: TrainingRuns,
 }
 
 /// Reads the results in `dir` from its summary and run records.
@@ -62,11 +60,11 @@ pub fn read_results(dir: &Path) -> Result<Results> {
     let header = read_header(dir)?;
     require_records(dir, &header)?;
     let folders = records::read(dir, &header.config)?;
-    let rewards = assemble::rewards(&folders)?;
+    let episodes = assemble::training_episodes(&folders)?;
     Ok(Results {
         config: header.config,
         library: header.library,
         runs: folders.into_iter().map(|f| f.summary).collect(),
-        rewards,
+        episodes,
     })
 }

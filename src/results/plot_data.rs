@@ -10,6 +10,7 @@ use serde::Deserialize;
 
 use super::summary::read_header;
 use crate::report::plots::{Curve, PlotData, SelectionHistory};
+use crate::report::TrainingEpisodes;
 
 #[derive(Deserialize)]
 struct EpisodeRow {
@@ -17,6 +18,7 @@ struct EpisodeRow {
     method: String,
     episode: u32,
     reward: f64,
+    steps: u32,
 }
 
 #[derive(Deserialize)]
@@ -31,7 +33,7 @@ struct TestRow {
 /// The plots' data, from the files of a results directory.
 pub fn read(dir: &Path) -> Result<PlotData> {
     let config = read_header(dir)?.config;
-    let returns = training_returns(&dir.join("episodes.csv"))?;
+    let episodes = training_episodes(&dir.join("episodes.csv"))?;
     let tests = by_run(
         rows::<TestRow>(&dir.join("tests.csv"))?
             .into_iter()
@@ -48,11 +50,16 @@ pub fn read(dir: &Path) -> Result<PlotData> {
                     .map(|(_, values)| values.clone())
                     .collect()
             };
-            let (runs, tested) = (of(&returns), of(&tests));
+            let runs: Vec<TrainingEpisodes> = episodes
+                .iter()
+                .filter(|((method, _), _)| *method == label)
+                .map(|(_, run)| run.clone())
+                .collect();
+            let tested = of(&tests);
             (!runs.is_empty()).then_some(Curve {
                 label,
                 kind: method.kind,
-                returns: runs,
+                runs,
                 tests: tested,
             })
         })
@@ -94,6 +101,7 @@ pub fn read(dir: &Path) -> Result<PlotData> {
         subject: None,
         return_range: crate::report::plots::return_bounds(&config.env),
         window: config.protocol.moving_average,
+        budget: config.protocol.budget,
         curves,
         policy_names: read.names,
         activations,
@@ -104,13 +112,24 @@ pub fn read(dir: &Path) -> Result<PlotData> {
 /// (method, run) → that run's values in order.
 pub(super) type ByRun = BTreeMap<(String, u32), Vec<f64>>;
 
-/// Each run's training returns from a results folder's `episodes.csv`, in episode order.
-pub(super) fn training_returns(path: &Path) -> Result<ByRun> {
-    Ok(by_run(
-        rows::<EpisodeRow>(path)?
-            .into_iter()
-            .map(|r| (r.method, r.run, r.episode, r.reward)),
-    ))
+/// Each run's training episodes from a results folder's `episodes.csv`, in episode order.
+pub(super) fn training_episodes(path: &Path) -> Result<BTreeMap<(String, u32), TrainingEpisodes>> {
+    let mut keyed: BTreeMap<(String, u32), Vec<EpisodeRow>> = BTreeMap::new();
+    for r in rows::<EpisodeRow>(path)? {
+        keyed.entry((r.method.clone(), r.run)).or_default().push(r);
+    }
+    // Runs side by side interleave their rows.
+    Ok(keyed
+        .into_iter()
+        .map(|(key, mut rows)| {
+            rows.sort_by_key(|r| r.episode);
+            let mut run = TrainingEpisodes::default();
+            for r in rows {
+                run.push(r.reward, r.steps);
+            }
+            (key, run)
+        })
+        .collect())
 }
 
 /// Groups `(method, run, index, value)` rows by run, each run's values in order of their

@@ -49,7 +49,7 @@ pub fn pool(dirs: &[PathBuf], out: &Path) -> Result<Report> {
             config: &results.config,
             library: results.library.as_deref().unwrap_or_default(),
             runs: &results.runs,
-            rewards: &results.rewards,
+            episodes: &results.episodes,
         })
         .collect();
     let report = Report::of(&tasks);

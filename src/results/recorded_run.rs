@@ -67,7 +67,7 @@ pub fn read(folder: &FolderState, method: &MethodId, run: u32) -> Result<Recorde
     let mut events = vec![Event::RunStarted {
         run,
         method: method.clone(),
-        planned_episodes: config.protocol.episodes,
+        budget: config.protocol.budget,
         library: library.map(Box::new),
     }];
     let by_episode: BTreeMap<u32, &ActivationRow> = rows.iter().map(|r| (r.episode, r)).collect();

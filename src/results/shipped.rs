@@ -6,7 +6,6 @@
 //! written; `activations.csv`, if it did not ship, leaves the figures drawn from it as they
 //! were. `sapnet open` reads the same runs ([`runs`]) and writes nothing.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
@@ -14,7 +13,7 @@ use serde::Deserialize;
 
 use super::plot_data;
 use super::summary::{self, Status, Summary, SummaryHeader, MAX_SUMMARY_BYTES};
-use crate::report::{plots, Report, RunSummary, TaskRuns};
+use crate::report::{plots, Report, RunSummary, TaskRuns, TrainingRuns};
 use crate::safe_io::{self, Links};
 use crate::trainer::MethodId;
 
@@ -70,19 +69,19 @@ pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
         };
         runs.push(run.with_method(method.clone()));
     }
-    let rewards = rewards(&dir.join("episodes.csv"), &methods)?;
-    Ok(ShippedRuns { runs, rewards })
+    let episodes = episodes(&dir.join("episodes.csv"), &methods)?;
+    Ok(ShippedRuns { runs, episodes })
 }
 
-/// A shipped folder's runs and their training returns.
+/// A shipped folder's runs and their training episodes.
 pub struct ShippedRuns {
     pub runs: Vec<RunSummary>,
-    pub rewards: BTreeMap<(MethodId, u32), Vec<f64>>,
+    pub episodes: TrainingRuns,
 }
 
 /// Makes `dir`'s report, plots and `summary.json` again from its top-level files.
 pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
-    let ShippedRuns { runs, rewards } = runs(dir, &header)?;
+    let ShippedRuns { runs, episodes } = runs(dir, &header)?;
     let config = header.config;
     let path = dir.join("summary.json");
     let library = header.library.unwrap_or_default();
@@ -92,7 +91,7 @@ pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
         config: &config,
         library: &library,
         runs: &runs,
-        rewards: &rewards,
+        episodes: &episodes,
     }]);
     report.write(dir)?;
     let data = plot_data::read(dir)?;
@@ -110,18 +109,18 @@ pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
     Ok(summary)
 }
 
-/// Each run's training returns from the folder's `episodes.csv`, keyed by its method.
-fn rewards(path: &Path, methods: &[MethodId]) -> Result<BTreeMap<(MethodId, u32), Vec<f64>>> {
-    plot_data::training_returns(path)?
+/// Each run's training episodes from the folder's `episodes.csv`, keyed by its method.
+fn episodes(path: &Path, methods: &[MethodId]) -> Result<TrainingRuns> {
+    plot_data::training_episodes(path)?
         .into_iter()
-        .map(|((label, run), returns)| {
+        .map(|((label, run), episodes)| {
             let Some(method) = methods.iter().find(|m| m.label() == label) else {
                 bail!(
                     "{}: runs of method {label:?}, which the config does not list",
                     path.display()
                 );
             };
-            Ok(((method.clone(), run), returns))
+            Ok(((method.clone(), run), episodes))
         })
         .collect()
 }

@@ -29,6 +29,16 @@ use super::gpi::{check_learner, learner_label};
 use super::{Actor, Combined, Learning, Library, ReuseError, Selector, SelectorView, StateValues};
 use crate::sapnet::SapNetParams;
 
+/// Where A2T's weights over the sources and the base come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Attention {
+    /// A network of the state, learned by the mixture's TD error (the paper's).
+    Learned,
+    /// Fixed and equal, `1/(N + 1)` each, never learned: the control that shows what the
+    /// learned attention adds.
+    Uniform,
+}
+
 /// A2T's knobs (`A2t()` in `protocol.methods`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -37,7 +47,10 @@ pub struct A2tKnobs {
     pub hidden: Vec<usize>,
     /// The attention network's hidden layers.
     pub attention_hidden: Vec<usize>,
-    /// The label of results; default `a2t` (`a2t[64,64]` for another base).
+    /// `Learned` (default) or `Uniform`.
+    pub attention: Attention,
+    /// The label of results; default `a2t` (`a2t-uniform` for uniform attention,
+    /// `a2t[64,64]` for another base).
     pub label: Option<String>,
 }
 
@@ -46,6 +59,7 @@ impl Default for A2tKnobs {
         Self {
             hidden: vec![100],
             attention_hidden: vec![100],
+            attention: Attention::Learned,
             label: None,
         }
     }
@@ -64,7 +78,11 @@ pub const KIND: MethodKind = MethodKind {
 
 impl ReuseMethod for A2tKnobs {
     fn label(&self) -> String {
-        learner_label("a2t", &self.hidden, self.label.as_deref())
+        let label = learner_label("a2t", &self.hidden, self.label.as_deref());
+        match (self.attention, &self.label) {
+            (Attention::Uniform, None) => format!("{label}-uniform"),
+            _ => label,
+        }
     }
 
     fn kind(&self) -> MethodKind {
@@ -76,7 +94,7 @@ impl ReuseMethod for A2tKnobs {
     }
 
     fn attention_hidden(&self) -> Option<&[usize]> {
-        Some(&self.attention_hidden)
+        (self.attention == Attention::Learned).then_some(self.attention_hidden.as_slice())
     }
 
     fn validate(&self, field: &str) -> Result<(), String> {
@@ -94,7 +112,11 @@ impl ReuseMethod for A2tKnobs {
         library: Library<'_>,
         _: &SapNetParams,
     ) -> Result<Box<dyn Selector>, ReuseError> {
-        Ok(Box::new(A2t::new(library.descriptions.len())))
+        let n = library.descriptions.len();
+        Ok(Box::new(match self.attention {
+            Attention::Learned => A2t::new(n),
+            Attention::Uniform => A2t::uniform(n),
+        }))
     }
 }
 
@@ -105,6 +127,8 @@ pub struct A2t {
     latest: Vec<f64>,
     sums: Vec<f64>,
     steps: u64,
+    /// The fixed weights of uniform attention (N + 1 of `1/(N + 1)`); empty when learned.
+    uniform: Vec<f32>,
 }
 
 impl A2t {
@@ -113,6 +137,24 @@ impl A2t {
             latest: vec![0.0; n],
             sums: vec![0.0; n],
             steps: 0,
+            uniform: Vec::new(),
+        }
+    }
+
+    /// With fixed and equal weights over the `n` sources and the base.
+    pub fn uniform(n: usize) -> Self {
+        Self {
+            uniform: vec![1.0 / (n + 1) as f32; n + 1],
+            ..Self::new(n)
+        }
+    }
+
+    /// The weights of the state: the attention's, or the uniform ones.
+    fn weights<'v>(&'v self, values: &StateValues<'v>) -> &'v [f32] {
+        match values.attention {
+            Some(weights) => weights,
+            None if !self.uniform.is_empty() => &self.uniform,
+            None => panic!("A2T's runs have an attention network or uniform weights"),
         }
     }
 }
@@ -147,10 +189,7 @@ impl Selector for A2t {
     }
 
     fn combine(&self, values: &StateValues<'_>) -> Combined {
-        let weights = values
-            .attention
-            .expect("A2T's runs have an attention network");
-        let greedy = choose(weights, values.learner, values.sources);
+        let greedy = choose(self.weights(values), values.learner, values.sources);
         match values.explored {
             Some(action) => Combined { action, ..greedy },
             None => greedy,
@@ -158,13 +197,16 @@ impl Selector for A2t {
     }
 
     fn on_combined(&mut self, values: &StateValues<'_>, _: Combined) {
-        if let Some(weights) = values.attention {
-            for (i, &w) in weights[..self.latest.len()].iter().enumerate() {
-                self.latest[i] = f64::from(w);
-                self.sums[i] += f64::from(w);
-            }
-            self.steps += 1;
+        let n = self.latest.len();
+        let weights: Vec<f64> = self.weights(values)[..n]
+            .iter()
+            .map(|&w| f64::from(w))
+            .collect();
+        for (i, w) in weights.into_iter().enumerate() {
+            self.latest[i] = w;
+            self.sums[i] += w;
         }
+        self.steps += 1;
     }
 
     /// Scores: each source's mean weight over the run; probabilities: its weight at the

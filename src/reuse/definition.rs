@@ -28,6 +28,13 @@ pub trait ReuseMethod {
         None
     }
 
+    /// For a method that acts on its sources' values of the target task (GPI): the target
+    /// copy interval, in updates, of the estimate of each source's value that the run
+    /// trains by TD from the source's own network ([`super::Selector::evaluate`]).
+    fn source_evaluation(&self) -> Option<u64> {
+        None
+    }
+
     /// The ranges of its knobs that serde cannot check; `field` is where it sits in the
     /// config (`protocol.methods[2]`).
     fn validate(&self, _field: &str) -> Result<(), String> {

@@ -1,33 +1,65 @@
 //! Generalized policy improvement (Barreto et al., "Successor Features for Transfer in
 //! Reinforcement Learning", NeurIPS 2017), on a library of DQN policies.
 //!
-//! The sources stay frozen. A learner of the method's own, a fresh DQN, learns from every
-//! step and joins the maximum, as SFQL's new task does: each step acts ε-greedily (the
-//! learner's schedule) on
+//! The sources' policies stay frozen. A learner of the method's own, a fresh DQN, learns
+//! from every step and joins the maximum, as SFQL's new task does: each step acts
+//! ε-greedily (the learner's schedule) on
 //!
 //! ```text
-//! π(s) ∈ argmax_a max( Q_L(s, a), max_i Q_i(s, a) )          (Barreto et al., eq. 10)
+//! π(s) ∈ argmax_a max( Q_L(s, a), max_i Q̂^{π_i}(s, a) )      (Barreto et al., eq. 10)
 //! ```
 //!
 //! and the run hands over that policy, the learner with the library, for its greedy tests.
 //!
+//! GPI's guarantee is on each source's value **on the target task**, `Q^{π_i}`. A DQN
+//! network is neither that nor even its own task's `Q*`: it is a biased estimate, and the
+//! maximum over several picks the most over-estimated (on MountainCar, where every true
+//! value is ≤ 0, sources output thousands). So, as SFQL keeps evaluating its sources on
+//! the new task's data, the run keeps per source a value network `Q̂_i`, initialised from
+//! the source's own and trained by TD on the run's replay with the target's γ,
+//! bootstrapping on the source's (frozen) greedy policy:
+//!
+//! ```text
+//! y = r + γ·Q̂_i⁻(s′, argmax_a Q_i(s′, a))
+//! ```
+//!
+//! by default only the source whose value won the maximum at the step's state, as SFQL
+//! updates the winner's successor features (`evaluate: Winner`), or every source
+//! (`evaluate: All`). `evaluate: Off` takes the networks as they are: the reading before
+//! the evaluation, kept to show what it changes.
+//!
 //! Choices a DQN library forced (docs/BASELINES.md):
-//! - SFQL learns successor features ψ and reward weights w, so its Q_i are `ψ_iᵀw` of the new
-//!   task; a library of Q-networks has only each source's Q of its own task. GPI here takes
-//!   the sources' Q as they are: exact when sources and target share the reward (the
-//!   single-task libraries), an approximation across the variants library.
-//! - The learner's update is DQN's own (`max_a' Q_target(s', a')` of the learner), not
-//!   SFQL's bootstrap on the GPI action at `s'`: the learner is the config's DQN, updated as
-//!   every other method's learner is.
-//! - Ties between Q-values go to the learner, then to the lowest source index.
+//! - SFQL learns successor features ψ and reward weights w; a library of Q-networks holds
+//!   no ψ, so each `Q̂_i` is learned directly, a network of the source's shape;
+//! - the estimates' target copies every `evaluation_target_interval` of their updates
+//!   (100 by default: evaluating a fixed policy has no maximum to over-estimate, and with
+//!   Table I's 10,000 an estimate that wins rarely would bootstrap on its initial
+//!   over-estimate for the whole run);
+//! - the learner's update is DQN's own (`max_a' Q_target(s', a')` of the learner), not
+//!   SFQL's bootstrap on the GPI action at `s'`;
+//! - ties between Q-values go to the learner, then to the lowest source index.
 
 use serde::{Deserialize, Serialize};
 
 use rand::rngs::StdRng;
 
 use super::definition::{check_label, MethodKind, ReuseMethod, Tested};
-use super::{Actor, Combined, Learning, Library, ReuseError, Selector, SelectorView, StateValues};
+use super::{
+    Actor, Combined, Evaluate, Learning, Library, ReuseError, Selector, SelectorView, StateValues,
+};
 use crate::sapnet::SapNetParams;
+
+/// Which sources' values on the target task are estimated, and from which steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Evaluation {
+    /// The source whose value won the maximum at the step's state learns from the step
+    /// (SFQL's update of the winning policy).
+    Winner,
+    /// Every source learns from every step.
+    All,
+    /// None: the sources' networks taken as they are.
+    Off,
+}
 
 /// GPI's knobs (`Gpi()` in `protocol.methods`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -35,7 +67,13 @@ use crate::sapnet::SapNetParams;
 pub struct GpiKnobs {
     /// The learner's hidden layers: the paper's DQN baseline's by default.
     pub hidden: Vec<usize>,
-    /// The label of results; default `gpi`, or `gpi[64,64]` for another learner.
+    /// Which sources' values on the target task are estimated: `Winner` (default), `All`
+    /// or `Off`.
+    pub evaluate: Evaluation,
+    /// The estimates' target copy interval, in their own updates.
+    pub evaluation_target_interval: u64,
+    /// The label of results; default `gpi` (`gpi-all`, `gpi-unevaluated` for the other
+    /// evaluations), or `gpi[64,64]` for another learner.
     pub label: Option<String>,
 }
 
@@ -43,6 +81,8 @@ impl Default for GpiKnobs {
     fn default() -> Self {
         Self {
             hidden: vec![100],
+            evaluate: Evaluation::Winner,
+            evaluation_target_interval: 100,
             label: None,
         }
     }
@@ -61,7 +101,16 @@ pub const KIND: MethodKind = MethodKind {
 
 impl ReuseMethod for GpiKnobs {
     fn label(&self) -> String {
-        learner_label("gpi", &self.hidden, self.label.as_deref())
+        let label = learner_label("gpi", &self.hidden, self.label.as_deref());
+        match (self.evaluate, &self.label) {
+            (Evaluation::All, None) => format!("{label}-all"),
+            (Evaluation::Off, None) => format!("{label}-unevaluated"),
+            _ => label,
+        }
+    }
+
+    fn source_evaluation(&self) -> Option<u64> {
+        (self.evaluate != Evaluation::Off).then_some(self.evaluation_target_interval)
     }
 
     fn kind(&self) -> MethodKind {
@@ -73,6 +122,12 @@ impl ReuseMethod for GpiKnobs {
     }
 
     fn validate(&self, field: &str) -> Result<(), String> {
+        crate::ron_file::check(
+            (1..=crate::limits::MAX_STEPS).contains(&self.evaluation_target_interval),
+            &format!("{field}.evaluation_target_interval"),
+            "at least 1 update",
+            self.evaluation_target_interval,
+        )?;
         check_learner(field, &self.hidden, self.label.as_deref())
     }
 
@@ -81,7 +136,10 @@ impl ReuseMethod for GpiKnobs {
         library: Library<'_>,
         _: &SapNetParams,
     ) -> Result<Box<dyn Selector>, ReuseError> {
-        Ok(Box::new(Gpi::new(library.descriptions.len())))
+        Ok(Box::new(Gpi::new(
+            library.descriptions.len(),
+            self.evaluate,
+        )))
     }
 }
 
@@ -121,12 +179,18 @@ pub(super) fn check_learner(
 pub struct Gpi {
     /// Steps whose action took its Q-value from each source, and from the learner.
     wins: FollowedCounts,
+    evaluation: Evaluation,
+    /// The source whose value won the maximum at the latest step's state, exploring or
+    /// not: the one whose estimate learns from the step under `Winner`.
+    winner: Option<usize>,
 }
 
 impl Gpi {
-    pub fn new(n: usize) -> Self {
+    pub fn new(n: usize, evaluation: Evaluation) -> Self {
         Self {
             wins: FollowedCounts::new(n),
+            evaluation,
+            winner: None,
         }
     }
 }
@@ -184,8 +248,17 @@ impl Selector for Gpi {
         }
     }
 
-    fn on_combined(&mut self, _: &StateValues<'_>, choice: Combined) {
+    fn on_combined(&mut self, values: &StateValues<'_>, choice: Combined) {
         self.wins.count(choice.followed);
+        self.winner = choose(values.learner, values.sources).followed;
+    }
+
+    fn evaluate(&self) -> Evaluate {
+        match (self.evaluation, self.winner) {
+            (Evaluation::Winner, Some(i)) => Evaluate::Source(i),
+            (Evaluation::All, _) => Evaluate::Every,
+            _ => Evaluate::Nobody,
+        }
     }
 
     /// Scores: the steps each source's Q-value won the maximum; probabilities: their share
@@ -282,7 +355,7 @@ mod tests {
 
     #[test]
     fn explores_around_the_maximum_and_counts_whose_value_won() {
-        let mut gpi = Gpi::new(2);
+        let mut gpi = Gpi::new(2, Evaluation::Winner);
         let sources = vec![vec![3.0, 0.5], vec![2.0, 2.5]];
         let values = |explored| StateValues {
             learner: &[1.0, 2.0],
@@ -317,12 +390,19 @@ mod tests {
         assert_eq!(GpiKnobs::default().label(), "gpi");
         let knobs = GpiKnobs {
             hidden: vec![64, 64],
-            label: None,
+            ..GpiKnobs::default()
         };
         assert_eq!(knobs.label(), "gpi[64,64]");
+        let unevaluated = GpiKnobs {
+            evaluate: Evaluation::Off,
+            ..GpiKnobs::default()
+        };
+        assert_eq!(unevaluated.label(), "gpi-unevaluated");
+        assert_eq!(unevaluated.source_evaluation(), None);
+        assert_eq!(GpiKnobs::default().source_evaluation(), Some(100));
         let err = GpiKnobs {
             hidden: vec![],
-            label: None,
+            ..GpiKnobs::default()
         }
         .validate("protocol.methods[3]")
         .unwrap_err();

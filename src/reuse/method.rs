@@ -10,6 +10,7 @@ use super::a2t::A2tKnobs;
 use super::best_source::Oracle;
 use super::definition::{MethodKind, ReuseMethod};
 use super::from_scratch::FromScratch;
+use super::frozen_oracle::FrozenOracle;
 use super::gpi::GpiKnobs;
 use super::prql::PrqlKnobs;
 use super::qdagger::QDaggerKnobs;
@@ -52,6 +53,8 @@ pub enum Method {
     A2t(A2tKnobs),
     /// Fine-tune the library's best source by its recorded score: the selection oracle.
     BestSource,
+    /// The control beside it: that source acting greedily as recorded, never learning.
+    FrozenOracle,
     /// DQN from scratch with these hidden layers (the paper's baselines: `[100]`,
     /// `[100, 100]`, `[100, 100, 100]`).
     Dqn { hidden: Vec<usize> },
@@ -78,6 +81,7 @@ impl Method {
             Self::QDagger(knobs) => Box::new(knobs.clone()),
             Self::A2t(knobs) => Box::new(knobs.clone()),
             Self::BestSource => Box::new(Oracle),
+            Self::FrozenOracle => Box::new(FrozenOracle),
             Self::Dqn { hidden } => Box::new(FromScratch { hidden }),
         }
     }
@@ -94,6 +98,12 @@ impl Method {
     /// The hidden layers of the method's attention network, if it has one.
     pub fn attention_hidden(&self) -> Option<Vec<usize>> {
         self.definition().attention_hidden().map(<[usize]>::to_vec)
+    }
+
+    /// The target copy interval of the method's estimates of its sources' values on the
+    /// target task, if it makes them.
+    pub fn source_evaluation(&self) -> Option<u64> {
+        self.definition().source_evaluation()
     }
 
     /// The hidden layers of the method's own learner, if it has one.

@@ -17,7 +17,8 @@
 //! acts).
 //!
 //! One file per method: [`sapnet`], [`random`], [`ucb1`], [`prql`], [`best_source`],
-//! [`from_scratch`], [`gpi`], [`qswitch`], [`qdagger`], [`a2t`], each defining its [`ReuseMethod`]. Adding one is a new file here, a variant
+//! [`from_scratch`], [`gpi`], [`qswitch`], [`qdagger`], [`a2t`], [`frozen_oracle`], each
+//! defining its [`ReuseMethod`]. Adding one is a new file here, a variant
 //! of [`Method`] and its arm in [`Method::definition`]; the compiler points at the rest.
 
 pub mod a2t;
@@ -25,6 +26,7 @@ pub mod best_source;
 mod definition;
 pub mod exclusion;
 pub mod from_scratch;
+pub mod frozen_oracle;
 pub mod gpi;
 pub mod lock_in;
 mod method;
@@ -104,6 +106,9 @@ pub enum Learning {
     /// A learner of the method's own, a fresh DQN, learns from every step; sources never
     /// learn.
     Learner,
+    /// Nothing learns: the sources act as recorded (a control that shows what learning
+    /// adds to them, or takes away).
+    Frozen,
 }
 
 /// What a method's own learner does with the step just taken ([`Learning::Learner`]).
@@ -114,9 +119,20 @@ pub enum LearnerRound {
     Online,
     /// Nothing: the step only fills the replay buffer (QDagger's teacher phase).
     Wait,
-    /// `updates` updates on the replay buffer as it stands, then a fresh buffer for the
-    /// steps to come (QDagger's offline phase, CleanRL's new buffer for the online one).
-    Offline { updates: u64 },
+    /// `updates` updates on the replay buffer as it stands, the target network copied every
+    /// `target_interval` of them, then a fresh buffer for the steps to come (QDagger's
+    /// offline phase, CleanRL's new buffer for the online one).
+    Offline { updates: u64, target_interval: u64 },
+}
+
+/// Whose value on the target task the step just stored goes to estimate, for a method that
+/// evaluates its sources ([`ReuseMethod::source_evaluation`]): GPI needs each source's
+/// `Q^{π_i}` of the target task, which a network trained on its own task is not.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Evaluate {
+    Nobody,
+    Source(usize),
+    Every,
 }
 
 /// A teacher among the sources whose Q-values the learner distils (QDagger).
@@ -233,6 +249,12 @@ pub trait Selector: Send + fmt::Debug {
     /// What the learner does with the step just taken (after [`act`](Self::act)'s step).
     fn learner_round(&mut self) -> LearnerRound {
         LearnerRound::Online
+    }
+
+    /// Whose value estimate on the target task learns from the step just taken, for a
+    /// method that evaluates its sources.
+    fn evaluate(&self) -> Evaluate {
+        Evaluate::Nobody
     }
 
     /// The teacher the learner distils, and the term's weight now; `None` for a method

@@ -307,13 +307,13 @@ struct SourceTraining<'a> {
 impl Observer for SourceTraining<'_> {
     fn on_event(&mut self, event: Event) -> Result<()> {
         match event {
-            Event::RunStarted {
-                method,
-                planned_episodes,
-                ..
-            } => self
-                .progress
-                .run_started(method.label(), 0, u64::from(planned_episodes)),
+            Event::RunStarted { method, budget, .. } => {
+                let planned = match budget {
+                    crate::config::Budget::Episodes(n) => u64::from(n),
+                    crate::config::Budget::Steps(n) => n,
+                };
+                self.progress.run_started(method.label(), 0, planned)
+            }
             Event::EpisodeEnded(record) => self.progress.episode(&record),
             _ => {}
         }

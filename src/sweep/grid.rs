@@ -88,7 +88,7 @@ impl Grid {
             base.quick();
         }
         if let Some(episodes) = self.episodes {
-            base.protocol.episodes = episodes;
+            base.protocol.budget = crate::config::Budget::Episodes(episodes);
         }
         let mut axes: Vec<(String, Vec<String>)> = self
             .axes

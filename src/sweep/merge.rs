@@ -17,7 +17,6 @@
 //!
 //! Cells not done are named and left out.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, Result};
@@ -25,7 +24,10 @@ use anyhow::{Context, Result};
 use super::{cell_name, cell_results, Manifest};
 use crate::config::Config;
 use crate::report::plots::SweepAxis;
-use crate::report::{self, comparison, improvement, Curve, PlotData, Report, RunSummary, TaskRuns};
+use crate::report::{
+    self, comparison, improvement, Curve, PlotData, Report, RunSummary, TaskRuns, TrainingEpisodes,
+    TrainingRuns,
+};
 use crate::results::{self, Results};
 use crate::reuse::Method;
 use crate::trainer::MethodId;
@@ -242,7 +244,7 @@ pub fn value_report(
             config: &pooled.config,
             library: pooled.library.as_deref().unwrap_or_default(),
             runs: &pooled.runs,
-            rewards: &pooled.rewards,
+            episodes: &pooled.episodes,
         })
         .collect();
     let mut report = Report::of(&tasks);
@@ -340,7 +342,7 @@ fn folder_name(axis: &str, value: &str) -> String {
 
 /// What makes two pooled runs one: the method's label, the run's seed, its training
 /// returns and its test returns.
-type SameRun<'a> = (String, u64, Option<&'a Vec<f64>>, &'a Vec<f64>);
+type SameRun<'a> = (String, u64, Option<&'a TrainingEpisodes>, &'a Vec<f64>);
 
 /// The runs of several cells as one protocol: the methods of all (matched by label, in the
 /// order first met), the runs numbered on from cell to cell.
@@ -358,7 +360,7 @@ fn pool(group: &[&Results]) -> Results {
     let ids = MethodId::all(&config.protocol.methods);
     let id_of = |label: &str| ids.iter().find(|id| id.label() == label).cloned();
     let mut runs = Vec::new();
-    let mut rewards: BTreeMap<(MethodId, u32), Vec<f64>> = BTreeMap::new();
+    let mut episodes = TrainingRuns::new();
     let mut offset = 0;
     // A method the other axes do not touch (DQN in a sweep over `sapnet.temperature`) runs
     // the same in every cell of one seed: one run, counted once, or the pooled runs would
@@ -370,7 +372,7 @@ fn pool(group: &[&Results]) -> Results {
                 continue;
             };
             let returns = results
-                .rewards
+                .episodes
                 .get(&(summary.record.method.clone(), summary.record.run));
             let key = (
                 id.label().to_string(),
@@ -386,7 +388,7 @@ fn pool(group: &[&Results]) -> Results {
             pooled.record.method = id.clone();
             pooled.record.run += offset;
             if let Some(returns) = returns {
-                rewards.insert((id, pooled.record.run), returns.clone());
+                episodes.insert((id, pooled.record.run), returns.clone());
             }
             runs.push(pooled);
         }
@@ -397,7 +399,7 @@ fn pool(group: &[&Results]) -> Results {
         config,
         library: group[0].library.clone(),
         runs,
-        rewards,
+        episodes,
     }
 }
 
@@ -411,14 +413,14 @@ fn plot_data(pooled: &Results, subject: Option<String>) -> PlotData {
                 .iter()
                 .filter(|r| r.record.method == id)
                 .collect();
-            let returns: Vec<Vec<f64>> = mine
+            let runs: Vec<TrainingEpisodes> = mine
                 .iter()
-                .filter_map(|r| pooled.rewards.get(&(id.clone(), r.record.run)).cloned())
+                .filter_map(|r| pooled.episodes.get(&(id.clone(), r.record.run)).cloned())
                 .collect();
-            (!returns.is_empty()).then(|| Curve {
+            (!runs.is_empty()).then(|| Curve {
                 label: id.label().to_string(),
                 kind: id.kind,
-                returns,
+                runs,
                 tests: mine.iter().map(|r| r.record.test_returns.clone()).collect(),
             })
         })
@@ -428,6 +430,7 @@ fn plot_data(pooled: &Results, subject: Option<String>) -> PlotData {
         subject,
         return_range: report::plots::return_bounds(&pooled.config.env),
         window: pooled.config.protocol.moving_average,
+        budget: pooled.config.protocol.budget,
         curves,
         policy_names: Vec::new(),
         activations: Vec::new(),

@@ -92,6 +92,13 @@ pub struct EpisodeRecord {
     pub wall_s: f64,
 }
 
+/// The episode in progress when a step budget ran out, truncated there.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CutEpisode {
+    pub steps: u32,
+    pub reward: f64,
+}
+
 /// The source a reusing run ends with: for SAP-Net the highest activation (Algorithm 3),
 /// for the other selectors what [`crate::reuse::Selector::chosen`] says.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -115,11 +122,24 @@ pub struct RunRecord<M = MethodId> {
     /// The seed of this run's random streams, derived from the config's run seed, the
     /// method's label and the run's index ([`crate::seeds::run_seed`]).
     pub seed: u64,
-    /// Training episodes completed (a step budget may cut a last, partial episode, which is
-    /// not counted; `steps` counts its steps).
+    /// Training episodes completed (a step budget cuts a last, partial episode, which is
+    /// not counted: `cut_episode` keeps it, `steps` counts its steps).
     pub episodes: u32,
+    /// Environment steps of training (the greedy tests' not counted).
     pub steps: u64,
+    /// Gradient updates of every network the method trains (each source's copy, its
+    /// learner, an attention, a value estimate), so that `updates / steps` says how much
+    /// computation per transition a method was given.
     pub updates: u64,
+    /// The episode a step budget truncated, if it cut one mid-way: its steps and its
+    /// return so far. Not one of `episodes`: a partial return is not a score.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cut_episode: Option<CutEpisode>,
+    /// For a method with a learner of its own: the steps whose action was not that
+    /// learner's greedy action at the state (its exploration, and whatever the library
+    /// changed of its behaviour).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub non_greedy_steps: Option<u64>,
     /// The chosen source, whose greedy returns `test_returns` are (`None` when the run's
     /// result is a learner of its own: DQN, PRQ-learning).
     pub chosen: Option<ChosenPolicy>,
@@ -158,6 +178,8 @@ impl<M> RunRecord<M> {
             episodes: 0,
             steps: 0,
             updates: 0,
+            cut_episode: None,
+            non_greedy_steps: None,
             chosen: None,
             source_steps: Vec::new(),
             lock_in_step: None,
@@ -182,6 +204,8 @@ impl RunRecord<String> {
             episodes,
             steps,
             updates,
+            cut_episode,
+            non_greedy_steps,
             chosen,
             source_steps,
             lock_in_step,
@@ -196,6 +220,8 @@ impl RunRecord<String> {
         record.episodes = episodes;
         record.steps = steps;
         record.updates = updates;
+        record.cut_episode = cut_episode;
+        record.non_greedy_steps = non_greedy_steps;
         record.chosen = chosen;
         record.source_steps = source_steps;
         record.lock_in_step = lock_in_step;
@@ -309,7 +335,8 @@ pub enum Event {
     RunStarted {
         run: u32,
         method: MethodId,
-        planned_episodes: u32,
+        /// Episodes or environment steps the run is given.
+        budget: crate::config::Budget,
         /// Present for runs that reuse the library.
         library: Option<Box<LibraryStart>>,
     },

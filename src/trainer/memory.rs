@@ -4,6 +4,7 @@
 
 use anyhow::{bail, Result};
 
+use crate::config::Budget;
 use crate::dqn::Architecture;
 use crate::trainer::RunSpec;
 
@@ -49,14 +50,13 @@ pub fn run_bytes(spec: &RunSpec) -> Result<f64, crate::env::EnvError> {
         ),
     };
     // A Gymnasium task's time limit may be unknown here: the replay's capacity bounds it.
-    let steps = spec.max_steps.map_or_else(
-        || {
-            spec.env
-                .max_episode_steps()
-                .map_or(f64::INFINITY, |t| f64::from(spec.episodes) * f64::from(t))
-        },
-        |s| s as f64,
-    );
+    let steps = match spec.budget {
+        Budget::Steps(s) => s as f64,
+        Budget::Episodes(n) => spec
+            .env
+            .max_episode_steps()
+            .map_or(f64::INFINITY, |t| f64::from(n) * f64::from(t)),
+    };
     let replay = (learners * spec.dqn.replay_capacity as f64).min(steps) * transition_bytes(obs);
     Ok(networks + replay)
 }

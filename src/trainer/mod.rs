@@ -20,8 +20,9 @@ use std::sync::Arc;
 use std::thread::{self, JoinHandle};
 
 pub use events::{
-    ActivationSnapshot, ChosenPolicy, Command, Deposit, EpisodeRecord, Event, LibraryStart, LockIn,
-    MethodId, RunRecord, SourceSummary, StepRecord, StreamOptions, TraceRecord,
+    ActivationSnapshot, ChosenPolicy, Command, CutEpisode, Deposit, EpisodeRecord, Event,
+    LibraryStart, LockIn, MethodId, RunRecord, SourceSummary, StepRecord, StreamOptions,
+    TraceRecord,
 };
 pub use run::train;
 pub use run_state::{test_greedy, LOCK_IN};

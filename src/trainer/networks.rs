@@ -1,5 +1,7 @@
 //! The Q-networks of a run: the sources as recorded, a copy of each fine-tuned as a
-//! learner of its own (when sources learn), and the method's own learner (when it has one).
+//! learner of its own (when sources learn), the method's own learner (when it has one), an
+//! attention over them (A2T), and an estimate of each source's value on the target task
+//! (GPI's evaluation).
 
 use rand::rngs::StdRng;
 use rand::SeedableRng;
@@ -8,7 +10,7 @@ use super::spec::{RunSpec, SourcePolicy};
 use super::CommandReceiver;
 use crate::dqn::{Architecture, AttentionLearner, DqnAgent, DqnError, QNet, ReplayBuffer};
 use crate::env::Environment;
-use crate::reuse::{Actor, Combined, Learning, Selector, StateValues};
+use crate::reuse::{Actor, Combined, Evaluate, Learning, Selector, StateValues};
 
 pub(super) struct RunNetworks<'a> {
     sources: &'a [SourcePolicy],
@@ -16,8 +18,26 @@ pub(super) struct RunNetworks<'a> {
     learner: Option<DqnAgent>,
     /// The attention over the sources and the learner, for a method that has one (A2T).
     attention: Option<AttentionLearner>,
+    /// Per source, the estimate of its greedy policy's value on the target task, for a
+    /// method that evaluates its sources (GPI), and its target copy interval in updates.
+    evaluators: Vec<DqnAgent>,
+    evaluation_interval: u64,
     /// The Q-values a combining method chooses from, kept between steps.
     values: ValueBuffers,
+    /// Steps whose action was not the method's own learner's greedy action at the state:
+    /// its exploration, and what the library changed of its behaviour.
+    non_greedy: u64,
+}
+
+/// The networks a combining method's choice reads.
+#[derive(Clone, Copy)]
+pub(super) struct Combining<'a> {
+    pub learner: &'a QNet,
+    pub sources: &'a [SourcePolicy],
+    /// Each source's value estimated on the target task, taking the place of its recorded
+    /// Q-values; empty for a method that takes the sources as recorded.
+    pub evaluated: &'a [DqnAgent],
+    pub attention: Option<&'a AttentionLearner>,
 }
 
 /// Every network's Q-values of one state, in buffers kept between steps.
@@ -29,33 +49,37 @@ pub(super) struct ValueBuffers {
 }
 
 impl ValueBuffers {
-    /// The choice `selector` makes from `learner`'s and the (frozen) `sources`' Q-values of
-    /// `obs` (and `attention`'s weights, if the method has one), with `explored` the
-    /// learner's exploring action, if its coin fell on one; `selector` hears it when
-    /// `acting`.
-    #[allow(clippy::too_many_arguments)]
+    /// The choice `selector` makes from the `networks`' Q-values of `obs` (the learner's,
+    /// the sources' as recorded or as evaluated, and the attention's weights, if the method
+    /// has one), with `explored` the learner's exploring action, if its coin fell on one;
+    /// `selector` hears it when `acting`.
     pub fn combine(
         &mut self,
         selector: &mut dyn Selector,
         acting: bool,
-        learner: &QNet,
-        sources: &[SourcePolicy],
-        attention: Option<&AttentionLearner>,
+        networks: Combining<'_>,
         obs: &[f32],
         explored: Option<usize>,
     ) -> Result<Combined, DqnError> {
+        let Combining {
+            learner,
+            sources,
+            evaluated,
+            attention,
+        } = networks;
         self.learner = learner.q_values(obs)?;
         self.sources.resize_with(sources.len(), Vec::new);
         // A2T's attention keeps the sources' values of the state the last step led to.
         let kept = attention.and_then(|a| a.kept_source_values(obs));
         let actions = self.learner.len();
         for (i, (values, source)) in self.sources.iter_mut().zip(sources).enumerate() {
-            match kept {
-                Some(kept) => {
+            match (kept, evaluated.get(i)) {
+                (Some(kept), _) => {
                     values.clear();
                     values.extend_from_slice(&kept[i * actions..(i + 1) * actions]);
                 }
-                None => *values = source.acting().q_values(obs)?,
+                (None, Some(evaluator)) => *values = evaluator.online().q_values(obs)?,
+                (None, None) => *values = source.acting().q_values(obs)?,
             }
         }
         if let Some(attention) = attention {
@@ -93,7 +117,7 @@ impl<'a> RunNetworks<'a> {
                 .iter()
                 .map(|s| DqnAgent::new(s.net.deep_copy()?, &spec.dqn))
                 .collect::<Result<Vec<_>, _>>()?,
-            Learning::Learner => Vec::new(),
+            Learning::Learner | Learning::Frozen => Vec::new(),
         };
         for agent in &mut agents {
             agent.measure_td_error(td_error);
@@ -130,13 +154,60 @@ impl<'a> RunNetworks<'a> {
             }
             None => None,
         };
+        let evaluation_interval = spec.reuse.source_evaluation();
+        let mut evaluators = Vec::new();
+        if evaluation_interval.is_some() {
+            for source in spec.sources.iter() {
+                // Starts from what the source believes of its own task, and learns what its
+                // policy is worth on this one, with this task's γ.
+                let mut evaluator = DqnAgent::new(source.net.deep_copy()?, &spec.dqn)?;
+                evaluator.evaluate_policy_of(source.net.deep_copy()?);
+                evaluator.interrupt_rounds_with(commands.stop_flag());
+                evaluators.push(evaluator);
+            }
+        }
         Ok(Self {
             sources: &spec.sources,
             agents,
             learner,
             attention,
+            evaluators,
+            evaluation_interval: evaluation_interval.unwrap_or(1),
             values: ValueBuffers::default(),
+            non_greedy: 0,
         })
+    }
+
+    /// The networks a combining choice reads, with `learner` the method's own.
+    pub fn combining<'b>(&'b self, learner: &'b QNet) -> Combining<'b> {
+        Combining {
+            learner,
+            sources: self.sources,
+            evaluated: &self.evaluators,
+            attention: self.attention.as_ref(),
+        }
+    }
+
+    /// The round of the sources' value estimates on the step just stored in `replay`:
+    /// those `which` names learn once each.
+    pub fn observe_evaluators(
+        &mut self,
+        which: Evaluate,
+        replay: &ReplayBuffer,
+        rng: &mut StdRng,
+    ) -> Result<(), DqnError> {
+        let interval = self.evaluation_interval;
+        match which {
+            Evaluate::Nobody => Ok(()),
+            Evaluate::Source(i) => match self.evaluators.get_mut(i) {
+                Some(evaluator) => evaluator.learn_once(replay, interval, rng).map(drop),
+                None => Ok(()),
+            },
+            Evaluate::Every => self
+                .evaluators
+                .iter_mut()
+                .try_for_each(|e| e.learn_once(replay, interval, rng).map(drop)),
+        }
     }
 
     /// The action of `actor` on `obs`, and the source it followed; `selector` makes the
@@ -155,17 +226,40 @@ impl<'a> RunNetworks<'a> {
         match actor {
             Actor::Source(i) => self.agents[i].act(obs, rng).map(own),
             Actor::SourceGreedy(i) => self.sources[i].acting().greedy_action(obs).map(own),
-            Actor::Learner => self.learner().act(obs, rng).map(own),
+            Actor::Learner => {
+                // DQN's ε-greedy choice, its coin drawn apart to see whether it explored;
+                // the greedy action is looked up then only (the same draws as `act`).
+                let learner = self.learner();
+                let action = match learner.explore(rng) {
+                    Some(explored) => {
+                        if explored != learner.greedy_action(obs)? {
+                            self.non_greedy += 1;
+                        }
+                        explored
+                    }
+                    None => learner.greedy_action(obs)?,
+                };
+                Ok(own(action))
+            }
             Actor::Combined => {
                 let learner = self
                     .learner
                     .as_ref()
                     .expect("a method that combines has a learner");
                 let explored = learner.explore(rng);
-                let net = learner.online();
-                let attention = self.attention.as_ref();
-                self.values
-                    .combine(selector, true, net, self.sources, attention, obs, explored)
+                let networks = Combining {
+                    learner: learner.online(),
+                    sources: self.sources,
+                    evaluated: &self.evaluators,
+                    attention: self.attention.as_ref(),
+                };
+                let choice = self
+                    .values
+                    .combine(selector, true, networks, obs, explored)?;
+                if choice.action != crate::reuse::argmax_f32(&self.values.learner) {
+                    self.non_greedy += 1;
+                }
+                Ok(choice)
             }
         }
     }
@@ -217,11 +311,6 @@ impl<'a> RunNetworks<'a> {
         Ok(())
     }
 
-    /// The attention network, for a method that has one.
-    pub fn attention(&self) -> Option<&AttentionLearner> {
-        self.attention.as_ref()
-    }
-
     /// The learning copy of source `source`, or the method's own learner for `None`.
     pub fn agent(&self, source: Option<usize>) -> &DqnAgent {
         match source {
@@ -237,16 +326,18 @@ impl<'a> RunNetworks<'a> {
         }
     }
 
-    /// The online network of [`agent`](Self::agent)`(source)`, taken out of the run.
-    pub fn take_net(&mut self, source: Option<usize>) -> QNet {
-        match source {
+    /// The online network of [`agent`](Self::agent)`(source)`, taken out of the run: a
+    /// copy of the source as recorded when sources do not learn.
+    pub fn take_net(&mut self, source: Option<usize>) -> Result<QNet, DqnError> {
+        Ok(match source {
+            Some(i) if self.agents.is_empty() => self.sources[i].net.deep_copy()?,
             Some(i) => self.agents.swap_remove(i).into_online(),
             None => self
                 .learner
                 .take()
                 .expect("a method that ends with no source has a learner")
                 .into_online(),
-        }
+        })
     }
 
     fn learner(&self) -> &DqnAgent {
@@ -255,9 +346,16 @@ impl<'a> RunNetworks<'a> {
             .expect("a method whose selector picks its learner has one")
     }
 
+    /// Steps whose action was not the method's own learner's greedy action, for a method
+    /// with a learner.
+    pub fn non_greedy_steps(&self) -> Option<u64> {
+        self.learner.as_ref().map(|_| self.non_greedy)
+    }
+
     pub fn updates(&self) -> u64 {
         let own = self.learner.as_ref().map_or(0, DqnAgent::updates)
-            + self.attention.as_ref().map_or(0, AttentionLearner::updates);
+            + self.attention.as_ref().map_or(0, AttentionLearner::updates)
+            + self.evaluators.iter().map(DqnAgent::updates).sum::<u64>();
         self.agents.iter().map(DqnAgent::updates).sum::<u64>() + own
     }
 }

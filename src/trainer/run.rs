@@ -31,8 +31,8 @@ use super::run_state::{EpisodeReturn, Run};
 use super::spec::RunSpec;
 use super::{CommandReceiver, RunOutcome, TrainerError};
 
-/// Trains `spec` for its episodes (or `spec.max_steps` steps, whichever comes first), then
-/// tests the result greedily: the chosen source, or the method's own learner. Sends the
+/// Trains `spec` for its budget of episodes or environment steps, then tests the result
+/// greedily: the chosen source, or the method's own learner. Sends the
 /// events of `spec.stream` and obeys `commands` (see [`Command`]); a [`Command::Stop`] (or
 /// a closed command channel) ends training early, and the run is then reported as
 /// stopped, untested.
@@ -47,12 +47,17 @@ pub fn train(
     commands: &CommandReceiver,
 ) -> Result<RunOutcome, TrainerError> {
     let mut run = Run::start(spec, events, commands)?;
-    let step_budget = spec.max_steps.unwrap_or(u64::MAX);
-    'episodes: for episode in 1..=spec.episodes {
+    let step_budget = spec.budget.steps().unwrap_or(u64::MAX);
+    'episodes: for episode in 1..=spec.budget.episodes() {
         let mut sums = EpisodeReturn::new();
         loop {
-            // A budget spent mid-episode leaves that episode uncounted: it never ends.
-            if run.steps() >= step_budget || !run.may_step() {
+            if run.steps() >= step_budget {
+                // The budget truncates the episode in progress: it never ends, so neither
+                // the selector nor the curve hears a return cut short; the record keeps it.
+                run.cut_episode(&sums);
+                break 'episodes;
+            }
+            if !run.may_step() {
                 break 'episodes;
             }
             let step = run.step(episode)?;

@@ -9,8 +9,8 @@ use rand::SeedableRng;
 
 use super::control::{Control, Next};
 use super::events::{
-    ActivationSnapshot, ChosenPolicy, EpisodeRecord, Event, LibraryStart, LockIn, RunRecord,
-    SourceSummary, StepRecord, TraceRecord,
+    ActivationSnapshot, ChosenPolicy, CutEpisode, EpisodeRecord, Event, LibraryStart, LockIn,
+    RunRecord, SourceSummary, StepRecord, TraceRecord,
 };
 use super::networks::{RunNetworks, ValueBuffers};
 use super::spec::{selector, RunSpec};
@@ -195,13 +195,13 @@ impl<'a> Run<'a> {
         let _ = events.send(Event::RunStarted {
             run: spec.run,
             method: spec.method.clone(),
-            planned_episodes: spec.episodes,
+            budget: spec.budget,
             library: library_start(spec, selector.as_ref()),
         });
         let replay_start = spec.dqn.replay_start_size as u64;
         let warm_up = match learning {
             Learning::ActingSource => n as u64 * replay_start,
-            Learning::Learner => 0,
+            Learning::Learner | Learning::Frozen => 0,
         };
         let last_snapshot = Instant::now();
         let obs = env.reset(Some(seeds.env))?.to_vec();
@@ -325,15 +325,16 @@ impl<'a> Run<'a> {
         if let Some(i) = followed {
             self.tally.count(i);
         }
-        let learner = match self.learning {
-            Learning::ActingSource => {
-                Some(actor.source().expect("sources learn only when they act"))
+        let (learner, round) = match self.learning {
+            Learning::ActingSource => (
+                Some(actor.source().expect("sources learn only when they act")),
+                LearnerRound::Online,
+            ),
+            Learning::Learner => (None, self.selector.learner_round()),
+            Learning::Frozen => {
+                self.selector.on_step();
+                return Ok(Learned::default());
             }
-            Learning::Learner => None,
-        };
-        let round = match self.learning {
-            Learning::ActingSource => LearnerRound::Online,
-            Learning::Learner => self.selector.learner_round(),
         };
         if let Some(distillation) = self.selector.distillation() {
             self.networks
@@ -342,16 +343,28 @@ impl<'a> Run<'a> {
         }
         let agent = self.networks.agent_mut(learner);
         let result = match round {
-            LearnerRound::Online => agent
-                .observe(&self.replay, &mut self.rng)
-                .and_then(|report| {
-                    self.networks
-                        .observe_attention(&self.replay, &mut self.rng)
-                        .map(|()| report)
-                }),
+            LearnerRound::Online => {
+                let evaluate = self.selector.evaluate();
+                agent
+                    .observe(&self.replay, &mut self.rng)
+                    .and_then(|report| {
+                        self.networks
+                            .observe_attention(&self.replay, &mut self.rng)
+                            .map(|()| report)
+                    })
+                    .and_then(|report| {
+                        self.networks
+                            .observe_evaluators(evaluate, &self.replay, &mut self.rng)
+                            .map(|()| report)
+                    })
+            }
             LearnerRound::Wait => Ok(None),
-            LearnerRound::Offline { updates } => {
-                let offline = agent.offline_round(&self.replay, updates, &mut self.rng);
+            LearnerRound::Offline {
+                updates,
+                target_interval,
+            } => {
+                let offline =
+                    agent.offline_round(&self.replay, updates, target_interval, &mut self.rng);
                 // The online phase learns from a buffer of its own (CleanRL's).
                 self.replay = ReplayBuffer::new(self.replay.capacity(), self.replay.obs_size());
                 offline.map(|_| None)
@@ -409,8 +422,22 @@ impl<'a> Run<'a> {
             source: error,
             episodes: self.record.episodes,
             steps: self.steps,
-            last_good: self.networks.take_net(learner),
+            last_good: match self.networks.take_net(learner) {
+                Ok(net) => net,
+                Err(error) => return TrainerError::Dqn(error),
+            },
         }))
+    }
+
+    /// The step budget ran out in the episode in progress, `sums` so far: the record keeps
+    /// it as truncated there (its steps are already in the run's).
+    pub fn cut_episode(&mut self, sums: &EpisodeReturn) {
+        if sums.steps > 0 {
+            self.record.cut_episode = Some(CutEpisode {
+                steps: sums.steps,
+                reward: sums.reward,
+            });
+        }
     }
 
     /// Episode `episode` ended with `sums`: the selector hears it, and the front ends.
@@ -425,19 +452,21 @@ impl<'a> Run<'a> {
         if self.snapshots {
             self.send_snapshot(episode);
         }
-        let shown = self.networks.agent(match self.learning {
-            Learning::ActingSource => Some(self.last_source),
-            Learning::Learner => None,
-        });
+        let shown = match self.learning {
+            Learning::ActingSource => Some(self.networks.agent(Some(self.last_source))),
+            Learning::Learner => Some(self.networks.agent(None)),
+            Learning::Frozen => None,
+        };
         let _ = self.events.send(Event::EpisodeEnded(EpisodeRecord {
             run: self.spec.run,
             method: self.spec.method.clone(),
             episode,
             reward: sums.reward,
             steps: sums.steps,
-            loss: shown.last_loss(),
-            statistic_loss: shown.statistic_loss(),
-            epsilon: shown.epsilon(),
+            loss: shown.and_then(|a| a.last_loss()),
+            statistic_loss: shown.map_or(0.0, |a| a.statistic_loss()),
+            // Frozen sources act greedily: no exploration.
+            epsilon: shown.map_or(0.0, |a| a.epsilon()),
             policy: if self.snapshots {
                 self.tally.end_episode()
             } else {
@@ -454,6 +483,7 @@ impl<'a> Run<'a> {
         let mut record = self.record;
         record.steps = self.steps;
         record.updates = self.networks.updates();
+        record.non_greedy_steps = self.networks.non_greedy_steps();
         record.source_steps = self.tally.run;
         let view = self.selector.view();
         (record.positive, record.negative) = (view.positive.clone(), view.negative.clone());
@@ -466,7 +496,7 @@ impl<'a> Run<'a> {
             score: view.scores[chosen],
             score_name: view.score_name.into(),
         });
-        let net = self.networks.take_net(chosen);
+        let net = self.networks.take_net(chosen)?;
         if !record.stopped {
             let mut test_env = env::make(&spec.env)?;
             let (episodes, seed) = (spec.test_episodes, self.seeds.test_env);
@@ -474,17 +504,9 @@ impl<'a> Run<'a> {
                 // The learner with the library, as the method acts greedily.
                 let mut values = ValueBuffers::default();
                 let selector = self.selector.as_mut();
-                let attention = self.networks.attention();
+                let networks = self.networks.combining(&net);
                 let greedy = |obs: &[f32]| {
-                    let choice = values.combine(
-                        selector,
-                        false,
-                        &net,
-                        &spec.sources,
-                        attention,
-                        obs,
-                        None,
-                    )?;
+                    let choice = values.combine(selector, false, networks, obs, None)?;
                     Ok(choice.action)
                 };
                 test_policy(greedy, test_env.as_mut(), episodes, seed)?

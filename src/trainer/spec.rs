@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use super::events::{MethodId, StreamOptions};
 use super::TrainerError;
+use crate::config::Budget;
 use crate::dqn::{DqnConfig, DqnError, FrozenNet, QNet};
 use crate::env::EnvConfig;
 use crate::reuse::{self, Method};
@@ -60,9 +61,8 @@ pub struct RunSpec {
     pub sapnet: SapNetParams,
     /// The library a reusing method draws on (empty for DQN from scratch).
     pub sources: Arc<Vec<SourcePolicy>>,
-    pub episodes: u32,
-    /// Stop after this many steps even within an episode.
-    pub max_steps: Option<u64>,
+    /// Episodes, or environment steps, the run is given.
+    pub budget: Budget,
     pub test_episodes: u32,
     pub seed: u64,
     pub stream: StreamOptions,
@@ -93,8 +93,7 @@ impl RunSpec {
             dqn,
             sapnet: SapNetParams::default(),
             sources: Arc::new(Vec::new()),
-            episodes,
-            max_steps: None,
+            budget: Budget::Episodes(episodes),
             test_episodes,
             seed,
             stream: StreamOptions::episodes(),

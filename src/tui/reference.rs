@@ -100,7 +100,10 @@ pub fn bands_of_folder(dir: &Path, task: &str) -> Result<Vec<Band>> {
         return Ok(data
             .curves
             .iter()
-            .map(|c| Band::from_runs(&c.label, &c.returns, data.window))
+            .map(|c| {
+                let returns: Vec<Vec<f64>> = c.runs.iter().map(|r| r.returns.clone()).collect();
+                Band::from_runs(&c.label, &returns, data.window)
+            })
             .collect());
     }
     let folder = FolderReader::new(dir).read().with_context(expected)?;
@@ -112,7 +115,7 @@ pub fn bands_of_folder(dir: &Path, task: &str) -> Result<Vec<Band>> {
             .runs
             .iter()
             .filter(|r| r.method == method && r.status == RunStatus::Done)
-            .map(|r| r.returns.clone())
+            .map(|r| r.training.returns.clone())
             .collect();
         if !runs.is_empty() {
             bands.push(Band::from_runs(method.label(), &runs, window));

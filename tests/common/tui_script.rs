@@ -44,7 +44,7 @@ pub fn sapnet_start() -> Event {
     Event::RunStarted {
         run: 0,
         method: method("sapnet"),
-        planned_episodes: 5000,
+        budget: sapnet::config::Budget::Episodes(5000),
         library: Some(Box::new(LibraryStart {
             policies: descriptions
                 .into_iter()
@@ -65,7 +65,7 @@ pub fn baseline_start() -> Event {
     Event::RunStarted {
         run: 0,
         method: method("dqn[100]"),
-        planned_episodes: 5000,
+        budget: sapnet::config::Budget::Episodes(5000),
         library: None,
     }
 }

@@ -25,7 +25,10 @@ fn the_mountain_car_config_uses_table_one() {
     let config = Config::from_file(&asset("mountain_car.ron")).unwrap();
     assert!(matches!(config.env, EnvConfig::MountainCar(_)));
     assert_eq!(config.dqn.replay_start_size, 100);
-    assert_eq!(config.protocol.episodes, 10_000);
+    assert_eq!(
+        config.protocol.budget,
+        sapnet::config::Budget::Episodes(10_000)
+    );
 }
 
 fn parse_error(text: &str) -> String {
@@ -142,8 +145,10 @@ fn prototype_weights_that_would_make_a_distance_nonpositive_are_refused() {
 #[test]
 fn configs_that_cannot_work_are_refused_with_the_field() {
     for (text, field) in [
-        ("(protocol: (episodes: 0))", "protocol.episodes"),
-        ("(protocol: (max_steps: Some(0)))", "protocol.max_steps"),
+        ("(protocol: (episodes: 0))", "protocol.budget"),
+        ("(protocol: (max_steps: Some(0)))", "protocol.budget"),
+        ("(protocol: (budget: Steps(0)))", "protocol.budget"),
+        ("(protocol: (budget: Episodes(0)))", "protocol.budget"),
         ("(dqn: (gradient_steps: 0))", "dqn.gradient_steps"),
         (
             "(dqn: (replay_capacity: 100, replay_start_size: 101))",

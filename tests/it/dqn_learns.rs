@@ -21,7 +21,7 @@ fn a_100_unit_dqn_learns_cartpole() {
         config.env.clone(),
         config.dqn.clone(),
         hidden.clone(),
-        config.protocol.episodes,
+        config.protocol.budget.episodes(),
         config.protocol.test_episodes,
         config.seed,
     );
@@ -37,7 +37,7 @@ fn a_100_unit_dqn_learns_cartpole() {
             _ => None,
         })
         .collect();
-    assert_eq!(rewards.len() as u32, config.protocol.episodes);
+    assert_eq!(rewards.len() as u32, config.protocol.budget.episodes());
     let best = rewards
         .windows(10)
         .map(|w| w.iter().sum::<f64>() / 10.0)

@@ -147,7 +147,7 @@ fn the_shipped_mountain_car_config_gives_the_pinned_numbers() {
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/mountain_car.ron");
     let mut config = Config::from_file(&shipped).unwrap();
     // Past the warm-up (10 × 100 steps) and into selection, in seconds.
-    config.protocol.episodes = 12;
+    config.protocol.budget = sapnet::config::Budget::Episodes(12);
     config.protocol.runs = 1;
     let cut = tmp.path().join("mountain_car_cut.ron");
     let text = sapnet::ron_file::ron_options().to_string(&config).unwrap();

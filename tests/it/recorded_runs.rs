@@ -32,7 +32,7 @@ fn protocol() -> Config {
         &embedded[end..]
     );
     let mut config = Config::from_ron(&text, "embedded, cut").unwrap();
-    config.protocol.episodes = 60;
+    config.protocol.budget = sapnet::config::Budget::Episodes(60);
     config.protocol.runs = 1;
     config.protocol.test_episodes = 1;
     config

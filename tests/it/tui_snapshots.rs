@@ -518,13 +518,13 @@ fn a_run_other_than_the_first_is_named_in_the_status_line() {
         let event = match event {
             Event::RunStarted {
                 method,
-                planned_episodes,
+                budget,
                 library,
                 ..
             } => Event::RunStarted {
                 run: 2,
                 method,
-                planned_episodes,
+                budget,
                 library,
             },
             other => other,

@@ -389,7 +389,7 @@ fn the_dashboard_shows_the_lock_in_step_the_headless_run_records() {
         .find(|s| s.run == 0 && s.method.label() == "sapnet")
         .unwrap();
     // Lock-in comes within the first few hundred steps; 40 episodes are past it.
-    spec.episodes = 40;
+    spec.budget = sapnet::config::Budget::Episodes(40);
     let run = |stream: StreamOptions, dashboard: &mut Dashboard| {
         let mut spec = spec.clone();
         spec.stream = stream;

@@ -466,7 +466,7 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
                 .map(|p| {
                     let e = of(p);
                     (
-                        p.episode.to_string(),
+                        p.at.to_string(),
                         p.runs.to_string(),
                         [e.point, e.lo, e.hi].map(|x| format!("{x:?}")),
                     )

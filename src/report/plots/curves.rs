@@ -9,6 +9,7 @@ use super::axes::{self, Fit};
 use super::legend::{self, Entry, Swatch};
 use super::palette::{emphasised, method_pens, Pen, MANY};
 use super::{Curve, Drawn, PlotData, FAMILY};
+use crate::config::Budget;
 use crate::report::runs::moving_average;
 use crate::report::sample_efficiency::EfficiencyPoint;
 use crate::seeds::{self, Part};
@@ -51,17 +52,33 @@ pub fn mean_intervals(label: &str, series: &[Vec<f64>]) -> Vec<Estimate> {
         .collect()
 }
 
-/// A chart of returns over episodes.
+/// A chart of returns over episodes or environment steps.
 pub(super) type EpisodeChart<'a, DB> =
     ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
-/// The chart of a curve over episodes in `area`: x the episodes `(last, window)`, y fitted
-/// by `fit`, labelled as every curve of these figures is.
+/// The x axis of a curve under `data`'s budget, up to `last` (the last episode drawn, or
+/// the step budget): its end and what it counts.
+pub(super) fn x_axis(data: &PlotData, last: u64) -> (f64, String) {
+    let w = data.window.max(1);
+    match data.budget {
+        Budget::Episodes(_) => (
+            last as f64,
+            format!("episode (the last of each window of {w})"),
+        ),
+        Budget::Steps(budget) => (
+            budget.max(last) as f64,
+            format!("environment step (a run's mean return of its last {w} episodes ended by it)"),
+        ),
+    }
+}
+
+/// The chart of a curve in `area`: x `(end, description)` from [`x_axis`], y fitted by
+/// `fit`, labelled as every curve of these figures is.
 pub(super) fn episode_chart<'a, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
     caption: String,
     y_desc: String,
-    (episodes, w): (usize, usize),
+    (end, x_desc): (f64, String),
     fit: &Fit,
 ) -> Result<EpisodeChart<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
     let mut chart = ChartBuilder::on(area)
@@ -71,10 +88,10 @@ pub(super) fn episode_chart<'a, DB: DrawingBackend>(
         .margin_right(30)
         .x_label_area_size(45)
         .y_label_area_size(60)
-        .build_cartesian_2d(0f64..episodes as f64, fit.low..fit.high)?;
+        .build_cartesian_2d(0f64..end, fit.low..fit.high)?;
     chart
         .configure_mesh()
-        .x_desc(format!("episode (the last of each window of {w})"))
+        .x_desc(x_desc)
         .y_desc(y_desc)
         .x_label_formatter(&|x| format!("{x:.0}"))
         .y_label_formatter(&|y| format!("{y:.0}"))
@@ -83,10 +100,10 @@ pub(super) fn episode_chart<'a, DB: DrawingBackend>(
     Ok(chart)
 }
 
-/// A translucent band of `pen`'s colour through the intervals `(episode, estimate)`,
-/// clamped to the chart's fit.
+/// A translucent band of `pen`'s colour through the intervals `(x, estimate)`, clamped to
+/// the chart's fit.
 pub(super) fn band_polygon(
-    intervals: impl Iterator<Item = (usize, Estimate)> + Clone,
+    intervals: impl Iterator<Item = (u64, Estimate)> + Clone,
     fit: &Fit,
     pen: Pen,
 ) -> Polygon<(f64, f64)> {
@@ -107,10 +124,10 @@ pub(super) fn pens(curves: &[Curve]) -> Vec<Pen> {
         .iter()
         .map(|c| {
             let means: Vec<f64> = c
-                .returns
+                .runs
                 .iter()
                 .filter(|r| !r.is_empty())
-                .map(|r| r.iter().sum::<f64>() / r.len() as f64)
+                .map(|r| r.returns.iter().sum::<f64>() / r.len() as f64)
                 .collect();
             if means.is_empty() {
                 f64::NEG_INFINITY
@@ -156,7 +173,8 @@ pub(super) fn beside_legend<DB: DrawingBackend>(
 
 /// Fig. 5/7: moving average of `window` returns, averaged over runs, one line per method,
 /// with the 95% bootstrap interval of that mean as a band (`efficiency`: the
-/// sample-efficiency curves' points, one list per method, whose mean carries it).
+/// sample-efficiency curves' points, one list per method, whose mean carries it). Under a
+/// step budget the line is those points' mean too, on the step axis.
 pub(super) fn learning_curve<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     data: &PlotData,
@@ -164,19 +182,37 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
 ) -> Drawn<DB> {
     root.fill(&WHITE)?;
     let w = data.window.max(1);
-    // Per method: the mean over runs of each run's moving average.
-    let lines: Vec<Vec<f64>> = data
-        .curves
+    // Per method: the mean over runs of each run's moving average, at each point.
+    let lines: Vec<Vec<(f64, f64)>> = match data.budget {
+        Budget::Episodes(_) => data
+            .curves
+            .iter()
+            .map(|c| {
+                let averaged: Vec<Vec<f64>> = c
+                    .runs
+                    .iter()
+                    .map(|r| moving_average(&r.returns, w))
+                    .collect();
+                let mean = mean_over_runs(&averaged);
+                mean.into_iter()
+                    .enumerate()
+                    .map(|(e, v)| ((e + w) as f64, v))
+                    .collect()
+            })
+            .collect(),
+        Budget::Steps(_) => efficiency
+            .iter()
+            .map(|points| points.iter().map(|p| (p.at as f64, p.mean.point)).collect())
+            .collect(),
+    };
+    let last = lines
         .iter()
-        .map(|c| {
-            let averaged: Vec<Vec<f64>> = c.returns.iter().map(|r| moving_average(r, w)).collect();
-            mean_over_runs(&averaged)
-        })
-        .collect();
-    let episodes = lines.iter().map(|l| l.len() + w - 1).max().unwrap_or(w);
-    let banded = |i: usize| data.curves[i].returns.len() > 1;
+        .filter_map(|l| l.last().map(|&(x, _)| x as u64))
+        .max()
+        .unwrap_or(w as u64);
+    let banded = |i: usize| data.curves[i].runs.len() > 1;
     let fit = axes::fit(
-        lines.iter().flatten().copied().chain(
+        lines.iter().flatten().map(|&(_, y)| y).chain(
             efficiency
                 .iter()
                 .enumerate()
@@ -194,38 +230,33 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
         &area,
         legend::title(data.subject.as_deref(), &caption),
         format!("episode return, MA{w}"),
-        (episodes, w),
+        x_axis(data, last),
         &fit,
     )?;
     let pens = pens(&data.curves);
     for (i, points) in efficiency.iter().enumerate() {
         if banded(i) && !pens[i].faint {
-            let band = points.iter().map(|p| (p.episode, p.mean));
+            let band = points.iter().map(|p| (p.at, p.mean));
             chart.draw_series(std::iter::once(band_polygon(band, &fit, pens[i])))?;
         }
     }
     // The lines over every band, the faint ones under the others.
     for i in in_drawing_order(&pens) {
-        let points = lines[i]
-            .iter()
-            .enumerate()
-            .map(|(e, &v)| ((e + w) as f64, v))
-            .collect();
-        legend::draw_line(&mut chart, points, pens[i])?;
+        legend::draw_line(&mut chart, lines[i].clone(), pens[i])?;
     }
     let entries: Vec<Entry> = data
         .curves
         .iter()
         .zip(&pens)
         .map(|(c, &pen)| Entry {
-            label: legend::with_runs(&c.label, c.returns.len()),
+            label: legend::with_runs(&c.label, c.runs.len()),
             swatch: Swatch::Line(pen),
         })
         .collect();
     let mut notes = vec![];
     let banded_runs: Vec<usize> = (0..data.curves.len())
         .filter(|&i| banded(i))
-        .map(|i| data.curves[i].returns.len())
+        .map(|i| data.curves[i].runs.len())
         .collect();
     if !banded_runs.is_empty() {
         notes.push(format!(
@@ -378,17 +409,18 @@ mod tests {
             subject: None,
             return_range: Some((0.0, 500.0)),
             window: 10,
+            budget: Budget::Episodes(10),
             curves: vec![
                 Curve {
                     label: "sapnet".into(),
                     kind: crate::reuse::sapnet::KIND,
-                    returns: vec![],
+                    runs: vec![],
                     tests: vec![vec![0.0, 10.0], vec![500.0, 20.0]],
                 },
                 Curve {
                     label: "dqn[100]".into(),
                     kind: crate::reuse::from_scratch::KIND,
-                    returns: vec![],
+                    runs: vec![],
                     tests: vec![vec![9.0, 10.0]],
                 },
             ],

@@ -19,11 +19,11 @@ pub(super) fn sample_efficiency<DB: DrawingBackend>(
 ) -> Drawn<DB> {
     root.fill(&WHITE)?;
     let w = data.window.max(1);
-    let episodes = points
+    let last = points
         .iter()
-        .filter_map(|p| p.last().map(|p| p.episode))
+        .filter_map(|p| p.last().map(|p| p.at))
         .max()
-        .unwrap_or(w);
+        .unwrap_or(w as u64);
     let fit = axes::fit(
         points
             .iter()
@@ -40,7 +40,7 @@ pub(super) fn sample_efficiency<DB: DrawingBackend>(
         &area,
         legend::title(data.subject.as_deref(), &caption),
         format!("episode return, MA{w}: IQM over runs"),
-        (episodes, w),
+        super::curves::x_axis(data, last),
         &fit,
     )?;
     let pens = pens(&data.curves);
@@ -49,13 +49,13 @@ pub(super) fn sample_efficiency<DB: DrawingBackend>(
         if !banded(curve) || pen.faint {
             continue;
         }
-        let band = curve.iter().map(|p| (p.episode, p.iqm));
+        let band = curve.iter().map(|p| (p.at, p.iqm));
         chart.draw_series(std::iter::once(band_polygon(band, &fit, *pen)))?;
     }
     for i in in_drawing_order(&pens) {
         let line = points[i]
             .iter()
-            .map(|p| (p.episode as f64, p.iqm.point))
+            .map(|p| (p.at as f64, p.iqm.point))
             .collect();
         legend::draw_line(&mut chart, line, pens[i])?;
     }
@@ -64,13 +64,13 @@ pub(super) fn sample_efficiency<DB: DrawingBackend>(
         .iter()
         .zip(&pens)
         .map(|(c, &pen)| Entry {
-            label: legend::with_runs(&c.label, c.returns.len()),
+            label: legend::with_runs(&c.label, c.runs.len()),
             swatch: Swatch::Line(pen),
         })
         .collect();
     let mut notes = vec![format!(
         "band: 95% bootstrap CI of the IQM over {}",
-        legend::runs_phrase(data.curves.iter().map(|c| c.returns.len()))
+        legend::runs_phrase(data.curves.iter().map(|c| c.runs.len()))
     )];
     notes.extend(emphasis_note(&pens));
     notes.extend(fit.note().map(|n| format!("band {n}")));

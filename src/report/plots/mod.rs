@@ -29,7 +29,9 @@ use anyhow::{anyhow, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::runs::TrainingEpisodes;
 use super::sample_efficiency::{self, EfficiencyPoint};
+use crate::config::Budget;
 use crate::reuse::MethodKind;
 
 /// DejaVu Sans (licence in `assets/fonts/`): plotters' `ab_glyph` backend needs a font and
@@ -46,8 +48,8 @@ pub struct Curve {
     pub label: String,
     /// Its kind picks its colour family (SAP-Net's the paper's red).
     pub kind: MethodKind,
-    /// Training returns of each run.
-    pub returns: Vec<Vec<f64>>,
+    /// Training episodes of each run.
+    pub runs: Vec<TrainingEpisodes>,
     /// Greedy test returns of each tested run.
     pub tests: Vec<Vec<f64>>,
 }
@@ -63,6 +65,9 @@ pub struct PlotData {
     /// y axes stop there.
     pub return_range: Option<(f64, f64)>,
     pub window: usize,
+    /// The protocol's budget: its curves are drawn on its axis (episodes or environment
+    /// steps, up to the budget).
+    pub budget: Budget,
     /// In the protocol's order; SAP-Net first if it ran.
     pub curves: Vec<Curve>,
     pub policy_names: Vec<String>,
@@ -97,7 +102,7 @@ pub fn write_all(dir: &Path, data: &PlotData) -> Result<()> {
     let efficiency: Vec<Vec<EfficiencyPoint>> = data
         .curves
         .iter()
-        .map(|c| sample_efficiency::curve(&c.label, &c.returns, data.window))
+        .map(|c| sample_efficiency::curve(&c.label, &c.runs, data.window, data.budget))
         .collect();
     let labelled: Vec<(String, Vec<EfficiencyPoint>)> = data
         .curves
@@ -105,7 +110,7 @@ pub fn write_all(dir: &Path, data: &PlotData) -> Result<()> {
         .map(|c| c.label.clone())
         .zip(efficiency.iter().cloned())
         .collect();
-    let (header, rows) = sample_efficiency::records(&labelled);
+    let (header, rows) = sample_efficiency::records(&labelled, data.budget.unit());
     super::write_rows(&dir.join("sample_efficiency.csv"), &header, &rows)?;
     atomically(&dir.join("sample_efficiency.png"), |path| {
         efficiency::sample_efficiency(png(path, WITH_LEGEND), data, &efficiency)
@@ -211,17 +216,21 @@ mod tests {
             subject: Some("sapnet.temperature = 1.0".into()),
             return_range: Some((0.0, 500.0)),
             window: 2,
+            budget: Budget::Episodes(3),
             curves: vec![
                 Curve {
                     label: "sapnet".into(),
                     kind: crate::reuse::sapnet::KIND,
-                    returns: vec![vec![10.0, 20.0, 30.0], vec![12.0, 18.0]],
+                    runs: vec![
+                        TrainingEpisodes::uniform(&[10.0, 20.0, 30.0], 10),
+                        TrainingEpisodes::uniform(&[12.0, 18.0], 10),
+                    ],
                     tests: vec![vec![100.0, 90.0], vec![80.0, 95.0]],
                 },
                 Curve {
                     label: "dqn[100]".into(),
                     kind: crate::reuse::from_scratch::KIND,
-                    returns: vec![vec![9.0, 11.0, 10.0]],
+                    runs: vec![TrainingEpisodes::uniform(&[9.0, 11.0, 10.0], 10)],
                     tests: vec![vec![9.0, 10.0]],
                 },
             ],

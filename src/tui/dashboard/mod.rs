@@ -17,6 +17,7 @@ pub use keys::{apply_teach_key, Action, Clicked};
 pub use live_curve::{LiveCurve, CURVE_POINTS};
 pub use run_views::{LibraryView, PolicyRow, RunView, HISTORY};
 
+use crate::config::Budget;
 use crate::teach::session::CALLS_PER_FRAME;
 use crate::teach::Teach;
 use crate::trainer::{ActivationSnapshot, Command, Event, MethodId, StepRecord, LOCK_IN};
@@ -172,13 +173,13 @@ impl Dashboard {
             Event::RunStarted {
                 run,
                 method,
-                planned_episodes,
+                budget,
                 library,
             } => {
                 if self.is_stale(&method, library.is_some()) {
                     return;
                 }
-                let run = RunView::new(method, run, planned_episodes);
+                let run = RunView::new(method, run, budget);
                 if let Some(start) = library {
                     let n = start.net.len();
                     self.library = Some(LibraryView {
@@ -239,6 +240,7 @@ impl Dashboard {
                 }
                 if let Some(run) = self.runs.iter_mut().find(|r| r.method == record.method) {
                     run.episode = record.episode;
+                    run.steps += u64::from(record.steps);
                     run.epsilon = record.epsilon;
                     run.curve.push(record.episode, record.reward);
                     run.statistic_loss.push(record.statistic_loss);
@@ -261,7 +263,7 @@ impl Dashboard {
                     // It failed before it started (its networks would not build): it still
                     // gets its row, SAP-Net's first, so that the failure is seen.
                     None => {
-                        let mut run = RunView::new(method, run, 0);
+                        let mut run = RunView::new(method, run, Budget::Episodes(0));
                         run.failed = Some(error);
                         if run.method.kind.spreads {
                             self.runs.insert(0, run);

@@ -3,6 +3,7 @@
 
 use std::collections::VecDeque;
 
+use crate::config::Budget;
 use crate::sapnet::{PolicyDescription, Prototype, SapNet};
 use crate::teach::labels::short_task;
 use crate::trainer::{MethodId, RunRecord};
@@ -106,8 +107,11 @@ pub struct RunView {
     pub method: MethodId,
     /// Which run of its method (from 0; `--follow-run` picks another than the first).
     pub run: u32,
-    pub planned_episodes: u32,
+    /// The episodes or environment steps the run is given.
+    pub budget: Budget,
     pub episode: u32,
+    /// Environment steps of the episodes that ended.
+    pub steps: u64,
     pub curve: LiveCurve,
     pub epsilon: f64,
     pub statistic_loss: Vec<f64>,
@@ -117,12 +121,13 @@ pub struct RunView {
 }
 
 impl RunView {
-    pub(super) fn new(method: MethodId, run: u32, planned_episodes: u32) -> Self {
+    pub(super) fn new(method: MethodId, run: u32, budget: Budget) -> Self {
         Self {
             method,
             run,
-            planned_episodes,
+            budget,
             episode: 0,
+            steps: 0,
             curve: LiveCurve::default(),
             epsilon: 0.0,
             statistic_loss: Vec::new(),

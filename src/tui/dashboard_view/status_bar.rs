@@ -8,6 +8,8 @@ use ratatui::widgets::Paragraph;
 use ratatui::Frame;
 
 use super::figures::thousands;
+use crate::config::Budget;
+use crate::results::folder_state::short_count;
 use crate::tui::dashboard::{Dashboard, Mode, SPEEDS};
 use crate::tui::theme::Theme;
 
@@ -62,12 +64,19 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: 
         // The episode being played, as the step line counts it: the next one once its
         // first step came (the run counts the episodes that ended).
         let playing = dashboard.last_step.as_ref().map_or(0, |s| s.episode);
-        format!(
-            "{}{which} ep {}/{}",
-            r.method,
-            r.episode.max(playing),
-            r.planned_episodes
-        )
+        let episode = r.episode.max(playing);
+        match r.budget {
+            Budget::Episodes(n) => format!("{}{which} ep {episode}/{n}", r.method),
+            Budget::Steps(n) => {
+                let stepped = dashboard.last_step.as_ref().map_or(0, |s| s.step);
+                let steps = short_count(r.steps.max(stepped));
+                format!(
+                    "{}{which} ep {episode} · {steps}/{} steps",
+                    r.method,
+                    short_count(n)
+                )
+            }
+        }
     });
     // Paused, training makes no steps: the last rate measured would be stale.
     let speed = match (dashboard.mode, dashboard.steps_per_second) {

@@ -9,7 +9,9 @@ use std::collections::BTreeSet;
 
 use crossterm::event::{KeyCode, KeyEvent};
 
+use crate::config::Budget;
 use crate::report::sample_efficiency::{self, EfficiencyPoint};
+use crate::report::TrainingEpisodes;
 use crate::results::folder_state::{FolderState, RunProgress, RunStatus};
 use crate::stats::Estimate;
 
@@ -58,7 +60,7 @@ pub struct Curves {
 
 /// A method's curve and what its runs were when it was made (their episodes in points'
 /// worths, whether each had ended): made again when that changes.
-type Cached = (Vec<(usize, bool)>, Vec<EfficiencyPoint>);
+type Cached = (Vec<(u64, bool)>, Vec<EfficiencyPoint>);
 
 impl Default for Curves {
     fn default() -> Self {
@@ -79,13 +81,17 @@ pub fn runs_of(folder: &FolderState, index: usize) -> Vec<&RunProgress> {
     folder
         .runs
         .iter()
-        .filter(|r| r.method.index == index && !r.returns.is_empty())
+        .filter(|r| r.method.index == index && !r.training.is_empty())
         .collect()
 }
 
-/// The episodes a run of the protocol plans: the x axis's end when not zoomed.
+/// The episodes (or, under a step budget, the steps) a run of the protocol is given: the x
+/// axis's end when not zoomed.
 pub fn planned(folder: &FolderState) -> f64 {
-    f64::from(folder.config.protocol.episodes.max(1))
+    match folder.config.protocol.budget {
+        Budget::Episodes(n) => f64::from(n.max(1)),
+        Budget::Steps(n) => n.max(1) as f64,
+    }
 }
 
 impl Curves {
@@ -96,10 +102,10 @@ impl Curves {
         // A curve is a bootstrap per point (a large protocol's, a good part of a second):
         // made again when a run has grown by a point's worth of episodes, or ended — not
         // at every refresh of a live folder.
-        let quantum = (folder.config.protocol.episodes as usize / sample_efficiency::POINTS).max(1);
-        let key: Vec<(usize, bool)> = runs
+        let quantum = (planned(folder) as u64 / sample_efficiency::POINTS as u64).max(1);
+        let key: Vec<(u64, bool)> = runs
             .iter()
-            .map(|r| (r.episodes() / quantum, r.status == RunStatus::Done))
+            .map(|r| (r.done() / quantum, r.status == RunStatus::Done))
             .collect();
         let mut cache = self.cache.borrow_mut();
         if cache.len() <= index {
@@ -113,9 +119,10 @@ impl Curves {
         let Some(label) = folder.config.protocol.methods.get(index).map(|m| m.label()) else {
             return Vec::new();
         };
-        let returns: Vec<Vec<f64>> = runs.iter().map(|r| r.returns.clone()).collect();
+        let training: Vec<TrainingEpisodes> = runs.iter().map(|r| r.training.clone()).collect();
+        let protocol = &folder.config.protocol;
         let points =
-            sample_efficiency::curve(&label, &returns, folder.config.protocol.moving_average);
+            sample_efficiency::curve(&label, &training, protocol.moving_average, protocol.budget);
         cache[index] = Some((key, points.clone()));
         points
     }

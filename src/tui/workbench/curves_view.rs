@@ -15,9 +15,11 @@ use ratatui::Frame;
 use super::cells::{fit, inner};
 use super::curves::{planned, runs_of, Curves};
 use super::state::Workbench;
+use crate::config::Budget;
 use crate::report::moving_average;
 use crate::report::plots::palette::method_colours;
-use crate::report::sample_efficiency::EfficiencyPoint;
+use crate::report::sample_efficiency::{self, EfficiencyPoint};
+use crate::report::{step_axis, TrainingEpisodes};
 use crate::results::folder_state::FolderState;
 use crate::stats::Estimate;
 use crate::tui::row_window::RowWindow;
@@ -74,14 +76,10 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
             let runs = runs_of(folder, method.index);
             let k = k.min(runs.len().saturating_sub(1));
             let window = folder.config.protocol.moving_average;
-            let averages: Vec<(f64, f64)> = runs
+            let averages = runs
                 .get(k)
-                .map(|r| moving_average(&r.returns, window))
-                .unwrap_or_default()
-                .into_iter()
-                .enumerate()
-                .map(|(i, a)| ((i + window) as f64, a))
-                .collect();
+                .map(|r| run_line(&r.training, window, folder.config.protocol.budget))
+                .unwrap_or_default();
             draw_chart(frame, chart, (&[method], &averages), curves, range, theme);
             draw_runs_legend(frame, legend, folder, method, k, theme);
         }
@@ -98,7 +96,37 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
                 .copied()
                 .collect();
             draw_chart(frame, chart, (&ordered, &[]), curves, range, theme);
-            draw_legend(frame, legend, &methods, curves, range, label_width, theme);
+            let budget = folder.config.protocol.budget;
+            draw_legend(
+                frame,
+                legend,
+                (&methods, budget),
+                curves,
+                range,
+                label_width,
+                theme,
+            );
+        }
+    }
+}
+
+/// One run's line: its moving average at each episode, or under a step budget its step
+/// curve ([`step_axis`]).
+fn run_line(run: &TrainingEpisodes, window: usize, budget: Budget) -> Vec<(f64, f64)> {
+    match budget {
+        Budget::Episodes(_) => moving_average(&run.returns, window)
+            .into_iter()
+            .enumerate()
+            .map(|(i, a)| ((i + window) as f64, a))
+            .collect(),
+        Budget::Steps(budget) => {
+            let points = step_axis::points(budget, sample_efficiency::POINTS);
+            let curve = step_axis::curve(run, window, &points);
+            points
+                .iter()
+                .zip(curve)
+                .filter_map(|(&at, v)| v.map(|v| (at as f64, v)))
+                .collect()
         }
     }
 }
@@ -174,7 +202,11 @@ fn title(
         format!("partial: {finished} of {planned_runs} runs finished, running ones so far")
     };
     let zoom = if curves.zoom.is_some() {
-        format!(" · ep {from:.0}–{to:.0} of {:.0}", planned(folder))
+        let unit = match folder.config.protocol.budget {
+            Budget::Episodes(_) => "ep",
+            Budget::Steps(_) => "step",
+        };
+        format!(" · {unit} {from:.0}–{to:.0} of {:.0}", planned(folder))
     } else {
         String::new()
     };
@@ -196,7 +228,7 @@ fn in_range(
 ) -> impl Iterator<Item = &EfficiencyPoint> {
     points
         .iter()
-        .filter(move |p| (from..=to).contains(&(p.episode as f64)))
+        .filter(move |p| (from..=to).contains(&(p.at as f64)))
 }
 
 /// The curves (each method's line and band; without colour the picked method's band
@@ -270,7 +302,7 @@ fn draw_chart(
         .paint(|ctx: &mut Context| {
             for m in methods {
                 let estimates: Vec<(f64, Estimate)> = in_range(&m.points, range)
-                    .map(|p| (p.episode as f64, statistic.of(p)))
+                    .map(|p| (p.at as f64, statistic.of(p)))
                     .collect();
                 if theme.color || m.index == picked {
                     // The band's edges, dotted.
@@ -325,7 +357,7 @@ fn draw_chart(
                 for m in methods {
                     let mut next = f64::NEG_INFINITY;
                     for p in in_range(&m.points, range) {
-                        let x = p.episode as f64;
+                        let x = p.at as f64;
                         if x >= next {
                             ctx.print(x, statistic.of(p).point, MARKERS[m.index % MARKERS.len()]);
                             next = x + every;
@@ -347,7 +379,7 @@ pub fn value_at_end(points: &[EfficiencyPoint], range: (f64, f64)) -> Option<&Ef
 fn draw_legend(
     frame: &mut Frame,
     area: Rect,
-    methods: &[Shown],
+    (methods, folder_budget): (&[Shown], Budget),
     curves: &Curves,
     range: (f64, f64),
     label_width: usize,
@@ -358,16 +390,20 @@ fn draw_legend(
         .iter()
         .map(|m| value_at_end(&m.points, range))
         .collect();
-    let at = ends.iter().flatten().map(|p| p.episode).max();
+    let at = ends.iter().flatten().map(|p| p.at).max();
+    let unit = match folder_budget {
+        Budget::Episodes(_) => "ep",
+        Budget::Steps(_) => "step",
+    };
     // The intervals where the legend is wide enough for them.
     let intervals = width >= label_width + 27;
     let mut lines = vec![Line::styled(
         fit(
             &match at {
-                Some(episode) if intervals => {
-                    format!("{} [95% CI] at ep {episode}", curves.statistic.name())
+                Some(at) if intervals => {
+                    format!("{} [95% CI] at {unit} {at}", curves.statistic.name())
                 }
-                Some(episode) => format!("{} at ep {episode}", curves.statistic.name()),
+                Some(at) => format!("{} at {unit} {at}", curves.statistic.name()),
                 None => curves.statistic.name().to_string(),
             },
             width,
@@ -462,7 +498,7 @@ fn draw_runs_legend(
         [shown],
     );
     for (k, run) in runs.iter().enumerate().skip(rows.first).take(rows.shown) {
-        let last = moving_average(&run.returns, window)
+        let last = moving_average(&run.training.returns, window)
             .last()
             .map_or_else(|| "-".to_string(), |a| format!("{a:.1}"));
         let text = format!(

@@ -34,7 +34,7 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
     let averages: Vec<Vec<f64>> = folder
         .runs
         .iter()
-        .map(|r| moving_average(&r.returns, window))
+        .map(|r| moving_average(&r.training.returns, window))
         .collect();
     // One scale for every line, the lowest MA10 of the folder to its highest, so that
     // lines compare and a curve's shape shows even far below the task's best return.
@@ -58,8 +58,16 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
         .max()
         .unwrap_or(1)
         .clamp(6, 12);
-    let episodes_width = format!("{0}/{0}", folder.config.protocol.episodes)
-        .len()
+    let episodes_width = folder
+        .runs
+        .iter()
+        .map(|r| {
+            let mut full = r.clone();
+            full.training.lengths.clear();
+            full.progress_text().len().max(r.progress_text().len())
+        })
+        .max()
+        .unwrap_or(8)
         .max(8);
     // method, run, status, episodes, [sparkline], MA10, ETA, source, with a space between.
     let fixed = method_width + 4 + 8 + episodes_width + 8 + 7 + source_width + 7;
@@ -120,10 +128,7 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
             Span::styled(
                 format!(
                     " {} {} {} {} {}",
-                    fit(
-                        &format!("{}/{}", run.episodes(), run.planned),
-                        episodes_width
-                    ),
+                    fit(&run.progress_text(), episodes_width),
                     fit(&sparkline(averages, range, spark_width), spark_width),
                     fit(&latest, 8),
                     fit(&eta, 7),
