@@ -52,7 +52,10 @@ fn protocol(runs: u32) -> Protocol {
                 wall_s: 0.0,
             };
             summaries.push(RunSummary::new(record, &returns, 10));
-            rewards.insert((method.clone(), run), TrainingEpisodes::uniform(&returns, 20));
+            rewards.insert(
+                (method.clone(), run),
+                TrainingEpisodes::uniform(&returns, 20),
+            );
         }
     }
     (config, summaries, rewards)

@@ -25,6 +25,7 @@ mod hostile_folders;
 mod import_cli;
 mod judgment_signals;
 mod layers;
+mod method_behaviour;
 mod other_agents;
 mod pinned_numbers;
 mod pool_cli;
