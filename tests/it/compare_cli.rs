@@ -60,6 +60,8 @@ fn sb3_monitor_files_give_rliables_intervals() {
             "20",
             "--task",
             "CartPole-v1",
+            // rliable.json scored each run over its episodes.
+            "--by-episode",
         ])
         .arg("--out")
         .arg(&out)
@@ -121,6 +123,70 @@ fn sb3_monitor_files_give_rliables_intervals() {
     let runs = std::fs::read_to_string(out.join("runs.csv")).unwrap();
     assert_eq!(runs.lines().count(), 1 + 6);
     assert!(runs.contains("dqn-seed2.monitor.csv") && runs.contains("Monitor"));
+}
+
+/// SB3's DQN finishes about 2,000 episodes in its 20,000 steps and PPO about 300: by
+/// default the runs are put side by side by step, up to the steps every run reached
+/// (19,993), each method given the same experience; `--by-episode` puts them by episode.
+#[test]
+fn monitor_files_of_different_episode_counts_are_aligned_by_step() {
+    let tmp = tempfile::tempdir().unwrap();
+    let compare = |out: &Path, extra: &[&str]| {
+        let output = sapnet()
+            .args([
+                "compare",
+                "--method",
+                &method("dqn"),
+                "--method",
+                &method("ppo"),
+            ])
+            .args(["--range", "0", "500", "--last", "20"])
+            .args(extra)
+            .arg("--out")
+            .arg(out)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", stderr(&output));
+    };
+    let by_step = tmp.path().join("by-step");
+    compare(&by_step, &[]);
+    let rows = comparison(&by_step);
+    for row in &rows {
+        assert_eq!(row["env_steps"], "19993.0", "{}", row["method"]);
+    }
+    let runs = std::fs::read_to_string(by_step.join("runs.csv")).unwrap();
+    let mut reader = csv::Reader::from_reader(runs.as_bytes());
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let mut episodes = Vec::new();
+    for record in reader.records() {
+        let record = record.unwrap();
+        assert_eq!(&record[col("steps")], "19993");
+        episodes.push(record[col("episodes")].parse::<usize>().unwrap());
+    }
+    // DQN's runs end ~2,000 episodes by the budget, PPO's ~300: the same steps.
+    assert!(episodes[..3].iter().all(|&e| e > 1_800), "{episodes:?}");
+    assert!(episodes[3..].iter().all(|&e| e < 320), "{episodes:?}");
+    let efficiency = std::fs::read_to_string(by_step.join("sample_efficiency.csv")).unwrap();
+    assert!(efficiency.starts_with("method,step,"), "{efficiency:.60}");
+    let last_step = efficiency
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse::<u64>().unwrap())
+        .max();
+    assert_eq!(last_step, Some(19_993));
+
+    let by_episode = tmp.path().join("by-episode");
+    compare(&by_episode, &["--by-episode"]);
+    let efficiency = std::fs::read_to_string(by_episode.join("sample_efficiency.csv")).unwrap();
+    assert!(
+        efficiency.starts_with("method,episode,"),
+        "{efficiency:.60}"
+    );
+    // The step column never aligned the scores: the training return differs.
+    let return_of =
+        |rows: &[std::collections::HashMap<String, String>]| rows[1]["return_iqm"].clone();
+    assert_ne!(return_of(&rows), return_of(&comparison(&by_episode)));
 }
 
 #[test]

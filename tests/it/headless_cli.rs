@@ -498,3 +498,61 @@ fn each_subcommands_help_lists_the_flags_it_reads() {
         assert!(output.status.success(), "{args:?}: {}", stderr(&output));
     }
 }
+
+/// The study's configs give every method the same environment steps: the quick protocol of
+/// assets/baselines_cartpole.ron (1/20 of its 200,000 steps) runs every method to exactly
+/// 10,000 steps, comparison.csv says so beside each method's updates per step, and the
+/// sample-efficiency curve is on the step axis up to the budget.
+#[test]
+fn a_step_budget_protocol_gives_every_method_the_same_steps() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, summary) = crate::common::library::quick_protocol(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/baselines_cartpole.ron"),
+        "cartpole",
+        dir.path(),
+    );
+    assert_eq!(summary["config"]["protocol"]["budget"]["Steps"], 10_000);
+    let text = std::fs::read_to_string(out.join("comparison.csv")).unwrap();
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("comparison.csv has no {name}"))
+    };
+    let mut methods = Vec::new();
+    for record in reader.records() {
+        let record = record.unwrap();
+        let method = record[col("method")].to_string();
+        assert_eq!(&record[col("env_steps")], "10000.0", "{method}");
+        let updates: f64 = record[col("updates_per_step")].parse().unwrap();
+        // The frozen oracle learns nothing; A2T's base and attention, and GPI's learner and
+        // the winner's estimate, update twice a step; the others once (their first
+        // replay_start steps aside). QDagger's student has not started by 10,000 steps.
+        let expected = match method.as_str() {
+            "frozen-oracle" | "qdagger" => 0.0,
+            "a2t" | "gpi" => 2.0,
+            _ => 1.0,
+        };
+        assert!(
+            (updates - expected).abs() < 0.06,
+            "{method}: {updates} updates per step"
+        );
+        assert!(!record[col("final_iqm")].is_empty(), "{method}");
+        methods.push(method);
+    }
+    assert_eq!(methods.len(), 10, "{methods:?}");
+    for steps_column in ["steps_to_195", "steps_to_475"] {
+        col(steps_column);
+    }
+    let efficiency = std::fs::read_to_string(out.join("sample_efficiency.csv")).unwrap();
+    assert!(efficiency.starts_with("method,step,"));
+    assert!(efficiency.lines().any(|l| l.starts_with("sapnet,10000,")));
+    // A run's record keeps the episode the budget cut, truncated there.
+    let runs = summary["runs"].as_array().unwrap();
+    assert!(runs.iter().all(|r| r["steps"] == 10_000));
+    assert!(runs
+        .iter()
+        .any(|r| r["cut_episode"]["steps"].as_u64().is_some()));
+}
