@@ -9,7 +9,8 @@ use anyhow::{Context, Result};
 use crate::cli::{Cli, Command, EnvArgs, SourcesArgs, SourcesCommand, SweepCommand, TeachArgs};
 use crate::config::{Budget, Config};
 use crate::experiment;
-use crate::headless::{self, OutputOptions, RunOptions};
+use crate::experiment::{OutputOptions, RunOptions};
+use crate::headless;
 use crate::results;
 use crate::ron_file::{parse_ron, ConfigError};
 use crate::teach::lesson::TeachConfig;
@@ -337,7 +338,7 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     }
     let dir = match &cli.run.out {
         Some(dir) => dir.clone(),
-        None => headless::default_out_dir(cli.run.config.as_deref()),
+        None => experiment::default_out_dir(cli.run.config.as_deref()),
     };
     let output = OutputOptions {
         dir,
@@ -345,7 +346,7 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     };
 
     let options = run_options(cli);
-    let summary = headless::run(&config, &output, &options, &on_interrupt()?)
+    let summary = experiment::run(&config, &output, &options, &on_interrupt()?)
         .map_err(|error| in_config_file(error, cli))?;
     headless::print_summary(&summary, &output.dir)
 }
@@ -377,14 +378,14 @@ fn resume_experiment(cli: &Cli) -> Result<()> {
         Some(path) => {
             let mut config = training_config(path)?;
             config.run_with(&cli.run.python_settings());
-            Some(headless::AddedMethods {
+            Some(experiment::AddedMethods {
                 config,
                 origin: path.clone(),
             })
         }
         None => None,
     };
-    let summary = headless::resume(
+    let summary = experiment::resume(
         dir,
         cli.run.runs,
         added.as_ref(),
@@ -434,11 +435,11 @@ fn run_in_ui(cli: &Cli, config: Config) -> Result<()> {
     let output = OutputOptions {
         dir: match &cli.run.out {
             Some(dir) => dir.clone(),
-            None => headless::default_out_dir(cli.run.config.as_deref()),
+            None => experiment::default_out_dir(cli.run.config.as_deref()),
         },
         force: cli.run.force,
     };
-    let opened = headless::OpenedOutput::open(&output)?;
+    let opened = experiment::OpenedOutput::open(&output)?;
     // SIGTERM and SIGHUP stop the protocol as `q` does, the terminal restored.
     let _signals = on_interrupt()?;
     let load = |path: &Path| -> Result<Config> {
@@ -576,8 +577,8 @@ fn run_sweep(cli: &Cli, command: &SweepCommand) -> Result<()> {
             if *all {
                 let _stop = on_interrupt()?;
                 let failed = sweep::run::run_all(sweep, jobs, &cli.run.python_settings())?;
-                let states = sweep::status::states(sweep)?;
-                eprint!("{}", sweep::status::report(&states));
+                let states = crate::results::sweep::status::states(sweep)?;
+                eprint!("{}", crate::results::sweep::status::report(&states));
                 anyhow::ensure!(
                     failed == 0,
                     "{failed} {} failed: `sapnet sweep status {}` says why",
@@ -606,16 +607,16 @@ fn run_sweep(cli: &Cli, command: &SweepCommand) -> Result<()> {
             }
             Ok(())
         }
-        SweepCommand::Status { sweep } => {
-            print_stdout(&sweep::status::report(&sweep::status::states(sweep)?))
-        }
+        SweepCommand::Status { sweep } => print_stdout(&crate::results::sweep::status::report(
+            &crate::results::sweep::status::states(sweep)?,
+        )),
         SweepCommand::Merge { sweep } => {
-            let report = sweep::merge::merge(sweep)?;
+            let report = crate::results::sweep::merge::merge(sweep)?;
             if !report.missing.is_empty() {
                 let names: Vec<String> = report
                     .missing
                     .iter()
-                    .map(|&id| sweep::cell_name(id))
+                    .map(|&id| crate::results::sweep::cell_name(id))
                     .collect();
                 eprintln!(
                     "{} {} left out: {}",

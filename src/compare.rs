@@ -127,7 +127,7 @@ fn alignment(
 ) -> Result<(Budget, Vec<Vec<TrainingEpisodes>>)> {
     let by_step: Option<Vec<Vec<TrainingEpisodes>>> = methods
         .iter()
-        .map(|m| m.runs.iter().map(OutsideRun::training_episodes).collect())
+        .map(|m| m.runs.iter().map(training_episodes).collect())
         .collect();
     let most_episodes = methods
         .iter()
@@ -172,7 +172,7 @@ fn alignment(
             let run = methods
                 .iter()
                 .flat_map(|m| &m.runs)
-                .find(|r| r.training_episodes().is_none())
+                .find(|r| training_episodes(r).is_none())
                 .map_or_else(String::new, |r| r.path.display().to_string());
             bail!(
                 "--steps: expected every run to say where its episodes ended (a step column, \
@@ -181,6 +181,34 @@ fn alignment(
         }
         (None, false, None) => Ok(by_episode()),
     }
+}
+
+/// `run`'s episodes as sapnet's own are kept, each with its length in steps, when its
+/// file places every episode by step (lengths are the steps between two ends) or
+/// gives every length; `None` otherwise.
+fn training_episodes(run: &OutsideRun) -> Option<TrainingEpisodes> {
+    let lengths: Vec<u32> = match run.axis {
+        outside_runs::Axis::Steps => {
+            let mut previous = 0i64;
+            run.episodes
+                .iter()
+                .map(|e| {
+                    let length = e.at.saturating_sub(previous).max(0);
+                    previous = previous.max(e.at);
+                    u32::try_from(length).unwrap_or(u32::MAX)
+                })
+                .collect()
+        }
+        outside_runs::Axis::Episodes => run
+            .episodes
+            .iter()
+            .map(|e| e.length.map(|l| u32::try_from(l).unwrap_or(u32::MAX)))
+            .collect::<Option<_>>()?,
+    };
+    Some(TrainingEpisodes {
+        returns: run.returns().collect(),
+        lengths,
+    })
 }
 
 /// What run `run` scored, read as `episodes` under `budget` (`window` the step curve's
@@ -381,4 +409,42 @@ fn write_runs(path: &Path, methods: &[Method], scored: &[ScoredMethod]) -> Resul
         })
         .collect();
     report::write_rows(path, &header, &records)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::outside_runs::{Episode, Format};
+
+    fn run(returns: &[f64]) -> OutsideRun {
+        OutsideRun {
+            path: "run.csv".into(),
+            format: Format::Csv,
+            series: "return".into(),
+            axis: outside_runs::Axis::Episodes,
+            episodes: returns
+                .iter()
+                .enumerate()
+                .map(|(i, &r)| Episode {
+                    at: i as i64 + 1,
+                    episode_return: r,
+                    length: None,
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn episodes_placed_by_step_give_their_lengths() {
+        let mut r = run(&[1.0, 2.0, 3.0]);
+        assert_eq!(training_episodes(&r), None, "no lengths, no steps");
+        r.axis = outside_runs::Axis::Steps;
+        for (e, at) in r.episodes.iter_mut().zip([10, 30, 60]) {
+            e.at = at;
+        }
+        let episodes = training_episodes(&r).unwrap();
+        assert_eq!(episodes.lengths, [10, 20, 30]);
+        assert_eq!(episodes.ends(), [10, 30, 60]);
+        assert_eq!(r.steps(), Some(60));
+    }
 }

@@ -3,7 +3,6 @@
 use std::num::NonZeroUsize;
 
 use super::OutsideRun;
-use crate::report::TrainingEpisodes;
 
 impl OutsideRun {
     /// The episodes' returns, in order.
@@ -28,34 +27,6 @@ impl OutsideRun {
     pub fn training_return(&self) -> f64 {
         // A run has at least one episode (reading refuses an empty one).
         self.returns().sum::<f64>() / self.episodes.len() as f64
-    }
-
-    /// The run's episodes as sapnet's own are kept, each with its length in steps, when
-    /// its file places every episode by step (lengths are the steps between two ends) or
-    /// gives every length; `None` otherwise.
-    pub fn training_episodes(&self) -> Option<TrainingEpisodes> {
-        let lengths: Vec<u32> = match self.axis {
-            super::Axis::Steps => {
-                let mut previous = 0i64;
-                self.episodes
-                    .iter()
-                    .map(|e| {
-                        let length = e.at.saturating_sub(previous).max(0);
-                        previous = previous.max(e.at);
-                        u32::try_from(length).unwrap_or(u32::MAX)
-                    })
-                    .collect()
-            }
-            super::Axis::Episodes => self
-                .episodes
-                .iter()
-                .map(|e| e.length.map(|l| u32::try_from(l).unwrap_or(u32::MAX)))
-                .collect::<Option<_>>()?,
-        };
-        Some(TrainingEpisodes {
-            returns: self.returns().collect(),
-            lengths,
-        })
     }
 
     /// The mean return of the last `k` episodes, or of all of them if the run has fewer.
@@ -86,20 +57,6 @@ mod tests {
                 })
                 .collect(),
         }
-    }
-
-    #[test]
-    fn episodes_placed_by_step_give_their_lengths() {
-        let mut r = run(&[1.0, 2.0, 3.0]);
-        assert_eq!(r.training_episodes(), None, "no lengths, no steps");
-        r.axis = Axis::Steps;
-        for (e, at) in r.episodes.iter_mut().zip([10, 30, 60]) {
-            e.at = at;
-        }
-        let episodes = r.training_episodes().unwrap();
-        assert_eq!(episodes.lengths, [10, 20, 30]);
-        assert_eq!(episodes.ends(), [10, 30, 60]);
-        assert_eq!(r.steps(), Some(60));
     }
 
     #[test]

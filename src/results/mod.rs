@@ -13,6 +13,7 @@ pub mod records;
 pub mod replot;
 pub mod shipped;
 pub mod summary;
+pub mod sweep;
 
 use std::path::Path;
 

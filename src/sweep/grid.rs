@@ -174,13 +174,7 @@ impl Grid {
     }
 }
 
-/// `sapnet.temperature=0.5, seed=1`.
-pub fn describe(axes: &[(String, String)]) -> String {
-    axes.iter()
-        .map(|(p, v)| format!("{p}={v}"))
-        .collect::<Vec<_>>()
-        .join(", ")
-}
+pub use crate::results::sweep::describe;
 
 /// Sets field `path` of the config `json` to `value` (RON text), read as the config reads
 /// that field: the value goes into a config of defaults at that path, whose JSON then gives

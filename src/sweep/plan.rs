@@ -5,8 +5,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 
-use super::grid::{describe, Grid};
-use super::{cell_config, CellEntry, Manifest};
+use super::grid::Grid;
+use crate::results::sweep::{cell_config, describe, CellEntry, Manifest};
+
 use crate::env::PythonSettings;
 use crate::policy_store::{sha256_hex, write_atomically};
 use crate::ron_file::ron_options;

@@ -10,15 +10,15 @@ use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
 
-use super::status::{state, CellState};
-use super::{
-    cell_config, cell_failure, cell_lock, cell_name, cell_partial, cell_results, Manifest,
-};
 use crate::config::Config;
 use crate::env::PythonSettings;
+use crate::experiment::{self, OutputOptions, RunOptions};
 use crate::folder_lock::FolderLock;
-use crate::headless::{self, OutputOptions, RunOptions};
 use crate::policy_store::sha256_hex;
+use crate::results::sweep::status::{state, CellState};
+use crate::results::sweep::{
+    cell_config, cell_failure, cell_lock, cell_name, cell_partial, cell_results, Manifest,
+};
 use crate::sources::{self, LibraryRoot};
 use crate::trainer::Command as TrainerCommand;
 
@@ -100,7 +100,7 @@ pub fn run_cell(
 fn attempt(
     sweep: &Path,
     manifest: &Manifest,
-    entry: &super::CellEntry,
+    entry: &crate::results::sweep::CellEntry,
     jobs: usize,
     python: &PythonSettings,
     stop: &Receiver<TrainerCommand>,
@@ -147,7 +147,7 @@ fn attempt(
             sweep.display()
         );
     }
-    let summary = headless::run(&config, &output, &options, stop)
+    let summary = experiment::run(&config, &output, &options, stop)
         .with_context(|| format!("cell {}", cell_name(id)))?;
     if summary.stopped() {
         return Ok(CellRun::Stopped);

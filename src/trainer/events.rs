@@ -336,7 +336,7 @@ pub enum Event {
         run: u32,
         method: MethodId,
         /// Episodes or environment steps the run is given.
-        budget: crate::config::Budget,
+        budget: crate::trainer::Budget,
         /// Present for runs that reuse the library.
         library: Option<Box<LibraryStart>>,
     },

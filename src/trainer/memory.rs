@@ -4,8 +4,8 @@
 
 use anyhow::{bail, Result};
 
-use crate::config::Budget;
 use crate::dqn::Architecture;
+use crate::trainer::Budget;
 use crate::trainer::RunSpec;
 
 /// Copies of a learning network's parameters: online, target, Adam's two moments, and the

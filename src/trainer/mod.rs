@@ -5,6 +5,7 @@
 //!   scratch; the source policies are trained as DQN from scratch);
 //! - [`spawn`]: a run on a thread of its own, with its command channel.
 
+mod budget;
 mod control;
 mod events;
 pub mod memory;
@@ -19,6 +20,7 @@ use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::Arc;
 use std::thread::{self, JoinHandle};
 
+pub use budget::Budget;
 pub use events::{
     ActivationSnapshot, ChosenPolicy, Command, CutEpisode, Deposit, EpisodeRecord, Event,
     LibraryStart, LockIn, MethodId, RunRecord, SourceSummary, StepRecord, StreamOptions,

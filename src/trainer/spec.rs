@@ -5,11 +5,11 @@ use std::sync::Arc;
 
 use super::events::{MethodId, StreamOptions};
 use super::TrainerError;
-use crate::config::Budget;
 use crate::dqn::{DqnConfig, DqnError, FrozenNet, QNet};
 use crate::env::EnvConfig;
 use crate::reuse::{self, Method};
 use crate::sapnet::{PolicyDescription, SapNetParams};
+use crate::trainer::Budget;
 
 /// A policy of the source library, ready to be reused.
 #[derive(Debug)]

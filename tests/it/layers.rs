@@ -31,21 +31,15 @@ use std::path::Path;
 /// (which brought `ron_file`).
 const LAYERS: &[(&str, &[&str])] = &[
     ("the dispatch", &["app"]),
-    (
-        "front ends",
-        &[
-            "tui",
-            "headless",
-            "sweep",
-            "teach",
-            "env_command",
-            "compare",
-        ],
-    ),
+    ("front ends", FRONT_ENDS),
     ("the command line's arguments", &["cli"]),
+    ("the teaching session", &["teach"]),
+    (
+        "protocols: planning them, running them into results folders",
+        &["experiment"],
+    ),
     ("results folders", &["results"]),
     ("the comparison and its plots", &["report"]),
-    ("protocols: planning and scheduling runs", &["experiment"]),
     ("training the source library", &["sources::train"]),
     ("the source library", &["sources"]),
     ("the run configuration", &["config"]),
@@ -78,12 +72,71 @@ const LAYERS: &[(&str, &[&str])] = &[
     ),
 ];
 
+/// The front ends, each its own: a front end drives the engine below it and never another
+/// front end (the protocol runner moved from `headless` to `experiment`, the sweep folder's
+/// format from `sweep` to `results`, for that). Teach's front end is its printed lesson;
+/// the teaching session below is what both it and the terminal UI drive.
+const FRONT_ENDS: &[&str] = &[
+    "tui",
+    "headless",
+    "sweep",
+    "teach::headless",
+    "env_command",
+    "compare",
+];
+
 #[test]
 fn src_imports_only_downward_and_in_no_circle() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let krate = Crate::read(&src);
     let findings = Findings::of(&krate, LAYERS);
     assert!(findings.is_empty(), "{findings}");
+}
+
+#[test]
+fn front_ends_never_import_each_other() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let krate = Crate::read(&src);
+    let found = crosswise(&krate, FRONT_ENDS);
+    assert!(
+        found.is_empty(),
+        "front ends importing each other (FRONT_ENDS in tests/it/layers.rs):\n{}",
+        found.join("\n")
+    );
+}
+
+/// Each import from a file of one of `front_ends` to a file of another.
+fn crosswise(krate: &Crate, front_ends: &[&str]) -> Vec<String> {
+    let holder = |module: &[String]| {
+        layer_of(module, &[("front ends", front_ends)]).and_then(|_| {
+            front_ends
+                .iter()
+                .filter(|e| {
+                    let e: Vec<&str> = e.split("::").collect();
+                    module.len() >= e.len() && module.iter().zip(&e).all(|(m, e)| m == e)
+                })
+                .max_by_key(|e| e.len())
+                .copied()
+        })
+    };
+    let mut found = Vec::new();
+    for (from, tos) in krate.imports() {
+        let Some(own) = holder(&from) else {
+            continue;
+        };
+        for (to, names) in tos {
+            match holder(&to) {
+                Some(other) if other != own => found.push(format!(
+                    "{} ({own}) imports {} from {} ({other})",
+                    krate.name(&from),
+                    join(&names),
+                    krate.name(&to)
+                )),
+                _ => {}
+            }
+        }
+    }
+    found
 }
 
 /// The seams issue 35 sealed, kept: policy reuse knows nothing of the DQN or of policies on
@@ -1023,6 +1076,36 @@ mod tests {
         assert_eq!(
             found.upward,
             ["src/b/mod.rs (core) imports run from src/a.rs (front)"]
+        );
+    }
+
+    /// Two front ends side by side in one layer: the layers allow the import, the rule
+    /// that front ends never import each other does not; a front end's own files and a
+    /// file below it are fine.
+    #[test]
+    fn a_front_end_importing_another_is_said() {
+        let krate = Crate::of([
+            ("src/lib.rs", "mod ui; mod cli; mod t; mod engine;"),
+            (
+                "src/ui/mod.rs",
+                "mod view; use crate::cli::print; use crate::engine::run;",
+            ),
+            ("src/ui/view.rs", "pub fn item() {}"),
+            ("src/cli.rs", "pub fn print() {}"),
+            ("src/t/mod.rs", "mod front; pub fn session() {}"),
+            (
+                "src/t/front.rs",
+                "use crate::t::session; use crate::ui::view::item;",
+            ),
+            ("src/engine.rs", "pub fn run() {}"),
+        ]);
+        let found = crosswise(&krate, &["ui", "cli", "t::front"]);
+        assert_eq!(
+            found,
+            [
+                "src/t/front.rs (t::front) imports item from src/ui/view.rs (ui)",
+                "src/ui/mod.rs (ui) imports print from src/cli.rs (cli)",
+            ]
         );
     }
 

@@ -10,7 +10,7 @@ use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
 use sapnet::config::Config;
-use sapnet::headless::{self, OpenedOutput, OutputOptions, RunOptions, Tap, Watched};
+use sapnet::experiment::{self, OpenedOutput, OutputOptions, RunOptions, Tap, Watched};
 use sapnet::results::folder_state::FolderReader;
 use sapnet::trainer::{Event, MethodId};
 use sapnet::tui::dashboard::Dashboard;
@@ -58,7 +58,7 @@ fn trained_live(config: &Config, out: &Path) -> BTreeMap<(String, u32), Dashboar
     let (to, watched) = mpsc::channel();
     let (_stop, stop) = mpsc::channel();
     let tap = Tap { to, live: None };
-    headless::run_opened(
+    experiment::run_opened(
         config,
         &output,
         OpenedOutput::open(&output).unwrap(),

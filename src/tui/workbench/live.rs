@@ -16,7 +16,7 @@ use super::stderr_capture::StderrCapture;
 use super::{read_on, session_view, Read};
 use crate::config::Config;
 use crate::env::PythonSettings;
-use crate::headless::{self, OpenedOutput, OutputOptions, RunOptions};
+use crate::experiment::{self, OpenedOutput, OutputOptions, RunOptions};
 use crate::results::folder_state::FolderReader;
 use crate::results::Summary;
 use crate::trainer::MethodId;
@@ -249,7 +249,7 @@ impl Running {
         let config = (settings.load)(path)?;
         let followed = default_followed(&config)?;
         let output = OutputOptions {
-            dir: headless::default_out_dir(Some(path)),
+            dir: experiment::default_out_dir(Some(path)),
             force: false,
         };
         let opened = OpenedOutput::open(&output)?;

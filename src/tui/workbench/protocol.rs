@@ -1,5 +1,5 @@
-//! A protocol trained behind the screen: headless's own code ([`headless::run_opened`],
-//! [`headless::resume_tapped`]: its scheduler, seeds and files) on a thread of its own,
+//! A protocol trained behind the screen: the experiment layer's engine ([`experiment::run_opened`],
+//! [`experiment::resume_tapped`]: its scheduler, seeds and files) on a thread of its own,
 //! tapped so that the screen sees every run's events and can steer the one it follows.
 
 use std::path::{Path, PathBuf};
@@ -11,7 +11,7 @@ use anyhow::{Context, Result};
 use super::session::RunKey;
 use crate::config::Config;
 use crate::env::PythonSettings;
-use crate::headless::{self, OpenedOutput, OutputOptions, RunOptions, Tap, Watched};
+use crate::experiment::{self, OpenedOutput, OutputOptions, RunOptions, Tap, Watched};
 use crate::results::Summary;
 use crate::trainer::Command;
 
@@ -36,7 +36,7 @@ impl ProtocolRun {
     ) -> Result<Self> {
         let dir = output.dir.clone();
         Self::spawn(dir, live, move |commands, tap| {
-            headless::run_opened(&config, &output, opened, &options, commands, Some(tap))
+            experiment::run_opened(&config, &output, opened, &options, commands, Some(tap))
         })
     }
 
@@ -50,7 +50,7 @@ impl ProtocolRun {
     ) -> Result<Self> {
         let at = dir.to_path_buf();
         Self::spawn(dir.to_path_buf(), live, move |commands, tap| {
-            headless::resume_tapped(&at, None, None, &python, &options, commands, Some(tap))
+            experiment::resume_tapped(&at, None, None, &python, &options, commands, Some(tap))
         })
     }
 

@@ -20,7 +20,7 @@ use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use super::picker::{Picked, Picker};
 use super::recorded;
 use super::state::{View, Workbench};
-use crate::headless::Watched;
+use crate::experiment::Watched;
 use crate::report::Report;
 use crate::results::folder_state::{FolderState, RunStatus};
 use crate::results::Status;

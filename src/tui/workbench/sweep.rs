@@ -1,7 +1,7 @@
 //! `sapnet open SWEEP_DIR`: a sweep folder (`sapnet sweep plan`) in the Sweep view — its
 //! cells (queued, running, done, failed) and, per axis value, the comparison of its
 //! finished cells, made by the code `sweep merge` writes `merged/comparison.csv` with
-//! ([`crate::sweep::merge::groups`], [`crate::sweep::merge::value_report`]).
+//! ([`crate::results::sweep::merge::groups`], [`crate::results::sweep::merge::value_report`]).
 //!
 //! Read only, as any folder from elsewhere: the manifest, each cell's state as `sweep
 //! status` reads it, a running cell's process from its protocol's lock (never taken) and
@@ -17,8 +17,8 @@ use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use crate::folder_lock::{self, Holder};
 use crate::report::Report;
 use crate::results::folder_state::FolderReader;
-use crate::sweep::status::{self, CellState};
-use crate::sweep::{cell_partial, cell_results, grid, merge, Manifest};
+use crate::results::sweep::status::{self, CellState};
+use crate::results::sweep::{cell_partial, cell_results, describe, merge, Manifest};
 
 /// Whether `dir` is a sweep folder: it holds a manifest, `sweep.ron`.
 pub fn is_sweep(dir: &Path) -> bool {
@@ -109,7 +109,7 @@ impl SweepState {
             };
             cells.push(CellRow {
                 id: cell.id,
-                axes: grid::describe(&cell.axes),
+                axes: describe(&cell.axes),
                 status,
                 progress,
             });
@@ -158,8 +158,10 @@ pub fn comparisons(dir: &Path, done: &[usize]) -> Result<Vec<ValueComparison>> {
     let manifest = Manifest::read(dir)?;
     let mut read = Vec::new();
     for cell in manifest.cells.iter().filter(|c| done.contains(&c.id)) {
-        let results = crate::results::read_results(&cell_results(dir, cell.id))
-            .with_context(|| format!("reading cell {}", crate::sweep::cell_name(cell.id)))?;
+        let results =
+            crate::results::read_results(&cell_results(dir, cell.id)).with_context(|| {
+                format!("reading cell {}", crate::results::sweep::cell_name(cell.id))
+            })?;
         read.push((cell, results));
     }
     let axes: Vec<String> = manifest
@@ -167,7 +169,7 @@ pub fn comparisons(dir: &Path, done: &[usize]) -> Result<Vec<ValueComparison>> {
         .first()
         .map(|c| c.axes.iter().map(|(p, _)| p.clone()).collect())
         .unwrap_or_default();
-    let refs: Vec<(&crate::sweep::CellEntry, &crate::results::Results)> =
+    let refs: Vec<(&crate::results::sweep::CellEntry, &crate::results::Results)> =
         read.iter().map(|(c, r)| (*c, r)).collect();
     Ok(merge::groups(&axes, &refs)
         .into_iter()

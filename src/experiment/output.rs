@@ -8,10 +8,17 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use anyhow::{bail, Context, Result};
 
-use super::OutputOptions;
 use crate::folder_lock::FolderLock;
 use crate::report;
 use crate::results::{self, records, Status};
+
+/// Where results go and whether old ones may be replaced.
+#[derive(Debug, Clone)]
+pub struct OutputOptions {
+    pub dir: PathBuf,
+    /// Replace results already in `dir`.
+    pub force: bool,
+}
 
 /// Entries that mark a directory as holding results already.
 const RESULT_FILES: [&str; 7] = [
