@@ -37,11 +37,12 @@ pub fn assemble(
     ending: Ending,
 ) -> Result<Summary> {
     let folders = records::read(out, config)?;
+    // A run's file or, kept compressed, its xz twin (read as `safe_io::open_csv` reads it).
     let parts = |file: &str| -> Vec<PathBuf> {
         folders
             .iter()
             .map(|f| f.dir.join(file))
-            .filter(|p| p.exists())
+            .filter(|p| crate::safe_io::csv_exists(p))
             .collect()
     };
     concatenate(&out.join("episodes.csv"), &parts("episodes.csv"), |p| {
@@ -111,14 +112,9 @@ fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<
         .open(&tmp)
         .with_context(|| format!("writing {}", tmp.display()))?;
     for part in parts {
-        let mut reader = BufReader::new(
-            crate::safe_io::open(
-                part,
-                crate::safe_io::Links::Refuse,
-                crate::safe_io::MAX_CSV_BYTES,
-            )
-            .with_context(|| format!("reading {}", part.display()))?,
-        );
+        let text = crate::safe_io::open_csv(part)
+            .with_context(|| format!("reading {}", part.display()))?;
+        let mut reader = BufReader::new(crate::safe_io::bounded_lines(text, part));
         let mut header = Vec::new();
         reader
             .read_until(b'\n', &mut header)
@@ -147,11 +143,14 @@ pub fn rewards(folders: &[RunFolder]) -> Result<BTreeMap<(MethodId, u32), Vec<f6
             .deserialize::<Row>()
             .enumerate()
             .map(|(i, row)| {
-                row.map(|r| r.reward)
-                    .with_context(|| format!("{}: row {}", path.display(), i + 2))
+                let reward = row
+                    .map(|r| r.reward)
+                    .with_context(|| format!("{}: row {}", path.display(), i + 2))?;
+                plot_data::a_kept_return(&path, i, reward)
             })
             .collect::<Result<Vec<f64>>>()?;
         let record = &folder.summary.record;
+        plot_data::some_returns(&path, record, returns.len())?;
         rewards.insert((record.method.clone(), record.run), returns);
     }
     Ok(rewards)

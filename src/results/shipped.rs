@@ -71,6 +71,11 @@ pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
         runs.push(run.with_method(method.clone()));
     }
     let rewards = rewards(&dir.join("episodes.csv"), &methods)?;
+    for run in &runs {
+        let key = (run.record.method.clone(), run.record.run);
+        let returns = rewards.get(&key).map_or(0, Vec::len);
+        plot_data::some_returns(&dir.join("episodes.csv"), &run.record, returns)?;
+    }
     Ok(ShippedRuns { runs, rewards })
 }
 
