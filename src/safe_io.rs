@@ -326,9 +326,76 @@ impl Read for XzText {
 }
 
 /// A CSV reader over `path`, a file inside a folder, or its compressed twin (see
-/// [`open_csv`]).
+/// [`open_csv`]), its lines bounded ([`bounded_lines`]).
 pub fn csv_reader(path: &Path) -> io::Result<csv::Reader<Box<dyn Read>>> {
-    Ok(csv::Reader::from_reader(open_csv(path)?))
+    Ok(csv::Reader::from_reader(Box::new(bounded_lines(
+        open_csv(path)?,
+        path,
+    ))))
+}
+
+/// The longest line of a CSV file sapnet reads (a row, quoted line breaks and all): a CSV
+/// reader holds a row whole, so a file of one endless line (a sparse file's hole, a
+/// gigabyte without a line break) would be held whole. A row of `activations.csv` for
+/// 10,000 sources (`MAX_SOURCES`) is under 1 MiB.
+pub const MAX_CSV_LINE_BYTES: u64 = 4 << 20;
+
+/// `text`, read from `path`, refused at a line (outside quotes) longer than
+/// [`MAX_CSV_LINE_BYTES`], naming the file and the line.
+pub fn bounded_lines<R: Read>(text: R, path: &Path) -> impl Read {
+    BoundedLines {
+        text,
+        path: path.to_path_buf(),
+        line: 1,
+        length: 0,
+        quoted: false,
+    }
+}
+
+struct BoundedLines<R> {
+    text: R,
+    path: PathBuf,
+    /// The line being read, 1 for the first.
+    line: u64,
+    /// Its bytes so far.
+    length: u64,
+    /// Inside a quoted field, where a line break is the field's.
+    quoted: bool,
+}
+
+impl<R: Read> Read for BoundedLines<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.text.read(buf)?;
+        for &byte in &buf[..n] {
+            match byte {
+                b'"' => self.quoted = !self.quoted,
+                b'\n' if !self.quoted => {
+                    self.line += 1;
+                    self.length = 0;
+                    continue;
+                }
+                _ => {}
+            }
+            self.length += 1;
+            if self.length > MAX_CSV_LINE_BYTES {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidData,
+                    format!(
+                        "{}: line {} is longer than the {MAX_CSV_LINE_BYTES} bytes a row may \
+                         hold{}: not a CSV file of runs",
+                        self.path.display(),
+                        self.line,
+                        if self.quoted {
+                            " (a quote opened and never closed)"
+                        } else {
+                            ""
+                        }
+                    ),
+                ));
+            }
+        }
+        Ok(n)
+    }
 }
 
 /// A new file at `path`, whatever was there: a stale file or a planted link is removed
