@@ -74,6 +74,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "limits",
             "seeds",
             "assets",
+            "shown_text",
         ],
     ),
 ];
