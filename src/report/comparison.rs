@@ -193,9 +193,13 @@ pub(super) fn library_tasks(library: &[LibraryEntry]) -> Vec<String> {
 /// unscored sources rank last).
 pub(super) fn library_ranks(library: &[LibraryEntry]) -> Vec<usize> {
     let score = |e: &LibraryEntry| e.final_score.unwrap_or(f64::NEG_INFINITY);
+    // 1 + the sources scored higher, counted in the scores sorted best first: O(n log n),
+    // for a library of any length a folder lists.
+    let mut best_first: Vec<f64> = library.iter().map(score).collect();
+    best_first.sort_by(|a, b| b.total_cmp(a));
     library
         .iter()
-        .map(|e| 1 + library.iter().filter(|o| score(o) > score(e)).count())
+        .map(|e| 1 + best_first.partition_point(|&o| o > score(e)))
         .collect()
 }
 
