@@ -34,8 +34,9 @@ pub enum Links {
     Refuse,
 }
 
-/// The longest portable name: a file name's limit on every common file system.
-pub const MAX_NAME_BYTES: usize = 255;
+/// The longest portable name: a file name's limit on every common file system (255
+/// bytes), less room for the longest extension a name is given (`.safetensors`).
+pub const MAX_NAME_BYTES: usize = 240;
 
 /// Whether `name` may name a file in a shared folder and a column of a CSV file: not empty,
 /// at most [`MAX_NAME_BYTES`], only ASCII letters, digits, `.`, `-` and `_`, not starting
@@ -52,7 +53,7 @@ pub fn is_portable_name(name: &str) -> bool {
 
 /// What [`is_portable_name`] expects, for messages.
 pub const PORTABLE_NAME: &str =
-    "letters, digits, `.`, `-` and `_`, not starting with `.`, at most 255 of them";
+    "letters, digits, `.`, `-` and `_`, not starting with `.`, at most 240 of them";
 
 /// Opens `path` for reading if it is a regular file of at most `limit` bytes.
 pub fn open(path: &Path, links: Links, limit: u64) -> io::Result<File> {

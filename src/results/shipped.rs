@@ -27,7 +27,12 @@ struct ListedRuns {
 /// Whether `dir` is a shipped folder this module can make again: no run records, but the
 /// episodes of the runs its summary lists.
 pub fn can_replot(dir: &Path) -> bool {
-    safe_io::csv_exists(&dir.join("episodes.csv"))
+    // Anything there (a link, a FIFO) counts: reading it then says what is wrong with it,
+    // where "no episodes.csv" would send the user to the command that refuses it.
+    let path = dir.join("episodes.csv");
+    [safe_io::xz_twin(&path), path]
+        .iter()
+        .any(|p| std::fs::symlink_metadata(p).is_ok())
 }
 
 /// Every run `dir`'s `summary.json` lists, with its training returns from `episodes.csv`:
