@@ -550,3 +550,29 @@ fn rename(from: &Path, to: &Path) -> Result<(), StoreError> {
         cause: source,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_temporary_name_fits_255_bytes_for_the_longest_policy_name() {
+        let tmp = tempfile::tempdir().unwrap();
+        let name = "p".repeat(crate::safe_io::MAX_NAME_BYTES);
+        assert!(crate::safe_io::is_portable_name(&name));
+        for ext in ["safetensors", "ron"] {
+            let path = tmp.path().join(format!("{name}.{ext}"));
+            let hidden = temporary(&path);
+            let file = hidden.file_name().unwrap().to_str().unwrap();
+            assert!(file.len() <= 255 && file.starts_with('.') && file.ends_with(".tmp"));
+            std::fs::write(&hidden, b"x").unwrap();
+            std::fs::rename(&hidden, &path).unwrap();
+        }
+        // Two long names cut the same are told apart.
+        let other = format!("{}q", "p".repeat(crate::safe_io::MAX_NAME_BYTES - 1));
+        assert_ne!(
+            temporary(&tmp.path().join(format!("{name}.ron"))),
+            temporary(&tmp.path().join(format!("{other}.ron")))
+        );
+    }
+}

@@ -496,6 +496,49 @@ mod tests {
     }
 
     #[test]
+    fn a_sparse_partial_record_is_refused_at_its_line_not_read_whole() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("episodes.csv");
+        std::fs::write(
+            &path,
+            "run,method,episode,reward,steps,loss,statistic_loss,epsilon,policy,wall_s\n",
+        )
+        .unwrap();
+        // A 3 GiB hole, then a line break: one endless line.
+        let file = std::fs::OpenOptions::new().write(true).open(&path).unwrap();
+        file.set_len(3 << 30).unwrap();
+        let mut file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .unwrap();
+        std::io::Write::write_all(&mut file, b"\n").unwrap();
+        let err = format!("{:#}", read_partial(tmp.path()).unwrap_err());
+        assert!(
+            err.contains("episodes.csv: line 2 is longer than the 4194304 bytes"),
+            "{err}"
+        );
+        // Without the line break, the last line itself is past the bound.
+        file.set_len(3 << 30).unwrap();
+        let err = format!("{:#}", read_partial(tmp.path()).unwrap_err());
+        assert!(err.contains("its last line is longer than"), "{err}");
+    }
+
+    #[test]
+    fn the_most_acting_source_is_counted_in_one_pass_first_named_on_a_tie() {
+        let tmp = tempfile::tempdir().unwrap();
+        let mut text = String::from(
+            "run,method,episode,reward,steps,loss,statistic_loss,epsilon,policy,wall_s\n",
+        );
+        for (i, policy) in ["b", "a", "", "a", "b", "c"].iter().enumerate() {
+            text.push_str(&format!("0,sapnet,{i},1.0,1,,0.0,0.03,{policy},0.5\n"));
+        }
+        std::fs::write(tmp.path().join("episodes.csv"), text).unwrap();
+        let episodes = read_partial(tmp.path()).unwrap().unwrap();
+        assert_eq!(episodes.most_acting().as_deref(), Some("b"));
+        assert_eq!(episodes.returns.len(), 6);
+    }
+
+    #[test]
     fn a_bad_row_is_refused_naming_the_file_its_row_and_the_columns() {
         let tmp = tempfile::tempdir().unwrap();
         std::fs::write(
