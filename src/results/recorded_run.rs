@@ -173,11 +173,25 @@ impl RunFiles {
     }
 }
 
+/// The most sources whose graph a finished run's dashboard builds again: 1,000 (the paper's
+/// library has 10), a million edges.
+pub const MAX_DRAWN_SOURCES: usize = 1_000;
+
 /// The library and the graph the run's selector drew on, made as the run made them: the
 /// selector built again from the library's descriptions and scores (SAP-Net's own net; for
 /// another selector the library's graph under the config's SAP-Net section).
 fn library_start(folder: &FolderState, method: &MethodId) -> Result<LibraryStart> {
     let config = &folder.config;
+    // The graph is n × n: 10,000 sources (a library's bound) take gigabytes and minutes to
+    // build again, for a screen that shows a few dozen of them.
+    if folder.library.len() > MAX_DRAWN_SOURCES {
+        bail!(
+            "{}: a library of {} sources: a finished run's dashboard builds the graph of at \
+             most {MAX_DRAWN_SOURCES} (its comparison and curves are in the other views)",
+            folder.dir.display(),
+            folder.library.len()
+        );
+    }
     let descriptions: Vec<_> = folder.library.iter().map(|e| e.description()).collect();
     let scores: Vec<Option<f64>> = folder.library.iter().map(|e| e.final_score).collect();
     let library = Library {

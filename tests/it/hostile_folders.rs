@@ -1277,6 +1277,30 @@ fn a_library_past_its_bound_or_counts_shorter_than_it_are_refused() {
         "library: 10001 sources, more than the 10000 a library may hold",
         Duration::from_secs(20),
     );
+    // Within MAX_SOURCES, a library whose graph a dashboard would take minutes to build
+    // again is a notice on Enter.
+    let mut json = original.clone();
+    let entry = json["library"][0].clone();
+    json["library"] = serde_json::Value::Array(vec![entry; 1_001]);
+    for run in json["runs"].as_array_mut().unwrap() {
+        for field in ["source_steps", "positive", "negative"] {
+            run[field] = serde_json::json!([]);
+        }
+    }
+    std::fs::write(&path, serde_json::to_string(&json).unwrap()).unwrap();
+    let folder = sapnet::results::folder_state::FolderReader::new(&dir)
+        .read()
+        .unwrap();
+    let run = &folder.runs[0];
+    let started = Instant::now();
+    let err = sapnet::results::recorded_run::read(&folder, &run.method, run.run, &mut |_| {})
+        .err()
+        .expect("refused");
+    assert!(
+        format!("{err:#}").contains("a library of 1001 sources: a finished run's dashboard"),
+        "{err:#}"
+    );
+    assert!(started.elapsed() < Duration::from_secs(5));
     let mut json = original;
     json["runs"][0]["positive"] = serde_json::json!([1, 2]);
     std::fs::write(&path, serde_json::to_string(&json).unwrap()).unwrap();
