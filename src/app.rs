@@ -53,11 +53,16 @@ pub fn run(cli: Cli) -> Result<()> {
             );
             print_stdout(&report.table())
         }
-        // A sweep folder opens in the Sweep view, any other in the workbench's views.
-        Some(Command::Open(args)) if tui::workbench::sweep::is_sweep(&args.dir) => {
-            tui::workbench::sweep_screen::run(&args.dir)
+        Some(Command::Open(args)) => {
+            // SIGINT, SIGTERM or SIGHUP leave as `q` does, the terminal restored.
+            let _stop = crate::signals::stop_on_signals()?;
+            // A sweep folder opens in the Sweep view, any other in the workbench's views.
+            if tui::workbench::sweep::is_sweep(&args.dir) {
+                tui::workbench::sweep_screen::run(&args.dir)
+            } else {
+                tui::workbench::run(&args.dir)
+            }
         }
-        Some(Command::Open(args)) => tui::workbench::run(&args.dir),
         Some(Command::Plot(args)) => {
             let summary = results::replot(&args.dir)?;
             eprintln!(
@@ -485,7 +490,8 @@ fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {
             import.file.display(),
             origin.format.describe(),
             origin.framework,
-            origin.prefix,
+            // The state dict's own keys: shown as data.
+            crate::shown_text::escaped(&origin.prefix),
             done.dir.display(),
             import.name,
             done.architecture,

@@ -67,8 +67,21 @@ pub fn compare(args: &CompareArgs) -> Result<Report> {
     }
     let (task, range) = task_and_range(args, &methods)?;
     let out = &args.out;
-    if out.exists() && std::fs::read_dir(out)?.next().is_some() {
-        bail!("--out {}: expected a new or empty directory", out.display());
+    match std::fs::metadata(out) {
+        Ok(m) if !m.is_dir() => bail!(
+            "--out {}: a file is there, expected a new or empty directory (the report is \
+             several files)",
+            out.display()
+        ),
+        Ok(_) => {
+            let mut entries =
+                std::fs::read_dir(out).with_context(|| format!("--out {}", out.display()))?;
+            if entries.next().is_some() {
+                bail!("--out {}: expected a new or empty directory", out.display());
+            }
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(e).with_context(|| format!("--out {}", out.display())),
     }
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
 

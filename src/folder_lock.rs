@@ -58,18 +58,11 @@ impl FolderLock {
         match file.try_lock() {
             Ok(()) => {}
             Err(std::fs::TryLockError::WouldBlock) => {
-                let mut holder = String::new();
-                let _ = file.read_to_string(&mut holder);
-                let holder = holder.trim();
                 bail!(
                     "{} is in use by another sapnet process ({}): {what} cannot start there \
                      until it ends (or choose another folder)",
                     dir.display(),
-                    if holder.is_empty() {
-                        "starting"
-                    } else {
-                        holder
-                    }
+                    in_use(&file)
                 );
             }
             Err(std::fs::TryLockError::Error(e)) => {
@@ -172,6 +165,44 @@ pub fn holder(dir: &Path) -> Result<Option<Holder>> {
         pid,
         says: says.trim().to_string(),
     }))
+}
+
+/// The most of a lock file read: sapnet's line is a few dozen bytes; a lock file grown
+/// past this (a planted one of gigabytes) was not written by sapnet.
+const LOCK_TEXT_BYTES: u64 = 1024;
+
+/// Who holds the lock on `file`: the PID the kernel names (`/proc/locks`), with the rest
+/// of the line the holder wrote (`on host since 10:02:07 UTC (the protocol)`) when that
+/// line names the same PID; the file's text alone is not taken as the holder.
+fn in_use(file: &File) -> String {
+    use std::os::unix::fs::MetadataExt;
+    let mut bytes = Vec::new();
+    let _ = file.take(LOCK_TEXT_BYTES).read_to_end(&mut bytes);
+    let text = String::from_utf8_lossy(&bytes);
+    let line = text.lines().next().unwrap_or("").trim();
+    let real = file.metadata().ok().and_then(|m| {
+        let locks = std::fs::read_to_string("/proc/locks").ok()?;
+        flock_holder(&locks, libc::major(m.dev()), libc::minor(m.dev()), m.ino())
+    });
+    let claimed = line.strip_prefix("running as PID ").and_then(|rest| {
+        let digits = rest
+            .find(|c: char| !c.is_ascii_digit())
+            .unwrap_or(rest.len());
+        Some((rest[..digits].parse::<u32>().ok()?, &rest[digits..]))
+    });
+    let shown = |text: &str| crate::shown_text::cut(text, 200);
+    match (real, claimed) {
+        (Some(pid), Some((said, rest))) if said == pid => {
+            format!("running as PID {pid}{}", shown(rest))
+        }
+        (Some(pid), _) if line.is_empty() => format!("running as PID {pid}, starting"),
+        (Some(pid), _) => format!(
+            "running as PID {pid}; its lock file says \"{}\"",
+            shown(line)
+        ),
+        (None, _) if line.is_empty() => "starting".to_string(),
+        (None, _) => format!("its lock file says \"{}\"", shown(line)),
+    }
 }
 
 /// The PID holding a `flock` on the file `major:minor:inode` among `/proc/locks`' lines

@@ -45,6 +45,7 @@ pub mod ron_file;
 pub mod safe_io;
 pub mod sapnet;
 pub mod seeds;
+pub mod shown_text;
 pub mod signals;
 pub mod sources;
 pub mod stats;

@@ -30,3 +30,10 @@ pub const MAX_STEPS: u64 = 1_000_000_000_000;
 /// Most hidden layers a network may have: far deeper than these tasks need, and a bound on
 /// the names that results derive from a method's layers.
 pub const MAX_HIDDEN_LAYERS: usize = 64;
+
+/// The most numbers a reader keeps from one CSV file of a folder or a run (8 bytes each):
+/// a return per row of `episodes.csv`, `tests.csv` or a monitor file, three per source per
+/// row of `activations.csv`. 2^25: a third more than the largest protocol a folder is known
+/// to hold (24 M episodes), 256 MiB of values. So a file of short rows, within its size
+/// bound or decompressed from a few kilobytes, cannot make a reader keep gigabytes.
+pub const MAX_VALUES_KEPT: usize = 1 << 25;

@@ -23,7 +23,12 @@ fn main() -> ExitCode {
         if is_broken_pipe(err) {
             return ExitCode::SUCCESS;
         }
-        eprintln!("error: {err:#}");
+        // A refusal may quote a received file: shown as data, never the terminal's
+        // commands.
+        eprintln!(
+            "error: {}",
+            sapnet::shown_text::escaped_lines(&format!("{err:#}"))
+        );
     }
     // A run stopped by a signal wrote what it had; the exit code says which signal.
     if let Some(signal) = sapnet::signals::received() {

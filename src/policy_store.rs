@@ -491,17 +491,29 @@ pub fn remove_temporaries(dir: &Path) -> std::io::Result<()> {
     Ok(())
 }
 
-/// A hidden sibling of `path`, unique to this process; `*.tmp` is ignored by git.
 /// Room for a weights file's JSON header beyond the tensors themselves: the names,
 /// shapes and offsets of a 64-layer network take a few kilobytes.
 const MAX_HEADER_BYTES: u64 = 1 << 20;
 
+/// A hidden sibling of `path`, unique to this process; `*.tmp` is ignored by git. Its name
+/// fits a file system's 255 bytes whatever the policy's name: a long one is cut and told
+/// apart from others cut the same by a hash of the whole.
 fn temporary(path: &Path) -> PathBuf {
+    use std::hash::{Hash, Hasher};
     let file = path
         .file_name()
         .and_then(|f| f.to_str())
         .unwrap_or("policy");
-    path.with_file_name(format!(".{file}.{}.tmp", std::process::id()))
+    let pid = std::process::id();
+    let whole = format!(".{file}.{pid}.tmp");
+    if whole.len() <= 255 {
+        return path.with_file_name(whole);
+    }
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    file.hash(&mut hasher);
+    // Portable names are ASCII: any byte is a character's end.
+    let cut = &file[..200.min(file.len())];
+    path.with_file_name(format!(".{cut}-{:016x}.{pid}.tmp", hasher.finish()))
 }
 
 /// The bytes of a weights file, a regular file of at most `limit` bytes read without
@@ -537,4 +549,30 @@ fn rename(from: &Path, to: &Path) -> Result<(), StoreError> {
         path: to.to_path_buf(),
         cause: source,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_temporary_name_fits_255_bytes_for_the_longest_policy_name() {
+        let tmp = tempfile::tempdir().unwrap();
+        let name = "p".repeat(crate::safe_io::MAX_NAME_BYTES);
+        assert!(crate::safe_io::is_portable_name(&name));
+        for ext in ["safetensors", "ron"] {
+            let path = tmp.path().join(format!("{name}.{ext}"));
+            let hidden = temporary(&path);
+            let file = hidden.file_name().unwrap().to_str().unwrap();
+            assert!(file.len() <= 255 && file.starts_with('.') && file.ends_with(".tmp"));
+            std::fs::write(&hidden, b"x").unwrap();
+            std::fs::rename(&hidden, &path).unwrap();
+        }
+        // Two long names cut the same are told apart.
+        let other = format!("{}q", "p".repeat(crate::safe_io::MAX_NAME_BYTES - 1));
+        assert_ne!(
+            temporary(&tmp.path().join(format!("{name}.ron"))),
+            temporary(&tmp.path().join(format!("{other}.ron")))
+        );
+    }
 }

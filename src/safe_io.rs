@@ -34,8 +34,9 @@ pub enum Links {
     Refuse,
 }
 
-/// The longest portable name: a file name's limit on every common file system.
-pub const MAX_NAME_BYTES: usize = 255;
+/// The longest portable name: a file name's limit on every common file system (255
+/// bytes), less room for the longest extension a name is given (`.safetensors`).
+pub const MAX_NAME_BYTES: usize = 240;
 
 /// Whether `name` may name a file in a shared folder and a column of a CSV file: not empty,
 /// at most [`MAX_NAME_BYTES`], only ASCII letters, digits, `.`, `-` and `_`, not starting
@@ -52,7 +53,7 @@ pub fn is_portable_name(name: &str) -> bool {
 
 /// What [`is_portable_name`] expects, for messages.
 pub const PORTABLE_NAME: &str =
-    "letters, digits, `.`, `-` and `_`, not starting with `.`, at most 255 of them";
+    "letters, digits, `.`, `-` and `_`, not starting with `.`, at most 240 of them";
 
 /// Opens `path` for reading if it is a regular file of at most `limit` bytes.
 pub fn open(path: &Path, links: Links, limit: u64) -> io::Result<File> {
@@ -119,25 +120,32 @@ pub fn read_text(path: &Path, links: Links, limit: u64) -> io::Result<String> {
 /// hundreds of megabytes; this bounds what a doctored folder can make sapnet read.
 pub const MAX_CSV_BYTES: u64 = 16 << 30;
 
-/// The most a compressed CSV file ([`open_csv`]) may decompress to: it is held in memory.
-/// The docs' largest `episodes.csv` is 23 MB.
+/// The most a compressed CSV file ([`open_csv`]) may decompress to: it is read as a
+/// stream, so this bounds the time a few kilobytes of xz can cost (and the rows a reader
+/// could be asked to keep), not what is held at once. The docs' largest `episodes.csv` is
+/// 23 MB.
 pub const MAX_DECOMPRESSED_CSV_BYTES: u64 = 1 << 30;
 
+/// The largest dictionary a compressed CSV file may declare: `xz -9`'s. The dictionary is
+/// what decompressing holds (with a 64 KiB buffer), whatever the file decompresses to.
+pub const MAX_XZ_DICTIONARY_BYTES: usize = 64 << 20;
+
 /// A CSV file inside a folder (see [`open`]), or, if it is absent, its xz-compressed twin
-/// `<name>.xz` decompressed in memory: `docs/`'s folders ship their `episodes.csv` so. The
-/// twin is read as the file is (a regular file, never through a link) and may decompress to
-/// at most [`MAX_DECOMPRESSED_CSV_BYTES`].
+/// `<name>.xz` decompressed as it is read: `docs/`'s folders ship their `episodes.csv` so.
+/// The twin is read as the file is (a regular file, never through a link), may declare a
+/// dictionary of at most [`MAX_XZ_DICTIONARY_BYTES`] and decompress to at most
+/// [`MAX_DECOMPRESSED_CSV_BYTES`]; its errors name it.
 pub fn open_csv(path: &Path) -> io::Result<Box<dyn Read>> {
     match open(path, Links::Refuse, MAX_CSV_BYTES) {
         Ok(file) => Ok(Box::new(file)),
         Err(e) if e.kind() == io::ErrorKind::NotFound => {
             let compressed = xz_twin(path);
             match open(&compressed, Links::Refuse, MAX_CSV_BYTES) {
-                Ok(file) => decompress_xz(file, MAX_DECOMPRESSED_CSV_BYTES)
-                    .map(|bytes| Box::new(io::Cursor::new(bytes)) as Box<dyn Read>)
-                    .map_err(|why| {
-                        io::Error::new(why.kind(), format!("{}: {why}", compressed.display()))
-                    }),
+                Ok(file) => Ok(Box::new(XzText::new(
+                    file,
+                    compressed,
+                    MAX_DECOMPRESSED_CSV_BYTES,
+                ))),
                 // Neither: the error names the file asked for.
                 Err(twin) if twin.kind() == io::ErrorKind::NotFound => Err(e),
                 Err(twin) => Err(io::Error::new(
@@ -157,52 +165,238 @@ pub fn csv_exists(path: &Path) -> bool {
         .any(|p| std::fs::symlink_metadata(p).is_ok_and(|m| m.is_file()))
 }
 
-fn xz_twin(path: &Path) -> PathBuf {
+/// `<name>.xz` beside `path`.
+pub fn xz_twin(path: &Path) -> PathBuf {
     let mut name = path.file_name().unwrap_or_default().to_os_string();
     name.push(".xz");
     path.with_file_name(name)
 }
 
-/// The bytes an xz stream decompresses to, refused past `limit`: a few kilobytes of xz can
-/// stand for gigabytes.
-fn decompress_xz(file: File, limit: u64) -> io::Result<Vec<u8>> {
-    struct Bounded {
-        bytes: Vec<u8>,
-        limit: u64,
+/// An xz file decompressed as it is read, refused past `limit` bytes out: a few kilobytes
+/// of xz can stand for gigabytes. What it holds is the dictionary the file declares
+/// (at most [`MAX_XZ_DICTIONARY_BYTES`]) and one input buffer, never a block. Streams
+/// written one after the other (`cat a.xz b.xz`) are read as `xz -d` reads them.
+struct XzText {
+    decoder: Box<xz4rust::XzDecoder<'static>>,
+    file: File,
+    /// Compressed bytes read and not yet decoded: `buffer[start..end]`.
+    buffer: Vec<u8>,
+    start: usize,
+    end: usize,
+    /// Past a stream's end: padding, another stream or the file's end follows.
+    between: bool,
+    /// Whether the file held any byte.
+    any: bool,
+    path: PathBuf,
+    out: u64,
+    limit: u64,
+}
+
+impl XzText {
+    fn new(file: File, path: PathBuf, limit: u64) -> Self {
+        Self {
+            decoder: xz4rust::XzDecoder::in_heap_with_alloc_dict_size(
+                xz4rust::DICT_SIZE_MIN,
+                MAX_XZ_DICTIONARY_BYTES,
+            ),
+            file,
+            buffer: vec![0; 64 << 10],
+            start: 0,
+            end: 0,
+            between: false,
+            any: false,
+            path,
+            out: 0,
+            limit,
+        }
     }
-    impl Write for Bounded {
-        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-            if (self.bytes.len() + buf.len()) as u64 > self.limit {
-                return Err(refused(&format!(
-                    "decompresses to more than the {} bytes sapnet reads into memory: \
-                     decompress it yourself (xz -dk)",
-                    self.limit
-                )));
+
+    /// Reads more of the file behind what is left; the bytes read, 0 at its end.
+    fn fill(&mut self) -> io::Result<usize> {
+        self.buffer.copy_within(self.start..self.end, 0);
+        self.end -= self.start;
+        self.start = 0;
+        let n = loop {
+            match self.file.read(&mut self.buffer[self.end..]) {
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+                read => break read?,
             }
-            self.bytes.extend_from_slice(buf);
-            Ok(buf.len())
+        };
+        self.end += n;
+        self.any |= n > 0;
+        Ok(n)
+    }
+
+    /// More input for the stream being decoded; its absence is a truncated file.
+    fn more(&mut self) -> io::Result<()> {
+        if self.fill()? > 0 {
+            return Ok(());
         }
-        fn flush(&mut self) -> io::Result<()> {
-            Ok(())
+        Err(self.error(if self.any {
+            "truncated: the file ends inside its xz stream (a copy cut short?); `xz -t` tests it"
+        } else {
+            "empty: not an xz file"
+        }))
+    }
+
+    fn error(&self, why: &str) -> io::Error {
+        io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("{}: {why}", self.path.display()),
+        )
+    }
+
+    /// The decoder's errors in words: what was wrong with the file, and what to do.
+    fn decoding_error(&self, error: &xz4rust::XzError) -> io::Error {
+        match error {
+            xz4rust::XzError::DictionaryTooLarge(bytes) => self.error(&format!(
+                "declares an xz dictionary of {bytes} bytes, more than the {} sapnet holds \
+                 (xz -9's): decompress it yourself (xz -dk) beside it",
+                MAX_XZ_DICTIONARY_BYTES
+            )),
+            xz4rust::XzError::StreamHeaderMagicNumberMismatch => {
+                self.error("not an xz file (its first bytes are not xz's)")
+            }
+            other => self.error(&format!(
+                "damaged, or not an xz file this reader can decompress ({other}); `xz -t` \
+                 tests it"
+            )),
         }
     }
-    let mut out = Bounded {
-        bytes: Vec::new(),
-        limit,
-    };
-    lzma_rs::xz_decompress(&mut io::BufReader::new(file), &mut out).map_err(|e| match e {
-        lzma_rs::error::Error::IoError(e) => e,
-        other => refused(&format!(
-            "not an xz file this reader can decompress: {other}"
-        )),
-    })?;
-    Ok(out.bytes)
+
+    /// Counts `n` bytes out against the bound.
+    fn produced(&mut self, n: usize) -> io::Result<usize> {
+        self.out += n as u64;
+        if self.out > self.limit {
+            return Err(self.error(&format!(
+                "decompresses to more than the {} bytes sapnet reads from a compressed file: \
+                 decompress it yourself (xz -dk) beside it",
+                self.limit
+            )));
+        }
+        Ok(n)
+    }
+}
+
+impl Read for XzText {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        use xz4rust::{XzError, XzNextBlockResult};
+        if buf.is_empty() {
+            return Ok(0);
+        }
+        loop {
+            if self.between {
+                // Stream padding (zeros), then another stream or the end.
+                while self.start < self.end && self.buffer[self.start] == 0 {
+                    self.start += 1;
+                }
+                if self.start == self.end {
+                    if self.fill()? == 0 {
+                        return Ok(0);
+                    }
+                    continue;
+                }
+                self.decoder.reset();
+                self.between = false;
+            }
+            if self.start == self.end {
+                self.more()?;
+            }
+            match self.decoder.decode(&self.buffer[self.start..self.end], buf) {
+                Ok(XzNextBlockResult::NeedMoreData(used, n)) => {
+                    self.start += used;
+                    if n > 0 {
+                        return self.produced(n);
+                    }
+                    if used == 0 {
+                        self.more()?;
+                    }
+                }
+                Ok(XzNextBlockResult::EndOfStream(used, n)) => {
+                    self.start += used;
+                    self.between = true;
+                    if n > 0 {
+                        return self.produced(n);
+                    }
+                }
+                Err(XzError::NeedsLargerInputBuffer) => self.more()?,
+                Err(other) => return Err(self.decoding_error(&other)),
+            }
+        }
+    }
 }
 
 /// A CSV reader over `path`, a file inside a folder, or its compressed twin (see
-/// [`open_csv`]).
+/// [`open_csv`]), its lines bounded ([`bounded_lines`]).
 pub fn csv_reader(path: &Path) -> io::Result<csv::Reader<Box<dyn Read>>> {
-    Ok(csv::Reader::from_reader(open_csv(path)?))
+    Ok(csv::Reader::from_reader(Box::new(bounded_lines(
+        open_csv(path)?,
+        path,
+    ))))
+}
+
+/// The longest line of a CSV file sapnet reads (a row, quoted line breaks and all): a CSV
+/// reader holds a row whole, so a file of one endless line (a sparse file's hole, a
+/// gigabyte without a line break) would be held whole. A row of `activations.csv` for
+/// 10,000 sources (`MAX_SOURCES`) is under 1 MiB.
+pub const MAX_CSV_LINE_BYTES: u64 = 4 << 20;
+
+/// `text`, read from `path`, refused at a line (outside quotes) longer than
+/// [`MAX_CSV_LINE_BYTES`], naming the file and the line.
+pub fn bounded_lines<R: Read>(text: R, path: &Path) -> impl Read {
+    BoundedLines {
+        text,
+        path: path.to_path_buf(),
+        line: 1,
+        length: 0,
+        quoted: false,
+    }
+}
+
+struct BoundedLines<R> {
+    text: R,
+    path: PathBuf,
+    /// The line being read, 1 for the first.
+    line: u64,
+    /// Its bytes so far.
+    length: u64,
+    /// Inside a quoted field, where a line break is the field's.
+    quoted: bool,
+}
+
+impl<R: Read> Read for BoundedLines<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.text.read(buf)?;
+        for &byte in &buf[..n] {
+            match byte {
+                b'"' => self.quoted = !self.quoted,
+                b'\n' if !self.quoted => {
+                    self.line += 1;
+                    self.length = 0;
+                    continue;
+                }
+                _ => {}
+            }
+            self.length += 1;
+            if self.length > MAX_CSV_LINE_BYTES {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidData,
+                    format!(
+                        "{}: line {} is longer than the {MAX_CSV_LINE_BYTES} bytes a row may \
+                         hold{}: not a CSV file of runs",
+                        self.path.display(),
+                        self.line,
+                        if self.quoted {
+                            " (a quote opened and never closed)"
+                        } else {
+                            ""
+                        }
+                    ),
+                ));
+            }
+        }
+        Ok(n)
+    }
 }
 
 /// A new file at `path`, whatever was there: a stale file or a planted link is removed
@@ -365,12 +559,67 @@ mod tests {
         let err = read_csv(&path).unwrap_err().to_string();
         assert!(err.contains("episodes.csv.xz"), "{err}");
         // A megabyte of zeros, read with a kilobyte's bound.
-        let bomb = xz(&vec![0; 1 << 20]);
-        let err = decompress_xz(File::open(write_tmp(&tmp, &bomb)).unwrap(), 1024).unwrap_err();
+        let bomb = write_tmp(&tmp, &xz(&vec![0; 1 << 20]));
+        let mut text = XzText::new(File::open(&bomb).unwrap(), bomb.clone(), 1024);
+        let err = io::copy(&mut text, &mut io::sink()).unwrap_err();
         assert!(
             err.to_string().contains("more than the 1024 bytes"),
             "{err}"
         );
+        // At the bound exactly, it is read whole.
+        let mut text = XzText::new(File::open(&bomb).unwrap(), bomb, 1 << 20);
+        assert_eq!(io::copy(&mut text, &mut io::sink()).unwrap(), 1 << 20);
+    }
+
+    /// `xz` itself, where the machine has it (real compression, real dictionaries).
+    fn xz_tool(args: &[&str], input: &[u8]) -> Option<Vec<u8>> {
+        let mut child = std::process::Command::new("xz")
+            .args(args)
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .ok()?;
+        let mut stdin = child.stdin.take().unwrap();
+        let input = input.to_vec();
+        let writer = std::thread::spawn(move || stdin.write_all(&input));
+        let output = child.wait_with_output().ok()?;
+        writer.join().unwrap().ok()?;
+        output.status.success().then_some(output.stdout)
+    }
+
+    #[test]
+    fn a_truncated_file_a_huge_dictionary_and_concatenated_streams_are_said_plainly() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("episodes.csv");
+        let twin = tmp.path().join("episodes.csv.xz");
+        let rows: String = (0..20_000).map(|i| format!("0,{i}.5\n")).collect();
+        let Some(whole) = xz_tool(&["-c"], rows.as_bytes()) else {
+            eprintln!("no xz on this machine: skipped");
+            return;
+        };
+        std::fs::write(&twin, &whole[..whole.len() / 2]).unwrap();
+        let err = read_csv(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("episodes.csv.xz: truncated: the file ends inside its xz stream"),
+            "{err}"
+        );
+        // Two streams one after the other, with stream padding between them, as `xz -d`.
+        let mut two = whole.clone();
+        two.extend_from_slice(&[0; 8]);
+        two.extend_from_slice(&whole);
+        std::fs::write(&twin, &two).unwrap();
+        assert_eq!(read_csv(&path).unwrap(), rows.repeat(2));
+        // A dictionary past xz -9's is refused before it is allocated.
+        let big = xz_tool(&["-c", "--lzma2=dict=128MiB"], b"run\n").unwrap();
+        std::fs::write(&twin, big).unwrap();
+        let err = read_csv(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("declares an xz dictionary of 134217728 bytes, more than the 67108864"),
+            "{err}"
+        );
+        std::fs::write(&twin, b"run,reward\n0,1\n").unwrap();
+        let err = read_csv(&path).unwrap_err().to_string();
+        assert!(err.contains("not an xz file"), "{err}");
     }
 
     fn write_tmp(tmp: &tempfile::TempDir, bytes: &[u8]) -> PathBuf {

@@ -167,15 +167,17 @@ fn not_linear(key: &str) -> String {
 }
 
 fn prefixes<'a>(keys: impl Iterator<Item = &'a String>) -> String {
-    keys.map(|k| {
-        if k.is_empty() {
-            "the bare layers `0.weight`, ...".to_string()
-        } else {
-            format!("`{k}`")
-        }
-    })
-    .collect::<Vec<_>>()
-    .join(", ")
+    // A state dict may hold thousands: the refusal stays a line.
+    crate::shown_text::cut_list(
+        keys.map(|k| {
+            if k.is_empty() {
+                "the bare layers `0.weight`, ...".to_string()
+            } else {
+                format!("`{}`", crate::shown_text::escaped(k))
+            }
+        }),
+        20,
+    )
 }
 
 #[cfg(test)]

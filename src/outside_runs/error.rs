@@ -41,6 +41,13 @@ pub enum OutsideRunError {
     #[error("{}: not a run sapnet can read ({why}): a run is a Stable-Baselines3 monitor.csv, \
              a CSV with a header, or a TensorBoard event file or folder of them", path.display())]
     UnknownFormat { path: PathBuf, why: &'static str },
+    #[error("{}: line {line}: more than the {limit} {what}", path.display())]
+    TooManyRows {
+        path: PathBuf,
+        line: u64,
+        limit: usize,
+        what: &'static str,
+    },
     #[error("{}: no episode: {what} holds no value", path.display())]
     NoEpisode { path: PathBuf, what: String },
     #[error("{}: {at}: {text:?} is not {expected}", path.display())]
@@ -83,6 +90,9 @@ pub enum OutsideRunError {
 /// `"a", "b" or "c"`.
 fn either(names: &[String]) -> String {
     let quoted: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
+    if quoted.len() > LISTED {
+        return crate::shown_text::cut_list(quoted, LISTED);
+    }
     match quoted.split_last() {
         None => String::new(),
         Some((last, [])) => last.clone(),
@@ -95,6 +105,9 @@ fn listed(names: &[String]) -> String {
     if names.is_empty() {
         return "none".to_string();
     }
-    let quoted: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
-    quoted.join(", ")
+    // A file may hold hundreds of thousands of them: the refusal stays a line.
+    crate::shown_text::cut_list(names.iter().map(|n| format!("{n:?}")), LISTED)
 }
+
+/// The most names a refusal lists.
+const LISTED: usize = 20;

@@ -19,7 +19,10 @@ use super::{Axis, Episode, Format, OutsideRun, OutsideRunError};
 
 /// Reads the monitor file `file`, opened from `path`.
 pub fn read(file: File, path: &Path) -> Result<OutsideRun, OutsideRunError> {
-    let mut table = Table::read(file, path, Comments::Skipped)?;
+    let mut table = Table::read(file, path, Comments::Skipped)?.at_most(
+        crate::limits::MAX_EPISODES as usize,
+        "episodes a run may have (a row each)",
+    );
     let return_column = table.column(&["r"])?;
     let length_column = table.column(&["l"])?;
     let mut episodes = Vec::new();

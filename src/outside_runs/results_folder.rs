@@ -35,12 +35,16 @@ pub fn read_method(dir: &Path, method: &str) -> Result<Vec<OutsideRun>, OutsideR
     let episode_column = table.column(&["episode"])?;
     let reward_column = table.column(&["reward"])?;
     let mut runs: BTreeMap<i64, Vec<Episode>> = BTreeMap::new();
+    // The folder's other methods, in the order met, for the refusal: a set beside the list
+    // keeps a file of 200,000 labels linear.
     let mut methods: Vec<String> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
     while let Some(row) = table.next_row() {
         let row = row?;
         let label = table.cell(&row, method_column).text();
         if label != method {
-            if !methods.iter().any(|m| m == label) {
+            if !seen.contains(label) {
+                seen.insert(label.to_string());
                 methods.push(label.to_string());
             }
             continue;

@@ -11,6 +11,9 @@ pub struct Table {
     path: PathBuf,
     names: Vec<String>,
     rows: csv::StringRecordsIntoIter<Box<dyn Read>>,
+    /// Rows read so far, and the most that may be ([`Table::at_most`]).
+    read: usize,
+    limit: (usize, &'static str),
 }
 
 /// Whether lines starting with `#` are comments (a monitor file's first line is one).
@@ -30,7 +33,8 @@ impl Table {
         let mut reader = csv::ReaderBuilder::new()
             .comment((comments == Comments::Skipped).then_some(b'#'))
             .trim(csv::Trim::All)
-            .from_reader(Box::new(file) as Box<dyn Read>);
+            // A row is held whole: its length is bounded, whatever the file holds.
+            .from_reader(Box::new(crate::safe_io::bounded_lines(file, path)) as Box<dyn Read>);
         let names = reader
             .headers()
             .map_err(|error| csv_error(path, error))?
@@ -41,7 +45,19 @@ impl Table {
             path: path.to_path_buf(),
             names,
             rows: reader.into_records(),
+            read: 0,
+            limit: (
+                crate::limits::MAX_VALUES_KEPT,
+                "rows sapnet reads from one file",
+            ),
         })
+    }
+
+    /// At most `rows` rows are read (`what` says what they are), a row past them refused
+    /// naming the file, its line and the bound.
+    pub fn at_most(mut self, rows: usize, what: &'static str) -> Self {
+        self.limit = (rows, what);
+        self
     }
 
     /// The index of the first of `candidates` the header holds.
@@ -70,6 +86,20 @@ impl Table {
     /// The next row, or `None` after the last.
     pub fn next_row(&mut self) -> Option<Result<Row, OutsideRunError>> {
         let record = self.rows.next()?;
+        self.read += 1;
+        if self.read > self.limit.0 {
+            let line = record
+                .as_ref()
+                .ok()
+                .and_then(|r| r.position())
+                .map_or(0, csv::Position::line);
+            return Some(Err(OutsideRunError::TooManyRows {
+                path: self.path.clone(),
+                line,
+                limit: self.limit.0,
+                what: self.limit.1,
+            }));
+        }
         Some(
             record
                 .map(|record| Row {

@@ -205,8 +205,9 @@ fn reached(threshold: f64, episodes: &[f64], seed: u64) -> ThresholdReached {
 /// The library's task labels, each once, in the order the sources list them.
 pub(super) fn library_tasks(library: &[LibraryEntry]) -> Vec<String> {
     let mut tasks: Vec<String> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
     for entry in library {
-        if !tasks.contains(&entry.task) {
+        if seen.insert(entry.task.as_str()) {
             tasks.push(entry.task.clone());
         }
     }
@@ -217,9 +218,13 @@ pub(super) fn library_tasks(library: &[LibraryEntry]) -> Vec<String> {
 /// unscored sources rank last).
 pub(super) fn library_ranks(library: &[LibraryEntry]) -> Vec<usize> {
     let score = |e: &LibraryEntry| e.final_score.unwrap_or(f64::NEG_INFINITY);
+    // 1 + the sources scored higher, counted in the scores sorted best first: O(n log n),
+    // for a library of any length a folder lists.
+    let mut best_first: Vec<f64> = library.iter().map(score).collect();
+    best_first.sort_by(|a, b| b.total_cmp(a));
     library
         .iter()
-        .map(|e| 1 + library.iter().filter(|o| score(o) > score(e)).count())
+        .map(|e| 1 + best_first.partition_point(|&o| o > score(e)))
         .collect()
 }
 
@@ -541,6 +546,17 @@ mod tests {
             entry(Some(10.0)),
         ];
         assert_eq!(library_ranks(&library), [2, 1, 4, 2]);
+        // The definition, counted pair by pair, on a library with ties and unscored
+        // sources: the sorted count agrees.
+        let library: Vec<LibraryEntry> = (0..2_000_u32)
+            .map(|i| entry((i % 7 != 0).then_some(f64::from((i * 7919) % 301))))
+            .collect();
+        let score = |e: &LibraryEntry| e.final_score.unwrap_or(f64::NEG_INFINITY);
+        let by_pairs: Vec<usize> = library
+            .iter()
+            .map(|e| 1 + library.iter().filter(|o| score(o) > score(e)).count())
+            .collect();
+        assert_eq!(library_ranks(&library), by_pairs);
         assert_eq!(most_used(&[0, 5, 5]), Some(1));
         assert_eq!(most_used(&[0, 0]), None);
     }

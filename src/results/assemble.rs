@@ -36,11 +36,12 @@ pub fn assemble(
     ending: Ending,
 ) -> Result<Summary> {
     let folders = records::read(out, config)?;
+    // A run's file or, kept compressed, its xz twin (read as `safe_io::open_csv` reads it).
     let parts = |file: &str| -> Vec<PathBuf> {
         folders
             .iter()
             .map(|f| f.dir.join(file))
-            .filter(|p| p.exists())
+            .filter(|p| crate::safe_io::csv_exists(p))
             .collect()
     };
     concatenate(&out.join("episodes.csv"), &parts("episodes.csv"), |p| {
@@ -110,14 +111,9 @@ fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<
         .open(&tmp)
         .with_context(|| format!("writing {}", tmp.display()))?;
     for part in parts {
-        let mut reader = BufReader::new(
-            crate::safe_io::open(
-                part,
-                crate::safe_io::Links::Refuse,
-                crate::safe_io::MAX_CSV_BYTES,
-            )
-            .with_context(|| format!("reading {}", part.display()))?,
-        );
+        let text = crate::safe_io::open_csv(part)
+            .with_context(|| format!("reading {}", part.display()))?;
+        let mut reader = BufReader::new(crate::safe_io::bounded_lines(text, part));
         let mut header = Vec::new();
         reader
             .read_until(b'\n', &mut header)
@@ -146,9 +142,11 @@ pub fn training_episodes(folders: &[RunFolder]) -> Result<TrainingRuns> {
         let mut episodes = TrainingEpisodes::default();
         for (i, row) in reader.deserialize::<Row>().enumerate() {
             let row = row.with_context(|| format!("{}: row {}", path.display(), i + 2))?;
-            episodes.push(row.reward, row.steps);
+            let reward = plot_data::a_kept_return(&path, i, row.reward)?;
+            episodes.push(reward, row.steps);
         }
         let record = &folder.summary.record;
+        plot_data::some_returns(&path, record, episodes.len())?;
         runs.insert((record.method.clone(), record.run), episodes);
     }
     Ok(runs)

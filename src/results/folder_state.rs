@@ -190,6 +190,11 @@ impl FolderReader {
         }
     }
 
+    /// The folder it reads.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
     /// The folder as it stands now.
     pub fn read(&mut self) -> Result<FolderState> {
         let dir = &self.dir.clone();
@@ -360,72 +365,123 @@ fn finished_run(
 #[derive(Debug, Default)]
 struct PartialEpisodes {
     training: TrainingEpisodes,
-    /// Per episode, the source that acted most in it (empty in the warm-up, or for a
-    /// method without a library).
-    policies: Vec<Option<String>>,
+    /// Per source that acted most in an episode (none in the warm-up, or for a method
+    /// without a library): in how many episodes it did, and the row it first did.
+    acting: std::collections::HashMap<String, (usize, usize)>,
     wall_s: Option<f64>,
 }
 
 impl PartialEpisodes {
     /// The source that acted most in the most episodes (the first named, on a tie).
     fn most_acting(&self) -> Option<String> {
-        let mut counts: Vec<(&str, usize)> = Vec::new();
-        for name in self.policies.iter().flatten() {
-            match counts.iter_mut().find(|(n, _)| n == name) {
-                Some((_, count)) => *count += 1,
-                None => counts.push((name, 1)),
-            }
-        }
-        let most = counts.iter().map(|&(_, c)| c).max()?;
-        counts
+        self.acting
             .iter()
-            .find(|&&(_, c)| c == most)
-            .map(|(n, _)| n.to_string())
+            .max_by(|(_, (a, a_first)), (_, (b, b_first))| a.cmp(b).then(b_first.cmp(a_first)))
+            .map(|(name, _)| name.clone())
     }
 }
 
 #[derive(Deserialize)]
-struct PartialRow {
+struct PartialRow<'a> {
     reward: f64,
     steps: u32,
-    policy: Option<String>,
+    policy: Option<&'a str>,
     wall_s: f64,
 }
 
 /// The episodes of a run in progress, from `runs/.<run>.partial/episodes.csv`; `None`
 /// when the run has no partial record (not started, or renamed into place since the
 /// folder was listed). The writer appends row by row: a last line not ended yet is
-/// not read.
+/// not read. Read as a stream up to the last line break found when it was opened (a line
+/// at most `safe_io::MAX_CSV_LINE_BYTES`), keeping a number per episode.
 fn read_partial(partial: &Path) -> Result<Option<PartialEpisodes>> {
+    use std::io::{Read, Seek, SeekFrom};
     if std::fs::symlink_metadata(partial).is_err() {
         return Ok(None);
     }
     let path = partial.join("episodes.csv");
-    let bytes = match safe_io::read(&path, Links::Refuse, safe_io::MAX_CSV_BYTES) {
-        Ok(bytes) => bytes,
+    let mut file = match safe_io::open(&path, Links::Refuse, safe_io::MAX_CSV_BYTES) {
+        Ok(file) => file,
         // Created but not yet written, or renamed into place between the two looks.
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
             return Ok(Some(PartialEpisodes::default()))
         }
         Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
     };
-    let whole = bytes
-        .iter()
-        .rposition(|&b| b == b'\n')
-        .map_or(0, |end| end + 1);
-    let mut reader = csv::Reader::from_reader(&bytes[..whole]);
-    let mut episodes = PartialEpisodes::default();
-    for (i, row) in reader.deserialize::<PartialRow>().enumerate() {
-        let row = row.with_context(|| {
-            format!(
-                "{}: row {}: expected the columns {}",
+    let reading = || format!("reading {}", path.display());
+    // The last line break, looked for in the file's last line's bound only: a longer line
+    // is refused by the reader below anyway.
+    let length = file.metadata().with_context(reading)?.len();
+    let tail = length.min(safe_io::MAX_CSV_LINE_BYTES + 1);
+    file.seek(SeekFrom::Start(length - tail))
+        .with_context(reading)?;
+    let mut end = Vec::new();
+    (&mut file)
+        .take(tail)
+        .read_to_end(&mut end)
+        .with_context(reading)?;
+    let whole = match end.iter().rposition(|&b| b == b'\n') {
+        Some(at) => length - tail + at as u64 + 1,
+        None if length > safe_io::MAX_CSV_LINE_BYTES => {
+            anyhow::bail!(
+                "{}: its last line is longer than the {} bytes a row may hold: not a run's \
+                 episodes",
                 path.display(),
-                i + 2,
+                safe_io::MAX_CSV_LINE_BYTES
+            )
+        }
+        None => 0,
+    };
+    drop(end);
+    file.rewind().with_context(reading)?;
+    let mut reader = csv::Reader::from_reader(safe_io::bounded_lines(file.take(whole), &path));
+    let headers = reader.byte_headers().with_context(reading)?.clone();
+    let mut record = csv::ByteRecord::new();
+    let mut episodes = PartialEpisodes::default();
+    for at in 2.. {
+        let expected = || {
+            format!(
+                "{}: row {at}: expected the columns {}",
+                path.display(),
                 super::files::EPISODES_HEADER.join(", ")
             )
-        })?;
+        };
+        if !reader
+            .read_byte_record(&mut record)
+            .with_context(expected)?
+        {
+            break;
+        }
+        let row: PartialRow = record.deserialize(Some(&headers)).with_context(expected)?;
+        if !row.reward.is_finite() {
+            anyhow::bail!(
+                "{}: row {at}, column reward: the return {} is not finite",
+                path.display(),
+                row.reward
+            );
+        }
+        if episodes.training.len() >= crate::limits::MAX_VALUES_KEPT {
+            anyhow::bail!(
+                "{}: row {at}: more than the {} episodes sapnet keeps from one file",
+                path.display(),
+                crate::limits::MAX_VALUES_KEPT
+            );
+        }
+        if let Some(name) = row.policy.filter(|p| !p.is_empty()) {
+            let distinct = episodes.acting.len();
+            match episodes.acting.get_mut(name) {
+                Some((count, _)) => *count += 1,
+                None if distinct >= crate::limits::MAX_SOURCES => anyhow::bail!(
+                    "{}: row {at}: more than the {} sources a library may hold act in it",
+                    path.display(),
+                    crate::limits::MAX_SOURCES
+                ),
+                None => {
+                    episodes.acting.insert(name.to_string(), (1, at));
+                }
+            }
+        }
         episodes.training.push(row.reward, row.steps);
-        episodes.policies.push(row.policy.filter(|p| !p.is_empty()));
         episodes.wall_s = Some(row.wall_s);
     }
     Ok(Some(episodes))
@@ -470,6 +526,49 @@ mod tests {
             wall_s: episodes.wall_s,
         };
         assert_eq!(progress.eta_s(), Some(3.0));
+    }
+
+    #[test]
+    fn a_sparse_partial_record_is_refused_at_its_line_not_read_whole() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("episodes.csv");
+        std::fs::write(
+            &path,
+            "run,method,episode,reward,steps,loss,statistic_loss,epsilon,policy,wall_s\n",
+        )
+        .unwrap();
+        // A 3 GiB hole, then a line break: one endless line.
+        let file = std::fs::OpenOptions::new().write(true).open(&path).unwrap();
+        file.set_len(3 << 30).unwrap();
+        let mut file = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .unwrap();
+        std::io::Write::write_all(&mut file, b"\n").unwrap();
+        let err = format!("{:#}", read_partial(tmp.path()).unwrap_err());
+        assert!(
+            err.contains("episodes.csv: line 2 is longer than the 4194304 bytes"),
+            "{err}"
+        );
+        // Without the line break, the last line itself is past the bound.
+        file.set_len(3 << 30).unwrap();
+        let err = format!("{:#}", read_partial(tmp.path()).unwrap_err());
+        assert!(err.contains("its last line is longer than"), "{err}");
+    }
+
+    #[test]
+    fn the_most_acting_source_is_counted_in_one_pass_first_named_on_a_tie() {
+        let tmp = tempfile::tempdir().unwrap();
+        let mut text = String::from(
+            "run,method,episode,reward,steps,loss,statistic_loss,epsilon,policy,wall_s\n",
+        );
+        for (i, policy) in ["b", "a", "", "a", "b", "c"].iter().enumerate() {
+            text.push_str(&format!("0,sapnet,{i},1.0,1,,0.0,0.03,{policy},0.5\n"));
+        }
+        std::fs::write(tmp.path().join("episodes.csv"), text).unwrap();
+        let episodes = read_partial(tmp.path()).unwrap().unwrap();
+        assert_eq!(episodes.most_acting().as_deref(), Some("b"));
+        assert_eq!(episodes.training.len(), 6);
     }
 
     #[test]

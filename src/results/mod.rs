@@ -5,6 +5,7 @@
 
 pub mod assemble;
 pub mod files;
+pub mod folder_changes;
 pub mod folder_state;
 pub mod plot_data;
 pub mod pool;

@@ -9,22 +9,23 @@ use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 
 use super::summary::read_header;
+use crate::limits::MAX_VALUES_KEPT;
 use crate::report::plots::{Curve, PlotData, SelectionHistory};
 use crate::report::TrainingEpisodes;
 
 #[derive(Deserialize)]
-struct EpisodeRow {
+struct EpisodeRow<'a> {
     run: u32,
-    method: String,
+    method: &'a str,
     episode: u32,
     reward: f64,
     steps: u32,
 }
 
 #[derive(Deserialize)]
-struct TestRow {
+struct TestRow<'a> {
     run: u32,
-    method: String,
+    method: &'a str,
     test: u32,
     #[serde(rename = "return")]
     test_return: f64,
@@ -33,29 +34,22 @@ struct TestRow {
 /// The plots' data, from the files of a results directory.
 pub fn read(dir: &Path) -> Result<PlotData> {
     let config = read_header(dir)?.config;
-    let episodes = training_episodes(&dir.join("episodes.csv"))?;
-    let tests = by_run(
-        rows::<TestRow>(&dir.join("tests.csv"))?
-            .into_iter()
-            .map(|r| (r.method, r.run, r.test, r.test_return)),
-    );
+    let mut episodes = training_episodes(&dir.join("episodes.csv"))?;
+    let path = dir.join("tests.csv");
+    let mut tests = ByRunReader::new(&path, "return");
+    each_row(&path, |record, headers, at| {
+        let row: TestRow = parse(record, headers, &path, at)?;
+        tests.push(row.method, row.run, row.test, row.test_return, at)
+    })?;
+    let mut tests = tests.finish();
     let methods = crate::trainer::MethodId::all(&config.protocol.methods);
     let curves = methods
         .iter()
         .filter_map(|method| {
             let label = method.label().to_string();
-            let of = |map: &ByRun| -> Vec<Vec<f64>> {
-                map.iter()
-                    .filter(|((method, _), _)| *method == label)
-                    .map(|(_, values)| values.clone())
-                    .collect()
-            };
-            let runs: Vec<TrainingEpisodes> = episodes
-                .iter()
-                .filter(|((method, _), _)| *method == label)
-                .map(|(_, run)| run.clone())
-                .collect();
-            let tested = of(&tests);
+            // Moved, not copied: a folder's returns are its largest data.
+            let runs = take_method(&mut episodes, &label);
+            let tested = take_method(&mut tests, &label);
             (!runs.is_empty()).then_some(Curve {
                 label,
                 kind: method.kind,
@@ -112,50 +106,258 @@ pub fn read(dir: &Path) -> Result<PlotData> {
 /// (method, run) → that run's values in order.
 pub(super) type ByRun = BTreeMap<(String, u32), Vec<f64>>;
 
-/// Each run's training episodes from a results folder's `episodes.csv`, in episode order.
+/// The runs of method `label` taken out of `map`, in run order.
+fn take_method<T>(map: &mut BTreeMap<(String, u32), T>, label: &str) -> Vec<T> {
+    let keys: Vec<_> = map
+        .range((label.to_string(), 0)..=(label.to_string(), u32::MAX))
+        .map(|(key, _)| key.clone())
+        .collect();
+    keys.iter().filter_map(|key| map.remove(key)).collect()
+}
+
+/// Each run's training episodes (return and length) from a results folder's
+/// `episodes.csv`, in episode order; a return that is not finite, or more values than
+/// [`MAX_VALUES_KEPT`], refused naming the file and the row.
 pub(super) fn training_episodes(path: &Path) -> Result<BTreeMap<(String, u32), TrainingEpisodes>> {
-    let mut keyed: BTreeMap<(String, u32), Vec<EpisodeRow>> = BTreeMap::new();
-    for r in rows::<EpisodeRow>(path)? {
-        keyed.entry((r.method.clone(), r.run)).or_default().push(r);
-    }
-    // Runs side by side interleave their rows.
-    Ok(keyed
+    let mut returns = ByRunReader::new(path, "reward");
+    let mut lengths = ByRunReader::new(path, "steps");
+    each_row(path, |record, headers, at| {
+        let row: EpisodeRow = parse(record, headers, path, at)?;
+        returns.push(row.method, row.run, row.episode, row.reward, at)?;
+        lengths.push(row.method, row.run, row.episode, f64::from(row.steps), at)
+    })?;
+    let mut lengths = lengths.finish();
+    Ok(returns
+        .finish()
         .into_iter()
-        .map(|(key, mut rows)| {
-            rows.sort_by_key(|r| r.episode);
-            let mut run = TrainingEpisodes::default();
-            for r in rows {
-                run.push(r.reward, r.steps);
-            }
-            (key, run)
+        .map(|(key, returns)| {
+            let lengths = lengths.remove(&key).unwrap_or_default();
+            let lengths = lengths.into_iter().map(|l| l as u32).collect();
+            (key, TrainingEpisodes { returns, lengths })
         })
         .collect())
 }
 
-/// Groups `(method, run, index, value)` rows by run, each run's values in order of their
-/// index (episode or test): runs side by side interleave their rows.
-fn by_run(rows: impl IntoIterator<Item = (String, u32, u32, f64)>) -> ByRun {
-    let mut keyed: BTreeMap<(String, u32), Vec<(u32, f64)>> = BTreeMap::new();
-    for (method, run, index, value) in rows {
-        keyed.entry((method, run)).or_default().push((index, value));
+/// Refuses row `at` of `path` when keeping `more` values beside the `kept` ones would pass
+/// [`MAX_VALUES_KEPT`].
+pub(super) fn check_kept(path: &Path, kept: usize, more: usize, at: usize) -> Result<()> {
+    if kept.saturating_add(more) > MAX_VALUES_KEPT {
+        bail!(
+            "{}: row {at}: more than the {MAX_VALUES_KEPT} values sapnet keeps from one file \
+             (a return per episode, 3 per source per row of activations.csv)",
+            path.display()
+        );
     }
-    keyed
-        .into_iter()
-        .map(|(key, mut values)| {
-            values.sort_by_key(|&(index, _)| index);
-            (key, values.into_iter().map(|(_, v)| v).collect())
-        })
-        .collect()
+    Ok(())
 }
 
-fn rows<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<Vec<T>> {
+/// Return `i` (row `i + 2`) of `path`, a run's own `episodes.csv`: finite, and within
+/// [`MAX_VALUES_KEPT`].
+pub(super) fn a_kept_return(path: &Path, i: usize, reward: f64) -> Result<f64> {
+    if !reward.is_finite() {
+        bail!(
+            "{}: row {}, column reward: the return {reward} is not finite",
+            path.display(),
+            i + 2
+        );
+    }
+    check_kept(path, i, 1, i + 2)?;
+    Ok(reward)
+}
+
+/// A run that ended (not stopped) has episodes: a record without any would make its
+/// scores NaN.
+pub(super) fn some_returns(
+    path: &Path,
+    record: &crate::trainer::RunRecord,
+    returns: usize,
+) -> Result<()> {
+    if returns == 0 && !record.stopped {
+        bail!(
+            "{}: no episode of {} run {}, which its record says ended (after {} episodes)",
+            path.display(),
+            record.method.label(),
+            record.run,
+            record.episodes
+        );
+    }
+    Ok(())
+}
+
+/// Groups `(method, run, index, value)` rows by run as they are read, each run's values in
+/// order of their index (episode or test): runs side by side interleave their rows. A run's
+/// rows come numbered 1, 2, 3… (as sapnet writes them): then only the values are kept, and
+/// the indices only from a run whose rows come in another order.
+struct ByRunReader<'p> {
+    path: &'p Path,
+    /// What the value is, for messages (`reward`).
+    column: &'static str,
+    runs: BTreeMap<String, BTreeMap<u32, Series>>,
+    kept: usize,
+}
+
+#[derive(Default)]
+struct Series {
+    values: Chunked<f64>,
+    /// The first row's index: the rows in order are `first`, `first + 1`, ….
+    first: u32,
+    /// Every row's index, once one broke the order.
+    indices: Option<Chunked<u32>>,
+}
+
+impl<'p> ByRunReader<'p> {
+    fn new(path: &'p Path, column: &'static str) -> Self {
+        Self {
+            path,
+            column,
+            runs: BTreeMap::new(),
+            kept: 0,
+        }
+    }
+
+    fn push(&mut self, method: &str, run: u32, index: u32, value: f64, at: usize) -> Result<()> {
+        if !value.is_finite() {
+            bail!(
+                "{}: row {at}, column {}: the return {value} is not finite",
+                self.path.display(),
+                self.column
+            );
+        }
+        check_kept(self.path, self.kept, 1, at)?;
+        self.kept += 1;
+        let runs = match self.runs.get_mut(method) {
+            Some(runs) => runs,
+            None => self.runs.entry(method.to_string()).or_default(),
+        };
+        let series = runs.entry(run).or_default();
+        if series.values.is_empty() {
+            series.first = index;
+        }
+        let next = u64::from(series.first) + series.values.len() as u64;
+        if series.indices.is_none() && u64::from(index) != next {
+            let first = series.first;
+            let mut indices = Chunked::default();
+            for i in 0..series.values.len() as u32 {
+                indices.push(first + i);
+            }
+            series.indices = Some(indices);
+        }
+        if let Some(indices) = &mut series.indices {
+            indices.push(index);
+        }
+        series.values.push(value);
+        Ok(())
+    }
+
+    fn finish(self) -> ByRun {
+        let mut by_run = ByRun::new();
+        for (method, runs) in self.runs {
+            for (run, series) in runs {
+                let values = series.values.into_vec();
+                let values = match series.indices {
+                    None => values,
+                    Some(indices) => {
+                        let mut pairs: Vec<(u32, f64)> =
+                            indices.into_vec().into_iter().zip(values).collect();
+                        pairs.sort_by_key(|&(index, _)| index);
+                        pairs.into_iter().map(|(_, v)| v).collect()
+                    }
+                };
+                by_run.insert((method.clone(), run), values);
+            }
+        }
+        by_run
+    }
+}
+
+/// Values kept in chunks of about a mebibyte: grown a chunk at a time, never copied into
+/// a larger block as a `Vec` grows (which would hold the old block and the new, twice the
+/// data, and leave the old ones to the allocator), so what a file's rows cost is the
+/// values themselves.
+struct Chunked<T> {
+    chunks: Vec<Vec<T>>,
+    len: usize,
+}
+
+impl<T> Default for Chunked<T> {
+    fn default() -> Self {
+        Self {
+            chunks: Vec::new(),
+            len: 0,
+        }
+    }
+}
+
+impl<T: Copy> Chunked<T> {
+    /// A chunk's values: a mebibyte, less room for the allocator's own bookkeeping.
+    const CHUNK: usize = ((1 << 20) - 512) / std::mem::size_of::<T>();
+
+    fn push(&mut self, value: T) {
+        match self.chunks.last_mut() {
+            Some(chunk) if chunk.len() < Self::CHUNK => chunk.push(value),
+            _ => {
+                let mut chunk = Vec::with_capacity(Self::CHUNK);
+                chunk.push(value);
+                self.chunks.push(chunk);
+            }
+        }
+        self.len += 1;
+    }
+
+    fn len(&self) -> usize {
+        self.len
+    }
+
+    fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The values in one block.
+    fn into_vec(self) -> Vec<T> {
+        let mut values = Vec::with_capacity(self.len);
+        for chunk in self.chunks {
+            values.extend_from_slice(&chunk);
+        }
+        values
+    }
+}
+
+/// Hands each row of `path` (a CSV file of a folder, or its xz twin) to `each` with the
+/// header and its row number (the header is row 1), one at a time: nothing but the row
+/// read is held.
+fn each_row(
+    path: &Path,
+    mut each: impl FnMut(&csv::ByteRecord, &csv::ByteRecord, usize) -> Result<()>,
+) -> Result<()> {
     let mut reader =
         crate::safe_io::csv_reader(path).with_context(|| format!("reading {}", path.display()))?;
-    reader
-        .deserialize()
-        .enumerate()
-        .map(|(i, row)| row.with_context(|| format!("{}: row {}", path.display(), i + 2)))
-        .collect()
+    let headers = reader
+        .byte_headers()
+        .with_context(|| format!("reading {}", path.display()))?
+        .clone();
+    let mut record = csv::ByteRecord::new();
+    for at in 2.. {
+        let more = reader
+            .read_byte_record(&mut record)
+            .with_context(|| format!("{}: row {at}", path.display()))?;
+        if !more {
+            break;
+        }
+        each(&record, &headers, at)?;
+    }
+    Ok(())
+}
+
+/// Row `at` of `path` as a `T`.
+fn parse<'r, T: Deserialize<'r>>(
+    record: &'r csv::ByteRecord,
+    headers: &'r csv::ByteRecord,
+    path: &Path,
+    at: usize,
+) -> Result<T> {
+    record
+        .deserialize(Some(headers))
+        .with_context(|| format!("{}: row {at}", path.display()))
 }
 
 /// What `activations.csv` holds: for the plots, and for a finished run's dashboard
@@ -172,6 +374,13 @@ pub(super) struct Activations {
 /// `method` column (before the comparison of methods) is SAP-Net's; one without the
 /// `episode` column numbers each run's rows from 1.
 pub(super) fn read_activations(path: &Path) -> Result<Activations> {
+    read_activations_of(path, None)
+}
+
+/// [`read_activations`], keeping only the rows of `only` (a method's label and a run)
+/// where it is named: a finished run's dashboard reads its own rows of a folder's file.
+/// Every value is finite, and at most [`MAX_VALUES_KEPT`] are kept.
+pub(super) fn read_activations_of(path: &Path, only: Option<(&str, u32)>) -> Result<Activations> {
     if !crate::safe_io::csv_exists(path) {
         return Ok(Activations::default());
     }
@@ -205,20 +414,34 @@ pub(super) fn read_activations(path: &Path) -> Result<Activations> {
         );
     }
     let mut runs: BTreeMap<(String, u32), SelectionHistory> = BTreeMap::new();
-    for (i, record) in reader.records().enumerate() {
+    let per_row = scores.len() + acted.len() + probabilities.len();
+    let mut kept = 0;
+    let mut record = csv::StringRecord::new();
+    for i in 0.. {
         let at = || format!("{}: row {}", path.display(), i + 2);
-        let record = record.with_context(at)?;
+        if !reader.read_record(&mut record).with_context(at)? {
+            break;
+        }
         let number = |column: usize| -> Result<f64> {
             let field = record.get(column).unwrap_or("");
-            field.parse().with_context(|| {
+            let value: f64 = field.parse().with_context(|| {
                 format!("{}, column {}: {field:?} is not a number", at(), column + 1)
-            })
+            })?;
+            if !value.is_finite() {
+                bail!("{}, column {}: {value} is not finite", at(), column + 1);
+            }
+            Ok(value)
         };
         let run = number(0)? as u32;
         let method = method_column
             .and_then(|c| record.get(c))
-            .unwrap_or("sapnet")
-            .to_string();
+            .unwrap_or("sapnet");
+        if only.is_some_and(|only| only != (method, run)) {
+            continue;
+        }
+        check_kept(path, kept, per_row, i + 2)?;
+        kept += per_row;
+        let method = method.to_string();
         let values = scores
             .iter()
             .map(|&(c, _)| number(c))

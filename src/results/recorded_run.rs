@@ -27,9 +27,9 @@ use crate::trainer::{
     ActivationSnapshot, EpisodeRecord, Event, LibraryStart, LockIn, MethodId, SourceSummary,
 };
 
-/// A finished run's events, and what of them its files kept.
+/// What a finished run's files kept of its events (the events themselves go to the sink
+/// [`read`] is given, as they are read).
 pub struct Recorded {
-    pub events: Vec<Event>,
     /// Whether `activations.csv` held the run's scores and probabilities: without them a
     /// reusing run's dashboard shows its library's scores as they started, with the steps
     /// each source acted and its judgments from the run's record.
@@ -40,8 +40,15 @@ pub struct Recorded {
 }
 
 /// The events of run `run` of `method` in `folder`, which must have finished (or been
-/// stopped) there.
-pub fn read(folder: &FolderState, method: &MethodId, run: u32) -> Result<Recorded> {
+/// stopped) there, handed to `sink` in order as they are read: a run of millions of
+/// episodes costs what the sink keeps of them (a dashboard keeps its curve thinned), not
+/// an event per episode.
+pub fn read(
+    folder: &FolderState,
+    method: &MethodId,
+    run: u32,
+    sink: &mut dyn FnMut(Event),
+) -> Result<Recorded> {
     let Some(summary) = folder.finished(method, run) else {
         bail!(
             "{}: {} run {run} has no record: it has not finished",
@@ -51,8 +58,15 @@ pub fn read(folder: &FolderState, method: &MethodId, run: u32) -> Result<Recorde
     };
     let config = &folder.config;
     let names: Vec<String> = folder.library.iter().map(|e| e.name.clone()).collect();
+    // Its record's counts, one per source, before a view indexes them.
+    let own = folder.dir.join(RUNS).join(run_name(method.label(), run));
+    let record_path = if own.is_dir() {
+        own.join("run.json")
+    } else {
+        folder.dir.join("summary.json")
+    };
+    super::summary::check_per_source(&record_path, &summary.record, names.len())?;
     let files = RunFiles::of(&folder.dir, method.label(), run);
-    let (episodes, learner) = read_episodes(&files.episodes, method, run, &names)?;
     let library = if method.kind.reuses && !folder.library.is_empty() {
         Some(library_start(folder, method)?)
     } else {
@@ -64,17 +78,23 @@ pub fn read(folder: &FolderState, method: &MethodId, run: u32) -> Result<Recorde
     };
     let activations = !rows.is_empty();
     let score_name = library.as_ref().map_or("", |l| l.score_name);
-    let mut events = vec![Event::RunStarted {
+    // What the record keeps of the selector, when no activations were on file: the
+    // scores the run started from.
+    let started = match (&library, activations) {
+        (Some(start), false) => Some((start.net.activations().to_vec(), start.net.probabilities())),
+        _ => None,
+    };
+    sink(Event::RunStarted {
         run,
         method: method.clone(),
         budget: config.protocol.budget,
         library: library.map(Box::new),
-    }];
+    });
     let by_episode: BTreeMap<u32, &ActivationRow> = rows.iter().map(|r| (r.episode, r)).collect();
     let record = &summary.record;
     let n = names.len();
     let (mut step, mut selections) = (0_u64, vec![0_u64; n]);
-    for episode in episodes {
+    let learner = each_episode(&files.episodes, method, run, &names, &mut |episode| {
         step += u64::from(episode.steps);
         if let Some(row) = by_episode.get(&episode.episode) {
             for (total, acted) in selections.iter_mut().zip(&row.selected) {
@@ -82,7 +102,7 @@ pub fn read(folder: &FolderState, method: &MethodId, run: u32) -> Result<Recorde
             }
             // The source lock-in is of: the one then above `LOCK_IN`, if one is.
             let top = reuse::argmax(&row.probabilities);
-            events.push(Event::Activations(ActivationSnapshot {
+            sink(Event::Activations(ActivationSnapshot {
                 run,
                 method: method.clone(),
                 step,
@@ -103,16 +123,9 @@ pub fn read(folder: &FolderState, method: &MethodId, run: u32) -> Result<Recorde
                 excluded: Vec::new(),
             }));
         }
-        events.push(Event::EpisodeEnded(episode));
-    }
-    if let (
-        false,
-        Some(Event::RunStarted {
-            library: Some(start),
-            ..
-        }),
-    ) = (activations, events.first())
-    {
+        sink(Event::EpisodeEnded(episode));
+    })?;
+    if let Some((scores, probabilities)) = started {
         // What the record keeps of the selector: the steps each source acted and its
         // judgments, beside the scores the run started from.
         let snapshot = ActivationSnapshot {
@@ -121,19 +134,18 @@ pub fn read(folder: &FolderState, method: &MethodId, run: u32) -> Result<Recorde
             step: record.steps,
             episode: record.episodes,
             score_name,
-            activations: start.net.activations().to_vec(),
-            probabilities: start.net.probabilities(),
+            activations: scores,
+            probabilities,
             selections: record.source_steps.clone(),
             positive: record.positive.clone(),
             negative: record.negative.clone(),
             lock_in: None,
             excluded: Vec::new(),
         };
-        events.push(Event::Activations(snapshot));
+        sink(Event::Activations(snapshot));
     }
-    events.push(Event::RunEnded(record.clone()));
+    sink(Event::RunEnded(record.clone()));
     Ok(Recorded {
-        events,
         activations,
         learner,
     })
@@ -161,11 +173,25 @@ impl RunFiles {
     }
 }
 
+/// The most sources whose graph a finished run's dashboard builds again: 1,000 (the paper's
+/// library has 10), a million edges.
+pub const MAX_DRAWN_SOURCES: usize = 1_000;
+
 /// The library and the graph the run's selector drew on, made as the run made them: the
 /// selector built again from the library's descriptions and scores (SAP-Net's own net; for
 /// another selector the library's graph under the config's SAP-Net section).
 fn library_start(folder: &FolderState, method: &MethodId) -> Result<LibraryStart> {
     let config = &folder.config;
+    // The graph is n × n: 10,000 sources (a library's bound) take gigabytes and minutes to
+    // build again, for a screen that shows a few dozen of them.
+    if folder.library.len() > MAX_DRAWN_SOURCES {
+        bail!(
+            "{}: a library of {} sources: a finished run's dashboard builds the graph of at \
+             most {MAX_DRAWN_SOURCES} (its comparison and curves are in the other views)",
+            folder.dir.display(),
+            folder.library.len()
+        );
+    }
     let descriptions: Vec<_> = folder.library.iter().map(|e| e.description()).collect();
     let scores: Vec<Option<f64>> = folder.library.iter().map(|e| e.final_score).collect();
     let library = Library {
@@ -220,29 +246,61 @@ struct EpisodeRow {
     wall_s: f64,
 }
 
-/// The run's episodes in order, its acting policy known again by its name among `names`;
-/// and whether the file kept each episode's ε and statistic loss.
-fn read_episodes(
+/// Hands the run's episodes to `each` in order as they are read (sapnet writes a run's
+/// rows in episode order; another order is refused), its acting policy known again by its
+/// name among `names`; says whether the file kept each episode's ε and statistic loss.
+fn each_episode(
     path: &Path,
     method: &MethodId,
     run: u32,
     names: &[String],
-) -> Result<(Vec<EpisodeRecord>, bool)> {
+    each: &mut dyn FnMut(EpisodeRecord),
+) -> Result<bool> {
     let mut reader =
         safe_io::csv_reader(path).with_context(|| format!("reading {}", path.display()))?;
     let headers = reader
         .headers()
-        .with_context(|| format!("reading {}", path.display()))?;
+        .with_context(|| format!("reading {}", path.display()))?
+        .clone();
     let learner = ["epsilon", "statistic_loss"]
         .iter()
         .all(|column| headers.iter().any(|h| h == *column));
-    let mut episodes = Vec::new();
-    for (i, row) in reader.deserialize::<EpisodeRow>().enumerate() {
-        let row = row.with_context(|| format!("{}: row {}", path.display(), i + 2))?;
+    // A name to its index, looked up per row: a library of thousands stays linear.
+    let index: std::collections::HashMap<&str, u32> = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.as_str(), i as u32))
+        .collect();
+    let mut record = csv::StringRecord::new();
+    let mut last: Option<u32> = None;
+    for at in 2.. {
+        let row = || format!("{}: row {at}", path.display());
+        if !reader.read_record(&mut record).with_context(row)? {
+            break;
+        }
+        let row: EpisodeRow = record.deserialize(Some(&headers)).with_context(row)?;
         if row.method != method.label() || row.run != run {
             continue;
         }
-        episodes.push(EpisodeRecord {
+        if !row.reward.is_finite() {
+            bail!(
+                "{}: row {at}, column reward: the return {} is not finite",
+                path.display(),
+                row.reward
+            );
+        }
+        if last.is_some_and(|last| row.episode <= last) {
+            bail!(
+                "{}: row {at}: episode {} of {} run {run} after episode {}: expected a \
+                 run's episodes in order, as sapnet writes them",
+                path.display(),
+                row.episode,
+                method.label(),
+                last.unwrap_or(0)
+            );
+        }
+        last = Some(row.episode);
+        each(EpisodeRecord {
             run,
             method: method.clone(),
             episode: row.episode,
@@ -253,13 +311,11 @@ fn read_episodes(
             epsilon: row.epsilon,
             policy: row
                 .policy
-                .and_then(|name| names.iter().position(|n| *n == name))
-                .map(|i| i as u32),
+                .and_then(|name| index.get(name.as_str()).copied()),
             wall_s: row.wall_s,
         });
     }
-    episodes.sort_by_key(|e| e.episode);
-    Ok((episodes, learner))
+    Ok(learner)
 }
 
 /// One episode's end in `activations.csv`: each source's score, probability and steps
@@ -280,7 +336,7 @@ fn run_activations(
     run: u32,
     sources: usize,
 ) -> Result<Vec<ActivationRow>> {
-    let read = plot_data::read_activations(path)?;
+    let read = plot_data::read_activations_of(path, Some((method, run)))?;
     let Some(history) = read.runs.get(&(method.to_string(), run)) else {
         return Ok(Vec::new());
     };

@@ -13,7 +13,7 @@ use serde::Deserialize;
 
 use super::plot_data;
 use super::summary::{self, Status, Summary, SummaryHeader, MAX_SUMMARY_BYTES};
-use crate::report::{plots, Report, RunSummary, TaskRuns, TrainingRuns};
+use crate::report::{plots, Report, RunSummary, TaskRuns, TrainingEpisodes, TrainingRuns};
 use crate::safe_io::{self, Links};
 use crate::trainer::MethodId;
 
@@ -26,7 +26,12 @@ struct ListedRuns {
 /// Whether `dir` is a shipped folder this module can make again: no run records, but the
 /// episodes of the runs its summary lists.
 pub fn can_replot(dir: &Path) -> bool {
-    safe_io::csv_exists(&dir.join("episodes.csv"))
+    // Anything there (a link, a FIFO) counts: reading it then says what is wrong with it,
+    // where "no episodes.csv" would send the user to the command that refuses it.
+    let path = dir.join("episodes.csv");
+    [safe_io::xz_twin(&path), path]
+        .iter()
+        .any(|p| std::fs::symlink_metadata(p).is_ok())
 }
 
 /// Every run `dir`'s `summary.json` lists, with its training returns from `episodes.csv`:
@@ -70,6 +75,11 @@ pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
         runs.push(run.with_method(method.clone()));
     }
     let episodes = episodes(&dir.join("episodes.csv"), &methods)?;
+    for run in &runs {
+        let key = (run.record.method.clone(), run.record.run);
+        let count = episodes.get(&key).map_or(0, TrainingEpisodes::len);
+        plot_data::some_returns(&dir.join("episodes.csv"), &run.record, count)?;
+    }
     Ok(ShippedRuns { runs, episodes })
 }
 

@@ -122,7 +122,43 @@ pub fn read_header(dir: &Path) -> Result<SummaryHeader> {
         .config
         .validate()
         .map_err(|e| anyhow::anyhow!("{}: the stored config: {e}", path.display()))?;
+    // Before anything that grows with it (a dashboard's graph is n × n).
+    let sources = header.library.as_ref().map_or(0, Vec::len);
+    if sources > crate::limits::MAX_SOURCES {
+        anyhow::bail!(
+            "{}: library: {sources} sources, more than the {} a library may hold",
+            path.display(),
+            crate::limits::MAX_SOURCES
+        );
+    }
     Ok(header)
+}
+
+/// Refuses a run's record whose per-source counts (`source_steps`, `positive`,
+/// `negative`) are neither empty (a method without a library, an older record) nor one per
+/// source of the library of `sources`: its views index them by source.
+pub fn check_per_source(
+    path: &Path,
+    record: &crate::trainer::RunRecord,
+    sources: usize,
+) -> Result<()> {
+    for (field, counts) in [
+        ("source_steps", &record.source_steps),
+        ("positive", &record.positive),
+        ("negative", &record.negative),
+    ] {
+        if !counts.is_empty() && counts.len() != sources {
+            anyhow::bail!(
+                "{}: {} run {}: {field} holds {} counts, expected one per source of \
+                 summary.json's library ({sources})",
+                path.display(),
+                record.method.label(),
+                record.run,
+                counts.len()
+            );
+        }
+    }
+    Ok(())
 }
 
 /// The largest `summary.json` read: every run's totals, a few kilobytes each, for the most

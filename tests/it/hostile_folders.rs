@@ -1169,3 +1169,375 @@ fn untextual_paths_and_number_mistakes_are_said_before_anything_runs() {
         refused(output, says);
     }
 }
+
+// Issue 52: bounded everywhere. Each test is built from the issue's reproducer; memory is
+// checked only where a bound refuses before allocating (the peaks are measured by hand:
+// see the README's reliability page).
+
+/// A copy of `docs/cartpole/`'s data files (`summary.json`, `episodes.csv.xz`): a shipped
+/// folder, read by `plot` and `open` from its top-level files.
+fn shipped_copy(tmp: &Path) -> PathBuf {
+    let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/cartpole");
+    let dir = tmp.join("shipped");
+    std::fs::create_dir(&dir).unwrap();
+    for file in ["summary.json", "episodes.csv.xz", "tests.csv"] {
+        std::fs::copy(docs.join(file), dir.join(file)).unwrap();
+    }
+    dir
+}
+
+/// `sapnet plot DIR` and `sapnet open DIR` (refused before the screen opens): both refused,
+/// exit 2, with `says`, within `limit`.
+fn plot_and_open_refuse(dir: &Path, says: &str, limit: Duration) {
+    for command in ["plot", "open"] {
+        let started = Instant::now();
+        let output = output_within(
+            sapnet().arg(command).arg(dir),
+            Duration::from_secs(120),
+            command,
+        );
+        refused(output, says);
+        assert!(
+            started.elapsed() < limit,
+            "{command} took {:?}",
+            started.elapsed()
+        );
+    }
+}
+
+/// `xz` bytes whose LZMA2 dictionary is said to be `props` (40: 4 GiB), the block
+/// header's checksum made again, as a crafted bomb would declare.
+fn with_dictionary(xz: &[u8], props: u8) -> Vec<u8> {
+    let mut bytes = xz.to_vec();
+    let size = (usize::from(bytes[12]) + 1) * 4;
+    let header = 12..12 + size;
+    let filter = bytes[header.clone()]
+        .windows(2)
+        .position(|w| w == [0x21, 0x01])
+        .expect("an LZMA2 filter");
+    bytes[12 + filter + 2] = props;
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC).checksum(&bytes[12..12 + size - 4]);
+    bytes[12 + size - 4..12 + size].copy_from_slice(&crc.to_le_bytes());
+    bytes
+}
+
+/// Items 1 and 14: an xz twin declaring a 1 GiB dictionary is refused before the
+/// dictionary is allocated; a truncated one says so (not "failed to fill whole buffer"); a
+/// linked or FIFO twin is refused for what it is, not sent to the command that refuses it.
+#[test]
+fn xz_twins_that_would_cost_memory_or_are_not_files_are_said_plainly() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = shipped_copy(tmp.path());
+    let twin = dir.join("episodes.csv.xz");
+    let whole = std::fs::read(&twin).unwrap();
+    std::fs::write(&twin, with_dictionary(&whole, 36)).unwrap();
+    plot_and_open_refuse(
+        &dir,
+        "declares an xz dictionary of 1073741824 bytes, more than the 67108864",
+        Duration::from_secs(20),
+    );
+    std::fs::write(&twin, &whole[..whole.len() / 2]).unwrap();
+    plot_and_open_refuse(
+        &dir,
+        "episodes.csv.xz: truncated: the file ends inside its xz stream",
+        Duration::from_secs(60),
+    );
+    std::fs::remove_file(&twin).unwrap();
+    symlink(tmp.path().join("elsewhere.xz"), &twin).unwrap();
+    plot_and_open_refuse(
+        &dir,
+        "episodes.csv.xz: a symbolic link",
+        Duration::from_secs(20),
+    );
+    std::fs::remove_file(&twin).unwrap();
+    assert!(Command::new("mkfifo")
+        .arg(&twin)
+        .status()
+        .unwrap()
+        .success());
+    plot_and_open_refuse(&dir, "episodes.csv.xz: a FIFO", Duration::from_secs(20));
+}
+
+/// Items 3 and 4: a summary.json library past MAX_SOURCES is refused in seconds, before
+/// anything grows with it; a record whose per-source counts are shorter than the library
+/// is refused when its dashboard is asked for (the notice Enter shows), never a panic.
+#[test]
+fn a_library_past_its_bound_or_counts_shorter_than_it_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = shipped_copy(tmp.path());
+    let path = dir.join("summary.json");
+    let mut json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let original = json.clone();
+    let entry = json["library"][0].clone();
+    json["library"] = serde_json::Value::Array(vec![entry; 10_001]);
+    std::fs::write(&path, serde_json::to_string(&json).unwrap()).unwrap();
+    plot_and_open_refuse(
+        &dir,
+        "library: 10001 sources, more than the 10000 a library may hold",
+        Duration::from_secs(20),
+    );
+    // Within MAX_SOURCES, a library whose graph a dashboard would take minutes to build
+    // again is a notice on Enter.
+    let mut json = original.clone();
+    let entry = json["library"][0].clone();
+    json["library"] = serde_json::Value::Array(vec![entry; 1_001]);
+    for run in json["runs"].as_array_mut().unwrap() {
+        for field in ["source_steps", "positive", "negative"] {
+            run[field] = serde_json::json!([]);
+        }
+    }
+    std::fs::write(&path, serde_json::to_string(&json).unwrap()).unwrap();
+    let folder = sapnet::results::folder_state::FolderReader::new(&dir)
+        .read()
+        .unwrap();
+    let run = &folder.runs[0];
+    let started = Instant::now();
+    let err = sapnet::results::recorded_run::read(&folder, &run.method, run.run, &mut |_| {})
+        .err()
+        .expect("refused");
+    assert!(
+        format!("{err:#}").contains("a library of 1001 sources: a finished run's dashboard"),
+        "{err:#}"
+    );
+    assert!(started.elapsed() < Duration::from_secs(5));
+    let mut json = original;
+    json["runs"][0]["positive"] = serde_json::json!([1, 2]);
+    std::fs::write(&path, serde_json::to_string(&json).unwrap()).unwrap();
+    let folder = sapnet::results::folder_state::FolderReader::new(&dir)
+        .read()
+        .unwrap();
+    let run = &folder.runs[0];
+    let mut events = 0;
+    let err =
+        sapnet::results::recorded_run::read(&folder, &run.method, run.run, &mut |_| events += 1)
+            .err()
+            .expect("refused");
+    assert!(
+        format!("{err:#}").contains("positive holds 2 counts, expected one per source"),
+        "{err:#}"
+    );
+    assert_eq!(events, 0, "refused before any event");
+}
+
+/// Item 6: a monitor file of a header then a 3 GiB sparse hole is refused at its line in
+/// seconds, never allocated whole; so is a run's partial record of one endless line.
+#[test]
+fn an_endless_line_is_refused_at_its_bound() {
+    let tmp = tempfile::tempdir().unwrap();
+    let monitor = tmp.path().join("hole.monitor.csv");
+    std::fs::write(&monitor, "#{\"t_start\": 0}\nr,l,t\n1.0,1,0.1\n").unwrap();
+    let file = std::fs::OpenOptions::new()
+        .write(true)
+        .open(&monitor)
+        .unwrap();
+    file.set_len(3 << 30).unwrap();
+    let other = tmp.path().join("other.monitor.csv");
+    std::fs::write(&other, "#{\"t_start\": 0}\nr,l,t\n1.0,1,0.1\n").unwrap();
+    let started = Instant::now();
+    let output = output_within(
+        sapnet()
+            .args(["compare", "--task", "CartPole-v1", "--method"])
+            .arg(format!("a={}", monitor.display()))
+            .arg("--method")
+            .arg(format!("b={}", other.display()))
+            .arg("--out")
+            .arg(tmp.path().join("out")),
+        Duration::from_secs(60),
+        "compare",
+    );
+    refused(
+        output,
+        "hole.monitor.csv: line 4 is longer than the 4194304 bytes a row may hold",
+    );
+    assert!(started.elapsed() < Duration::from_secs(20));
+}
+
+/// Item 8: `plot` keeps, in the top-level episodes.csv it makes again, a run whose record
+/// keeps its episodes only compressed.
+#[test]
+fn plot_keeps_a_run_kept_only_compressed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("results");
+    ok(dqn(&out, &[]).output().unwrap());
+    let before = std::fs::read_to_string(out.join("episodes.csv")).unwrap();
+    let part = out.join("runs/dqn-16-run1/episodes.csv");
+    let mut xz = Vec::new();
+    lzma_rs::xz_compress(&mut &std::fs::read(&part).unwrap()[..], &mut xz).unwrap();
+    std::fs::write(part.with_extension("csv.xz"), xz).unwrap();
+    std::fs::remove_file(&part).unwrap();
+    ok(sapnet().arg("plot").arg(&out).output().unwrap());
+    let after = std::fs::read_to_string(out.join("episodes.csv")).unwrap();
+    let rows = |text: &str, run: &str| text.lines().filter(|l| l.starts_with(run)).count();
+    assert!(rows(&before, "1,") > 0);
+    assert_eq!(rows(&after, "1,"), rows(&before, "1,"), "{after}");
+    assert_eq!(after.lines().count(), before.lines().count());
+}
+
+/// Item 9: SIGTERM to `sapnet open` leaves the alternate screen and raw mode, exit 143.
+#[test]
+fn sigterm_restores_the_terminal_of_sapnet_open() {
+    if !crate::common::tmux::available() {
+        eprintln!("tmux is not installed: the SIGTERM test of open is skipped");
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = shipped_copy(tmp.path());
+    let pid_file = tmp.path().join("pid");
+    // `exec`: the PID written is sapnet's own.
+    let command = format!(
+        "sh -c 'echo $$ > {}; exec {} open {}'; echo SAPNET-EXITED $?; stty -a | grep -o -- '-*icanon'; sleep 60",
+        pid_file.display(),
+        env!("CARGO_BIN_EXE_sapnet"),
+        dir.display()
+    );
+    let session = crate::common::tmux::Session::start(120, 40, &command);
+    session.wait_for(&["Runs", "complete"]);
+    let pid = std::fs::read_to_string(&pid_file).unwrap();
+    signal(pid.trim(), "-TERM");
+    let screen = session.wait_for(&["SAPNET-EXITED 143", "icanon"]);
+    assert!(
+        !screen.contains("Runs ·"),
+        "the alternate screen was left:\n{screen}"
+    );
+    assert!(
+        screen.lines().any(|l| l.trim() == "icanon"),
+        "raw mode was left on:\n{screen}"
+    );
+}
+
+/// Items 11 and 12: a held lock file of 2 GiB, whose text names another PID and holds an
+/// escape sequence, is refused naming the real holder (from /proc/locks), its text read
+/// only in part and shown escaped.
+#[test]
+fn a_held_lock_is_named_by_its_real_holder_and_its_text_shown_as_data() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("results");
+    ok(dqn(&out, &[]).output().unwrap());
+    let lock = out.join(".sapnet.lock");
+    std::fs::write(&lock, "running as PID 1 on \u{1b}]0;pwned\u{7}host\n").unwrap();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&lock)
+        .unwrap()
+        .set_len(2 << 30)
+        .unwrap();
+    let mut holder = Command::new("flock")
+        .arg(&lock)
+        .args(["sleep", "60"])
+        .spawn()
+        .unwrap();
+    // The lock is taken once flock has started its child.
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !std::fs::read_to_string("/proc/locks")
+        .unwrap()
+        .contains(&format!(" {} ", holder.id()))
+    {
+        assert!(Instant::now() < deadline, "flock never took the lock");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let output = sapnet()
+        .args(["--headless", "--resume", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let _ = holder.kill();
+    let _ = holder.wait();
+    refused(
+        output.clone(),
+        &format!("running as PID {}; its lock file says", holder.id()),
+    );
+    let said = stderr(&output);
+    assert!(said.contains("\\u{1b}]0;pwned\\u{7}host"), "{said}");
+    assert!(!said.contains('\u{1b}'), "{said}");
+}
+
+/// Item 12: `sweep status` shows a cell's failure note as data, cut.
+#[test]
+fn sweep_status_shows_a_failure_note_as_data() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = tmp.path().join("sweep");
+    plan_sweep(tmp.path(), &sweep);
+    std::fs::create_dir_all(sweep.join("failed")).unwrap();
+    let note = format!("\u{1b}[2J\u{1b}]0;title\u{7}{}", "x".repeat(10_000));
+    std::fs::write(sweep.join("failed/0000.txt"), note).unwrap();
+    let output = ok(sapnet()
+        .args(["sweep", "status"])
+        .arg(&sweep)
+        .output()
+        .unwrap());
+    let shown = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(
+        shown.contains("0000 failed: \\u{1b}[2J\\u{1b}]0;title\\u{7}xx"),
+        "{shown}"
+    );
+    assert!(shown.contains("more characters)"), "{shown}");
+    assert!(!shown.contains('\u{1b}'), "{shown}");
+}
+
+/// Item 13: a NaN return is refused by `plot` and `open` naming the file and row, as
+/// `compare` refuses it; so is a finished run without an episode.
+#[test]
+fn nan_returns_and_empty_runs_are_refused_by_plot_and_open() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("results");
+    ok(dqn(&out, &[]).output().unwrap());
+    let part = out.join("runs/dqn-16-run0/episodes.csv");
+    let text = std::fs::read_to_string(&part).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let mut cells: Vec<&str> = lines[2].split(',').collect();
+    cells[3] = "NaN";
+    lines[2] = cells.join(",");
+    std::fs::write(&part, lines.join("\n") + "\n").unwrap();
+    plot_and_open_refuse(
+        &out,
+        "runs/dqn-16-run0/episodes.csv: row 3, column reward: the return NaN is not finite",
+        Duration::from_secs(60),
+    );
+    std::fs::write(&part, format!("{}\n", lines[0])).unwrap();
+    plot_and_open_refuse(
+        &out,
+        "no episode of dqn[16] run 0, which its record says ended",
+        Duration::from_secs(60),
+    );
+}
+
+/// Item 14: `compare --out` naming a file says so; a refusal listing a folder's methods
+/// lists 20 and counts the rest.
+#[test]
+fn compare_refusals_say_what_is_wrong_in_a_line() {
+    let tmp = tempfile::tempdir().unwrap();
+    // A results folder whose episodes.csv holds 200 methods' runs.
+    let folder = tmp.path().join("folder");
+    ok(dqn(&folder, &[]).output().unwrap());
+    let mut episodes = String::from("run,method,episode,reward\n");
+    for m in 0..200 {
+        episodes.push_str(&format!("0,m{m},1,1.0\n"));
+    }
+    std::fs::write(folder.join("episodes.csv"), episodes).unwrap();
+    let compare = |out: &Path, first: &str| {
+        sapnet()
+            .args(["compare", "--task", "CartPole-v1", "--method"])
+            .arg(format!("a={}#{first}", folder.display()))
+            .arg("--method")
+            .arg(format!("b={}#m1", folder.display()))
+            .arg("--out")
+            .arg(out)
+            .output()
+            .unwrap()
+    };
+    let file = tmp.path().join("a-file");
+    std::fs::write(&file, "").unwrap();
+    refused(
+        compare(&file, "m0"),
+        "a file is there, expected a new or empty directory",
+    );
+    let output = compare(&tmp.path().join("out"), "absent");
+    refused(
+        output.clone(),
+        "its methods are \"m0\", \"m1\", \"m2\", \"m3\", \"m4\", \"m5\", \"m6\"",
+    );
+    let said = stderr(&output);
+    assert!(said.contains("\"m19\" … and 180 more"), "{said}");
+    assert!(said.len() < 1000, "{said}");
+}

@@ -68,6 +68,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "limits",
             "seeds",
             "assets",
+            "shown_text",
         ],
     ),
 ];

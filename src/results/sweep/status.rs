@@ -53,6 +53,10 @@ pub fn state(sweep: &Path, id: usize) -> CellState {
     }
 }
 
+/// The most characters of a failure shown per cell: an error's last line is short; a
+/// failure note written by hand may not be.
+const FAILURE_CHARS: usize = 300;
+
 /// The counts, then one line per cell that is not done.
 pub fn report(states: &[(usize, CellState)]) -> String {
     let count = |f: fn(&CellState) -> bool| states.iter().filter(|(_, s)| f(s)).count();
@@ -66,7 +70,11 @@ pub fn report(states: &[(usize, CellState)]) -> String {
     );
     for (id, state) in states {
         match state {
-            CellState::Failed(line) => out.push_str(&format!("{id:04} failed: {line}\n")),
+            // The cell's failure note is a file of the sweep's folder: shown as data.
+            CellState::Failed(line) => out.push_str(&format!(
+                "{id:04} failed: {}\n",
+                crate::shown_text::cut(line, FAILURE_CHARS)
+            )),
             CellState::Running => out.push_str(&format!("{id:04} running (or killed)\n")),
             CellState::Missing | CellState::Done => {}
         }

@@ -164,12 +164,15 @@ pub(super) fn draw(
                 if relative { a - highest } else { a },
             )));
             cells.push(Cell::from(probability_bar(probability, bar_width)));
-            cells.push(Cell::from(count(view.selections[i])));
+            // A count missing (a record from elsewhere, refused when read) shows as 0,
+            // never a panic.
+            let at = |counts: &[u64]| counts.get(i).copied().unwrap_or(0);
+            cells.push(Cell::from(count(at(&view.selections))));
             if full {
                 cells.push(Cell::from(format!(
                     "{}/{}",
-                    count(view.positive[i]),
-                    count(view.negative[i])
+                    count(at(&view.positive)),
+                    count(at(&view.negative))
                 )));
             }
             if history {

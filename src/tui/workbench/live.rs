@@ -57,11 +57,12 @@ struct FolderReads {
 impl FolderReads {
     fn start(dir: &Path) -> Result<Self> {
         let reader = FolderReader::new(dir);
+        let looked = crate::results::folder_changes::look(dir);
         let (reads_tx, reads) = mpsc::channel();
         let (stop_tx, stop) = mpsc::channel::<()>();
         std::thread::Builder::new()
             .name("workbench: reading".into())
-            .spawn(move || read_on(reader, &reads_tx, &stop))
+            .spawn(move || read_on(reader, looked, &reads_tx, &stop))
             .context("starting the thread that reads the folder")?;
         Ok(Self {
             reads,

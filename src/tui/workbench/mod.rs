@@ -4,9 +4,10 @@
 //!
 //! The folder is only read: no file is written or created there and its lock is never
 //! taken (the writer is found without it, [`crate::folder_lock::holder`]); its files are
-//! read as a folder from elsewhere is ([`crate::results::folder_state`]). A thread reads
-//! the folder again every [`REFRESH`] and, when the set of finished runs changed, makes
-//! the comparison again (a bootstrap of seconds for a large protocol), so that the keys
+//! read as a folder from elsewhere is ([`crate::results::folder_state`]). A thread looks
+//! at the folder every [`REFRESH`], reads it again when its files changed
+//! ([`crate::results::folder_changes`]: a finished folder is read once) and, when the set
+//! of finished runs changed, makes the comparison again (a bootstrap of seconds for a large protocol), so that the keys
 //! never wait for it.
 //!
 //! - [`state`]: what the workbench keeps and what its keys do; it draws nothing.
@@ -51,6 +52,7 @@ use crossterm::event::{self as term, KeyEventKind};
 use ratatui::layout::Rect;
 
 use crate::report::Report;
+use crate::results::folder_changes;
 use crate::results::folder_state::{FolderReader, FolderState};
 use state::{Action, Workbench};
 
@@ -70,6 +72,8 @@ type Read = Result<(FolderState, Option<Option<Report>>), String>;
 /// good one kept on screen.
 pub fn run(dir: &Path) -> Result<()> {
     let mut reader = FolderReader::new(dir);
+    // Looked at before the read: a change during it is seen at the next look.
+    let looked = folder_changes::look(dir);
     let folder = reader
         .read()
         .with_context(|| format!("sapnet open {}", dir.display()))?;
@@ -83,7 +87,7 @@ pub fn run(dir: &Path) -> Result<()> {
     let (_stop, stop) = mpsc::channel::<()>();
     std::thread::Builder::new()
         .name("sapnet open: reading".into())
-        .spawn(move || read_on(reader, &reads_tx, &stop))
+        .spawn(move || read_on(reader, looked, &reads_tx, &stop))
         .context("starting the thread that reads the folder")?;
     let (mut terminal, _guard) = super::open_terminal()?;
     let mut dirty = true;
@@ -126,12 +130,31 @@ pub fn run(dir: &Path) -> Result<()> {
     }
 }
 
-/// Reads the folder every [`REFRESH`] until `stop` is dropped, sending each read, with the
-/// report made again when the finished runs changed.
-fn read_on(mut reader: FolderReader, reads: &mpsc::Sender<Read>, stop: &mpsc::Receiver<()>) {
+/// Reads the folder again when its files changed ([`folder_changes`]: looked at every
+/// [`REFRESH`]; `looked` is the look of the read on screen) until `stop` is dropped,
+/// sending each read, with the report made again when the finished runs changed.
+fn read_on(
+    mut reader: FolderReader,
+    mut looked: folder_changes::Look,
+    reads: &mpsc::Sender<Read>,
+    stop: &mpsc::Receiver<()>,
+) {
     lowest_priority();
     let mut reported = None;
+    let mut first = true;
     loop {
+        if !first {
+            match stop.recv_timeout(REFRESH) {
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+                _ => return,
+            }
+            let look = folder_changes::look(reader.dir());
+            if look == looked {
+                continue;
+            }
+            looked = look;
+        }
+        first = false;
         let read = match reader.read() {
             Ok(folder) => {
                 let finished = folder.finished_key();
@@ -147,10 +170,6 @@ fn read_on(mut reader: FolderReader, reads: &mpsc::Sender<Read>, stop: &mpsc::Re
         };
         if reads.send(read).is_err() {
             return;
-        }
-        match stop.recv_timeout(REFRESH) {
-            Err(mpsc::RecvTimeoutError::Timeout) => {}
-            _ => return,
         }
     }
 }

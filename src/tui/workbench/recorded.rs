@@ -19,13 +19,11 @@ pub fn dashboard(
     task: &str,
     reference: &[Band],
 ) -> Result<Dashboard> {
-    let recorded = recorded_run::read(folder, method, run)?;
     let mut dashboard = Dashboard::new(task);
     dashboard.reference = reference.to_vec();
     dashboard.follow(method.label());
-    for event in recorded.events {
-        dashboard.on_event(event);
-    }
+    // Fed as read: the dashboard keeps what it shows (its curve thinned), not the events.
+    let recorded = recorded_run::read(folder, method, run, &mut |event| dashboard.on_event(event))?;
     dashboard.from_files = Some(FromFiles {
         activations: recorded.activations,
         learner: recorded.learner,
