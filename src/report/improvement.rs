@@ -31,8 +31,11 @@ pub struct Improvement {
     /// Of the [`BOOTSTRAP_SEEDS`] intervals of `P(X > Y)`, how many exclude ½.
     pub seeds_excluding: usize,
     pub verdict: Verdict,
-    /// Where the pair is not separated, on one task: the runs per method at which the
-    /// rank test would detect the `P(X > Y)` these runs show, at 80% power.
+    /// Where the pair is not separated (or fragile), on one task: the runs per method at
+    /// which the
+    /// rank test would detect the `P(X > Y)` these runs show, at 80% power and at the level
+    /// Holm's adjustment tests the table's first pair (0.05 over the pairs); `None` where
+    /// that is no more runs than these (no plan the rule could pass).
     pub runs_needed: Option<usize>,
     /// Pooled over several tasks: the verdict on each task alone, in the report's order
     /// (each task's table its own Holm family).
@@ -83,6 +86,10 @@ pub(super) fn every_pair(methods: &[MethodRuns], tasks: &[String]) -> Vec<Improv
             Vec::new()
         };
         let n = present.len();
+        // The level Holm's adjustment tests the table's first pair at: a plan of runs that
+        // the rule can pass is made there.
+        let pairs = (n * n.saturating_sub(1) / 2).max(1);
+        let level = power::ALPHA / pairs as f64;
         for i in 0..n {
             for j in 0..n {
                 if i == j {
@@ -107,8 +114,10 @@ pub(super) fn every_pair(methods: &[MethodRuns], tasks: &[String]) -> Vec<Improv
                     seeds_excluding: separation::excluding_half(&pair.intervals),
                     verdict,
                     runs_needed: (tasks.len() == 1 && verdict != Verdict::Separated)
-                        .then(|| power::runs_per_method(p.point))
-                        .flatten(),
+                        .then(|| power::runs_per_method_at(p.point, level))
+                        .flatten()
+                        // A plan: more runs than these, which the rule did not separate.
+                        .filter(|&needed| needed > present[i].1.runs().min(present[j].1.runs())),
                     per_task: per_task.iter().map(|t| t[at].verdict()).collect(),
                 });
             }
@@ -338,6 +347,38 @@ mod tests {
         assert_eq!(cb.verdict, Verdict::NotSeparated);
         assert!(cb.runs_needed.unwrap() > 1000, "{:?}", cb.runs_needed);
         assert!(cb.per_task.is_empty(), "one task has no per-task column");
+    }
+
+    /// Eleven methods of six runs each, every method's runs above every run of the next:
+    /// every P is 0 or 1, yet no pair can pass Holm over 55 pairs at six runs (the smallest
+    /// exact p, 2/C(12, 6) = 0.0022, times 55 is above 0.05). The plan each pair is told is
+    /// made at Holm's first level, 0.05/55: 12 runs a method, never the 6 it already has.
+    #[test]
+    fn runs_needed_is_a_plan_the_rule_could_pass() {
+        let methods: Vec<MethodRuns> = (0..11)
+            .map(|k| {
+                let runs: Vec<f64> = (0..6).map(|i| f64::from(k * 10 + i)).collect();
+                method(&format!("m{k:02}"), vec![runs])
+            })
+            .collect();
+        let rows = every_pair(&methods, &["cartpole".into()]);
+        assert_eq!(rows.len(), 2 * 55);
+        for row in &rows {
+            assert_ne!(
+                row.verdict,
+                Verdict::Separated,
+                "{} over {}",
+                row.method,
+                row.over
+            );
+            assert_eq!(
+                row.runs_needed,
+                Some(12),
+                "{} over {}",
+                row.method,
+                row.over
+            );
+        }
     }
 
     #[test]

@@ -28,11 +28,21 @@ pub const POWER: f64 = 0.8;
 ///
 /// Precondition: `0 ≤ p ≤ 1`.
 pub fn runs_per_method(p: f64) -> Option<usize> {
+    runs_per_method_at(p, ALPHA)
+}
+
+/// [`runs_per_method`] at the two-sided level `alpha`: a table's pairs are tested with
+/// Holm's adjustment, under which the pair with the smallest p must pass `ALPHA / pairs`,
+/// so a plan that the rule can pass is made at that level (Bonferroni's, which Holm's
+/// first step is).
+///
+/// Precondition: `0 ≤ p ≤ 1`, `0 < alpha < 1`.
+pub fn runs_per_method_at(p: f64, alpha: f64) -> Option<usize> {
     debug_assert!((0.0..=1.0).contains(&p), "a probability, not {p}");
     if p == 0.5 {
         return None;
     }
-    let z = normal::quantile(1.0 - ALPHA / 2.0) + normal::quantile(POWER);
+    let z = normal::quantile(1.0 - alpha / 2.0) + normal::quantile(POWER);
     let share = 0.5;
     let all_runs = z * z / (12.0 * share * (1.0 - share) * (p - 0.5).powi(2));
     // At least (z/0.5)²/3 ≈ 10.5 runs in all, when p is 0 or 1; a p a hair from ½ asks
@@ -43,6 +53,17 @@ pub fn runs_per_method(p: f64) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// At the level Holm's adjustment tests the first of 55 pairs, 0.05/55: z = 3.317,
+    /// (3.317 + 0.842)²/(3·¼) = 23.06 runs in all, 12 per method for a complete separation
+    /// (p = 1) — where 6 runs a method, whose smallest exact p (0.0022) cannot pass
+    /// 0.05/55 = 0.00091, would be promised at 0.05.
+    #[test]
+    fn a_plan_at_holms_level_asks_for_more_runs() {
+        assert_eq!(runs_per_method(1.0), Some(6));
+        assert_eq!(runs_per_method_at(1.0, 0.05 / 55.0), Some(12));
+        assert!(runs_per_method_at(0.75, 0.05 / 55.0).unwrap() > runs_per_method(0.75).unwrap());
+    }
 
     #[test]
     fn noether_runs_as_the_reference_script_counts_them() {

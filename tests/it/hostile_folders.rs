@@ -371,9 +371,11 @@ fn output_within(command: &mut Command, limit: Duration, what: &str) -> Output {
 /// the manifest's hash of the cell is made to match.
 fn lengthen_cell(sweep: &Path, id: usize, episodes: u32) {
     let cell = sweep.join(format!("cells/{id:04}.ron"));
-    let text = std::fs::read_to_string(&cell)
-        .unwrap()
-        .replace("episodes: 5,", &format!("episodes: {episodes},"));
+    let text = std::fs::read_to_string(&cell).unwrap().replace(
+        "budget: Episodes(5),",
+        &format!("budget: Episodes({episodes}),"),
+    );
+    assert!(text.contains(&format!("Episodes({episodes})")), "{text}");
     let old_hash = sapnet::policy_store::sha256_hex(&std::fs::read(&cell).unwrap());
     std::fs::write(&cell, &text).unwrap();
     let hash = sapnet::policy_store::sha256_hex(text.as_bytes());
@@ -920,7 +922,7 @@ fn counts_beyond_their_bounds_are_refused_before_anything_is_allocated() {
         ("(dqn: (gradient_steps: 1000000000))", "1 to 10000 updates"),
         (
             "(protocol: (episodes: 4000000000))",
-            "expected 1 to 10000000",
+            "with 1 ≤ n ≤ 10000000",
         ),
     ] {
         let path = config("bad.ron", text);

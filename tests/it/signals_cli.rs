@@ -74,9 +74,13 @@ fn a_signalled_headless_run_writes_what_it_did_and_exits_128_plus_the_signal() {
             .unwrap();
         let table = String::from_utf8_lossy(&plot.stdout);
         let episodes = summary["runs"][0]["episodes"].as_u64().unwrap();
+        let steps = summary["runs"][0]["steps"].as_u64().unwrap();
         assert_eq!(
             table.trim(),
-            format!("not in the table, stopped before their end: dqn[8] run 0 at episode {episodes}/1000000"),
+            format!(
+                "not in the table, stopped before their end: dqn[8] run 0 at episode \
+                 {episodes} (step {steps}) of 1000000 episodes"
+            ),
             "{signal}"
         );
     }
