@@ -432,3 +432,75 @@ fn policies_added_and_recategorised_by_flag() {
         "{said}"
     );
 }
+
+/// Issue 52, item 7: `teach --save` once renamed over whatever PATH was. A FIFO, a socket
+/// and a directory are refused naming the path and what was expected (exit 2), and left
+/// as they were; nothing is left beside them.
+#[test]
+fn save_refuses_a_fifo_a_socket_and_a_directory_and_leaves_them() {
+    use std::os::unix::fs::FileTypeExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let fifo = tmp.path().join("fifo");
+    let path = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: a NUL-terminated path and a mode, as mkfifo(3) takes them.
+    assert_eq!(unsafe { libc::mkfifo(path.as_ptr(), 0o644) }, 0);
+    let socket = tmp.path().join("socket");
+    let _listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
+    let directory = tmp.path().join("folder");
+    std::fs::create_dir(&directory).unwrap();
+    for (target, what) in [
+        (&fifo, "a FIFO"),
+        (&socket, "a socket"),
+        (&directory, "a directory"),
+    ] {
+        let named = target.to_str().unwrap();
+        let output = sapnet(&["teach", "--save", named]);
+        assert_eq!(output.status.code(), Some(2), "{what}");
+        let error = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            error.contains(named) && error.contains(what) && error.contains("a regular file"),
+            "{what}: {error}"
+        );
+    }
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+    assert!(std::fs::symlink_metadata(&socket)
+        .unwrap()
+        .file_type()
+        .is_socket());
+    assert_eq!(std::fs::read_dir(&directory).unwrap().count(), 0);
+    let mut left: Vec<String> = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["fifo", "folder", "socket"], "no temporary file left");
+}
+
+/// A lesson saved over a file of 0600 keeps 0600 (it once became 0644), and is replaced
+/// whole; a new file is made as any other.
+#[test]
+fn save_keeps_an_existing_files_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let private = tmp.path().join("private.ron");
+    std::fs::write(
+        &private,
+        "an older lesson, much longer than the new one ".repeat(100),
+    )
+    .unwrap();
+    std::fs::set_permissions(&private, std::fs::Permissions::from_mode(0o600)).unwrap();
+    let output = sapnet(&["teach", "--save", private.to_str().unwrap()]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let mode = std::fs::metadata(&private).unwrap().permissions().mode();
+    assert_eq!(mode & 0o7777, 0o600);
+    let text = std::fs::read_to_string(&private).unwrap();
+    assert!(text.starts_with("// A sapnet lesson"), "{text}");
+    assert!(!text.contains("an older lesson"), "{text}");
+}
