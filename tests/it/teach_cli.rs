@@ -504,3 +504,30 @@ fn save_keeps_an_existing_files_permissions() {
     assert!(text.starts_with("// A sapnet lesson"), "{text}");
     assert!(!text.contains("an older lesson"), "{text}");
 }
+
+/// Issue 52, item 12: a received lesson whose names hold an OSC title and a screen clear.
+/// `--headless` prints them as visible escapes, never as the bytes a terminal acts on.
+#[test]
+fn control_characters_in_a_lessons_names_are_printed_as_escapes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let lesson = tmp.path().join("hostile.ron");
+    std::fs::write(
+        &lesson,
+        "(names: [\"\u{1b}]0;owned\u{7}\", \"\u{1b}[2J\u{1b}[H\"], edges: [(0, 1, 0.4)])",
+    )
+    .unwrap();
+    let config = lesson.to_str().unwrap();
+    let out = sapnet(&["teach", "--headless", "--config", config, "--activate", "0"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(!text.contains(['\u{1b}', '\u{7}']), "{text:?}");
+    assert!(
+        text.contains("activate \\u{1b}]0;owned\\u{7}: A[\\u{1b}]0;owned\\u{7}] += 𝒜 = 1"),
+        "{text}"
+    );
+    assert!(text.contains("\\u{1b}[2J\\u{1b}[H"), "{text}");
+}
