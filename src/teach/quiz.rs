@@ -114,6 +114,13 @@ impl Teach {
         self.exercise
     }
 
+    /// Whether the screen keeps the next call's ΔA and eq. 10's outcome (deposit or stop)
+    /// to itself: in the exercise they are what `s` asks, said once answered (and the
+    /// call made).
+    pub fn hides_next_answer(&self) -> bool {
+        self.exercise.is_some()
+    }
+
     /// `s`: in exercise mode, asks the next call's ΔA before making it; else makes it.
     pub fn step_or_ask(&mut self) {
         let next = self.walk.as_ref().and_then(|w| w.next_call());

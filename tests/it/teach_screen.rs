@@ -489,3 +489,62 @@ fn a_question_is_asked_at_the_walks_end_and_its_answer_hidden() {
     teach.prompt_submit();
     assert_eq!(teach.notice(), Some("right: 7.25 ± 0.01 · questions 1/1"));
 }
+
+/// Issue 51, item 5: the exercise once printed the answer beside its question. Fig. 2
+/// from π1: the first call deposits (1/3)/(1×0.4) = 0.833333, the second
+/// (1/6)/(2×0.8) = 0.104167, the third stops (Ω = 1.2 ≥ T_ω = 1). Each is nowhere on the
+/// screen while it is asked, and said once answered.
+#[test]
+fn the_exercise_hides_the_answer_until_it_is_given() {
+    let mut teach = fig2();
+    teach.move_cursor(1);
+    teach.activate();
+    teach.toggle_exercise();
+    let answer = |teach: &mut Teach, typed: &str| {
+        typed.chars().for_each(|c| teach.prompt_type(c));
+        teach.prompt_submit();
+    };
+    teach.step_or_ask();
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = text(&terminal);
+        assert!(
+            screen.contains("ΔA of the next call"),
+            "{size:?}:\n{screen}"
+        );
+        assert!(!screen.contains("0.833"), "{size:?}:\n{screen}");
+        assert!(!screen.contains("true"), "{size:?}:\n{screen}");
+        insta::assert_snapshot!(
+            format!("teach_exercise_asked_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+    answer(&mut teach, "0.8333");
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = text(&terminal);
+        assert!(screen.contains("0.833333"), "{size:?}:\n{screen}");
+        assert!(!screen.contains("0.104"), "the next answer:\n{screen}");
+        insta::assert_snapshot!(
+            format!("teach_exercise_answered_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+    teach.step_or_ask();
+    answer(&mut teach, "0.1");
+    teach.step_or_ask();
+    for size in SIZES {
+        let screen = text(&draw(&teach, size));
+        assert!(
+            !screen.contains("stop (") && !screen.contains("stopped"),
+            "{screen}"
+        );
+        assert!(!screen.contains("the call stops"), "{size:?}:\n{screen}");
+    }
+    answer(&mut teach, "stop");
+    for size in SIZES {
+        let screen = text(&draw(&teach, size));
+        assert!(screen.contains("stopped"), "{size:?}:\n{screen}");
+        assert!(screen.contains("score 2/3"), "{size:?}:\n{screen}");
+    }
+}
