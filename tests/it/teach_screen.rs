@@ -177,9 +177,9 @@ fn the_trace_shows_four_calls_at_the_smallest_size() {
     }
 }
 
-/// Table II's π3 activated at 80×24, where the activations table has four rows for ten
-/// policies: the policies the walk deposits on (π4, π5, π6, its category) are in view
-/// beside π3, not π0…π2 (the rows nearest π3 by index).
+/// Table II's π3 activated: the policies the walk deposits on (π4, π5, π6, its category)
+/// are in view beside π3. At 80×24 the activations table once had four rows for ten
+/// policies and kept these in view; a grid now shows all ten.
 #[test]
 fn the_policies_receiving_delta_a_stay_in_the_table() {
     let mut teach = table2();
@@ -207,16 +207,19 @@ fn the_policies_receiving_delta_a_stay_in_the_table() {
             .take_while(|l| !l.contains("pending spread calls"))
             .collect();
         let text = table.join("\n");
+        // A row's first cell, or a cell of the grid's second column.
+        let shows = |i: usize| {
+            ["│π", "│ π"]
+                .iter()
+                .any(|at| text.contains(&format!("{at}{i} ")))
+        };
         for i in [3, 4, 5, 6] {
-            assert!(
-                text.contains(&format!("│π{i} ")),
-                "π{i} at {size:?}:\n{text}"
-            );
+            assert!(shows(i), "π{i} at {size:?}:\n{text}");
         }
-        if size == (80, 24) {
-            assert!(!text.contains("│π0 "), "{text}");
-            assert!(text.contains("6 of 10 not shown"), "{text}");
-        }
+        // Issue 51, item 5: at 80×24 a table of four rows once hid six policies; a grid
+        // shows all ten.
+        assert!((0..10).all(shows), "{size:?}:\n{text}");
+        assert!(!text.contains("not shown"), "{text}");
         insta::assert_snapshot!(
             format!("teach_receivers_in_view_{}x{}", size.0, size.1),
             terminal.backend()
@@ -547,4 +550,37 @@ fn the_exercise_hides_the_answer_until_it_is_given() {
         assert!(screen.contains("stopped"), "{size:?}:\n{screen}");
         assert!(screen.contains("score 2/3"), "{size:?}:\n{screen}");
     }
+}
+
+/// At 80×24 Table II's activations are a grid of two columns: a click on a cell picks its
+/// policy, a click on the gap between the columns picks none.
+#[test]
+fn a_click_on_a_cell_of_the_activations_grid_picks_its_policy() {
+    let teach = table2();
+    let size = (80, 24);
+    let screen = lines(&draw(&teach, size));
+    let screen_area = ratatui::layout::Rect::new(0, 0, size.0, size.1);
+    let click = |column: usize, row: usize| {
+        teach_view::clicked(&teach, screen_area, column as u16, row as u16)
+    };
+    for i in 0..10 {
+        let (row, column) = screen
+            .iter()
+            .enumerate()
+            .find_map(|(row, l)| {
+                let table = right(l, size.0);
+                let at = table.find(&format!("π{i} 0."))?;
+                Some((
+                    row,
+                    usize::from(size.0) * 45 / 100 + table[..at].chars().count(),
+                ))
+            })
+            .unwrap_or_else(|| panic!("π{i}'s cell:\n{}", screen.join("\n")));
+        assert_eq!(click(column, row), Some(i), "π{i}");
+        assert_eq!(click(column + 8, row), Some(i), "π{i}'s A");
+    }
+    let row = screen.iter().position(|l| l.contains("π0 0.")).unwrap();
+    let gap = right(&screen[row], size.0).find(" │ ").unwrap();
+    let gap = usize::from(size.0) * 45 / 100 + right(&screen[row], size.0)[..gap].chars().count();
+    assert_eq!(click(gap + 1, row), None, "the gap");
 }
