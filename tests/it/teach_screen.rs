@@ -584,3 +584,36 @@ fn a_click_on_a_cell_of_the_activations_grid_picks_its_policy() {
     let gap = usize::from(size.0) * 45 / 100 + right(&screen[row], size.0)[..gap].chars().count();
     assert_eq!(click(gap + 1, row), None, "the gap");
 }
+
+/// Issue 51, item 5: Table II's chart had ten curves and no legend (no room for one).
+/// Each curve's end is named beside it: π3's walk ends with π3 highest in A and P, π4…π6
+/// (its category) sharing a row in A, the other six the bottom one; names that do not
+/// fit are counted (`π4 +2`).
+#[test]
+fn the_charts_curves_are_named_at_their_ends() {
+    let mut teach = table2();
+    teach.move_cursor(3);
+    teach.activate();
+    teach.run_to_end();
+    teach.next_panel();
+    teach.next_panel();
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = lines(&terminal);
+        let chart: Vec<String> = screen
+            .iter()
+            .map(|l| right(l, size.0))
+            .skip_while(|l| !l.contains("chart (v: through time)"))
+            .collect();
+        let text = chart.join("\n");
+        // π3 ends highest in both charts, A's and P's, alone on its row.
+        assert_eq!(text.matches(" π3 ").count(), 2, "{size:?}:\n{text}");
+        for named in ["π4", "π0"] {
+            assert!(text.contains(named), "{size:?} {named}:\n{text}");
+        }
+        insta::assert_snapshot!(
+            format!("teach_table2_chart_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+}
