@@ -617,3 +617,29 @@ fn the_charts_curves_are_named_at_their_ends() {
         );
     }
 }
+
+/// Table II through time at 80×24 has room for four of ten policies' rows: it once cut
+/// the rest silently. The picked policy's row stays in view as the arrows move, and the
+/// border counts the rows left out.
+#[test]
+fn through_time_keeps_the_picked_policy_in_view_and_counts_the_rest() {
+    let mut teach = table2();
+    teach.move_cursor(3);
+    teach.activate();
+    teach.run_to_end();
+    teach.move_cursor(5);
+    for _ in 0..3 {
+        teach.next_panel();
+    }
+    let terminal = draw(&teach, (80, 24));
+    let panel: Vec<String> = lines(&terminal)
+        .iter()
+        .map(|l| right(l, 80))
+        .skip_while(|l| !l.contains("through time"))
+        .collect();
+    let text = panel.join("\n");
+    assert!(text.contains("│π8 "), "{text}");
+    assert!(!text.contains("│π0 "), "{text}");
+    assert!(text.contains("▲ 5 more · ▼ 1 more"), "{text}");
+    insta::assert_snapshot!("teach_table2_through_time_80x24", terminal.backend());
+}
