@@ -2,14 +2,10 @@
 //! time, with every quantity of eq. 8–11 shown.
 //!
 //! - [`config`]: the teach file (RON), a graph given by its edges or by policy categories.
-//! - [`session`]: a lesson being taught (teach mode's state; the terminal UI draws it):
-//!   what its rooms share, the picked policy, the panel shown. Its rooms:
-//!   - [`walk`]: one activation's spreading stepped a call at a time, with undo, and A
-//!     and P through time; [`playback`]: `r` and `R`;
-//!   - [`names`]: what the screen calls the policies;
-//!   - [`graph_edits`]: the knobs and the graph edited by key and by mouse;
-//!   - [`prompt`]: the line typed; [`quiz`]: the exercise and the lesson's questions;
-//!   - [`lesson_file`]: the lesson written back (`w`).
+//! - [`session`]: a lesson being taught (teach mode's state; the terminal UI draws it),
+//!   a room per job under `session/`: the walk with undo and `r`/`R`, the policies' names,
+//!   the graph's edits by key and mouse, the line typed, the quiz, the lesson written
+//!   back.
 //! - [`knobs`]: the session's live edits (T_ω, 𝒜, τ, paths, an edge's weight) and what
 //!   each changed.
 //! - [`labels`]: short names for policies and tasks, for a graph node or a narrow column.
@@ -23,19 +19,12 @@
 
 pub mod category;
 pub mod edit;
-pub mod graph_edits;
 pub mod headless;
 pub mod knobs;
 pub mod labels;
 pub mod lesson;
-pub mod lesson_file;
-pub mod names;
-pub mod playback;
-pub mod prompt;
 pub mod questions;
-pub mod quiz;
 pub mod session;
-pub mod walk;
 
 pub use lesson::{Lesson, TeachConfig};
 pub use session::Teach;
@@ -56,13 +45,19 @@ mod tests {
             ("knobs.rs", include_str!("knobs.rs")),
             ("labels.rs", include_str!("labels.rs")),
             ("session.rs", include_str!("session.rs")),
-            ("walk.rs", include_str!("walk.rs")),
-            ("playback.rs", include_str!("playback.rs")),
-            ("names.rs", include_str!("names.rs")),
-            ("graph_edits.rs", include_str!("graph_edits.rs")),
-            ("prompt.rs", include_str!("prompt.rs")),
-            ("quiz.rs", include_str!("quiz.rs")),
-            ("lesson_file.rs", include_str!("lesson_file.rs")),
+            ("session/walk.rs", include_str!("session/walk.rs")),
+            ("session/playback.rs", include_str!("session/playback.rs")),
+            ("session/names.rs", include_str!("session/names.rs")),
+            (
+                "session/graph_edits.rs",
+                include_str!("session/graph_edits.rs"),
+            ),
+            ("session/prompt.rs", include_str!("session/prompt.rs")),
+            ("session/quiz.rs", include_str!("session/quiz.rs")),
+            (
+                "session/lesson_file.rs",
+                include_str!("session/lesson_file.rs"),
+            ),
         ];
         // The paths are put together, so that this test does not find them in itself.
         let front_ends = [["crate", "tui::"], ["ratatui", ""], ["crossterm", ""]];

@@ -1,67 +1,77 @@
 //! Teach mode's state: a lesson being taught, the policy picked, the activation in
-//! progress. Each of its jobs has a room of its own, and `Teach` owns their state:
+//! progress. Each of its jobs has a room of its own under `session/`, and `Teach` owns
+//! their state:
 //!
-//! - [`walk`](super::walk): one activation stepped a `spread` call at a time, with undo,
-//!   and A and P through time;
-//! - [`playback`](super::playback): `r` and `R`, calls made between frames;
-//! - [`names`](super::names): what the screen calls the policies (`p`);
-//! - [`graph_edits`](super::graph_edits): knobs turned, edges and policies edited by key
-//!   and by mouse (`M`);
-//! - [`prompt`](super::prompt): the line typed, and what Enter does with it;
-//! - [`quiz`](super::quiz): the exercise's predictions and the lesson's questions;
-//! - [`lesson_file`](super::lesson_file): the lesson written back (`w`).
+//! - `walk`: one activation stepped a `spread` call at a time, with undo, and A and P
+//!   through time;
+//! - `playback`: `r` and `R`, calls made between frames;
+//! - `names`: what the screen calls the policies (`p`);
+//! - `graph_edits`: knobs turned, edges and policies edited by key and by mouse (`M`);
+//! - `prompt`: the line typed, and what Enter does with it;
+//! - `quiz`: the exercise's predictions and the lesson's questions;
+//! - `lesson_file`: the lesson written back (`w`).
 //!
-//! This file holds what they share: the net, the cursor, the notice, the panel shown.
+//! This file holds what they share: the net, the cursor, the notice, the panel shown. The
+//! rooms are its children, so that they read its fields and it reads theirs without the
+//! files importing each other in a circle.
 
-use super::graph_edits::Editing;
+mod graph_edits;
+mod lesson_file;
+mod names;
+mod playback;
+mod prompt;
+mod quiz;
+mod walk;
+
 use super::lesson::TeachConfig;
-use super::names::Names;
-use super::playback::Playback;
-use super::quiz::Questions;
-use super::walk::{Timeline, Walk};
 use crate::sapnet::SapNet;
+use graph_edits::Editing;
+use names::Names;
+use playback::Playback;
+use quiz::Questions;
+use walk::{Timeline, Walk};
 
-pub use super::graph_edits::MOUSE_EDGE_WEIGHT;
-pub use super::playback::{CALLS_PER_FRAME, SPEEDS};
-pub use super::prompt::{Prompt, PromptKind, LESSON_FILE};
-pub use super::quiz::{Score, ANSWER_TOLERANCE};
-pub use super::walk::{TimeRow, WalkView};
+pub use graph_edits::MOUSE_EDGE_WEIGHT;
+pub use playback::{CALLS_PER_FRAME, SPEEDS};
+pub use prompt::{Prompt, PromptKind, LESSON_FILE};
+pub use quiz::{Score, ANSWER_TOLERANCE};
+pub use walk::{TimeRow, WalkView};
 
 /// Where teach mode stands: which policy is picked, and the activation in progress.
 #[derive(Debug, Clone)]
 pub struct Teach {
     /// The lesson's net, with the activations as they stand after the calls made so far.
-    pub(super) net: SapNet,
-    pub(super) names: Names,
+    net: SapNet,
+    names: Names,
     /// The activations before the first activation of this lesson (`c` goes back to them).
-    pub(super) initial: Vec<f64>,
+    initial: Vec<f64>,
     /// The policy the arrows point at.
-    pub(super) cursor: usize,
-    pub(super) walk: Option<Walk>,
-    pub(super) playback: Playback,
+    cursor: usize,
+    walk: Option<Walk>,
+    playback: Playback,
     /// The walks finished so far, and the decay between two.
-    pub(super) timeline: Timeline,
+    timeline: Timeline,
     /// Category of each policy, to draw related policies together.
-    pub(super) groups: Option<Vec<usize>>,
+    groups: Option<Vec<usize>>,
     /// Per policy, whether the live run had its category out of the candidates when teach
     /// mode opened on its net (empty: none, or a lesson).
-    pub(super) excluded: Vec<bool>,
+    excluded: Vec<bool>,
     /// The knob and edge the next edit acts on, the last edit, the mouse's `M` mode.
-    pub(super) editing: Editing,
+    editing: Editing,
     /// Something the last key did that the screen must say: an edit refused, pending
     /// calls made before a new activation.
-    pub(super) notice: Option<String>,
+    notice: Option<String>,
     /// A line being typed (an edge to add, the file to save to), if any.
-    pub(super) prompt: Option<Prompt>,
+    prompt: Option<Prompt>,
     /// Exercise mode (`X`): before each call the student types its ΔA; the score so far.
-    pub(super) exercise: Option<Score>,
+    exercise: Option<Score>,
     /// The lesson's questions, asked one after another when a walk ends.
-    pub(super) questions: Questions,
+    questions: Questions,
     /// The lesson file this session was opened from, for what the net does not hold: the
     /// policies' descriptions where categories build M, and what `w` writes back.
-    pub(super) source: TeachConfig,
+    source: TeachConfig,
     /// What the panel under the edits shows (`v` cycles).
-    pub(super) panel: WalkPanel,
+    panel: WalkPanel,
 }
 
 /// What the panel under the edits shows; `v` goes to the next.

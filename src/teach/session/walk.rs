@@ -7,9 +7,9 @@
 
 use serde::Serialize;
 
-use super::lesson::WalkPosition;
-use super::session::Teach;
+use super::Teach;
 use crate::sapnet::{Call, Graph, SapNet, SpreadState, Spreader, TraceStep};
+use crate::teach::lesson::WalkPosition;
 
 /// One activation being stepped.
 #[derive(Debug, Clone)]

@@ -4,10 +4,10 @@
 //! a refusal changes nothing and is said, and the walk on screen restarts from the
 //! activations it started from, so that its end before and after can be compared.
 
-use super::edit::{GraphEdit, NO_CATEGORY};
-use super::knobs::{refusal, walk_end, EditReport, Knob};
 use super::prompt::PromptKind;
-use super::session::Teach;
+use super::Teach;
+use crate::teach::edit::{GraphEdit, NO_CATEGORY};
+use crate::teach::knobs::{refusal, walk_end, EditReport, Knob};
 
 /// The weight of an edge added by the mouse (`M`): Fig. 2's; `5` and `+`/`−` change it.
 pub const MOUSE_EDGE_WEIGHT: f64 = 0.4;

@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use super::lesson::{TeachConfig, WalkPosition};
-use super::session::Teach;
+use super::Teach;
+use crate::teach::lesson::{TeachConfig, WalkPosition};
 
 impl Teach {
     /// The lesson as it stands, in the format `sapnet teach --config` reads: the graph

@@ -1,7 +1,7 @@
 //! What teach mode calls the policies: the lesson's names where they tell the policies
 //! apart on the graph, else π0…; and, for names π0…, the paper's π1…πN (`p`).
 
-use super::labels;
+use crate::teach::labels;
 
 /// The policies' names as the screen shows them, and as the lesson gave them.
 #[derive(Debug, Clone)]

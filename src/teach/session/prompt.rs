@@ -4,8 +4,8 @@
 
 use std::path::PathBuf;
 
-use super::edit::GraphEdit;
-use super::session::Teach;
+use super::Teach;
+use crate::teach::edit::GraphEdit;
 
 /// A line the user types in teach mode, and what Enter does with it.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -3,9 +3,9 @@
 //! checked, scored, and only then is the answer said.
 
 use super::prompt::{Prompt, PromptKind};
-use super::questions::Question;
-use super::session::Teach;
+use super::Teach;
 use crate::sapnet::Call;
+use crate::teach::questions::Question;
 
 /// Answers right of answers given.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]

@@ -5,7 +5,7 @@
 
 use std::time::{Duration, Instant};
 
-use super::session::Teach;
+use super::Teach;
 
 /// Calls `R` makes between two frames: a few milliseconds' worth.
 pub const CALLS_PER_FRAME: usize = 50_000;
