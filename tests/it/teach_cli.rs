@@ -433,9 +433,9 @@ fn policies_added_and_recategorised_by_flag() {
     );
 }
 
-/// Issue 52, item 7: `teach --save` once renamed over whatever PATH was. A FIFO, a socket
-/// and a directory are refused naming the path and what was expected (exit 2), and left
-/// as they were; nothing is left beside them.
+/// Issue 52, item 7: `teach --save` once renamed over whatever PATH was. A FIFO, a socket,
+/// a directory and (as root) a device node are refused naming the path and what was
+/// expected (exit 2), and left as they were; nothing is left beside them.
 #[test]
 fn save_refuses_a_fifo_a_socket_and_a_directory_and_leaves_them() {
     use std::os::unix::fs::FileTypeExt;
@@ -448,11 +448,21 @@ fn save_refuses_a_fifo_a_socket_and_a_directory_and_leaves_them() {
     let _listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
     let directory = tmp.path().join("folder");
     std::fs::create_dir(&directory).unwrap();
-    for (target, what) in [
+    // /dev/null's twin (major 1, minor 3), made here rather than risking /dev/null itself:
+    // only root may make one, as only root could have had /dev/null replaced.
+    let device = tmp.path().join("null");
+    let path = std::ffi::CString::new(device.to_str().unwrap()).unwrap();
+    // SAFETY: a NUL-terminated path, a mode and a device number, as mknod(2) takes them.
+    let made = unsafe { libc::mknod(path.as_ptr(), libc::S_IFCHR | 0o666, libc::makedev(1, 3)) };
+    let mut refused = vec![
         (&fifo, "a FIFO"),
         (&socket, "a socket"),
         (&directory, "a directory"),
-    ] {
+    ];
+    if made == 0 {
+        refused.push((&device, "a device"));
+    }
+    for (target, what) in refused {
         let named = target.to_str().unwrap();
         let output = sapnet(&["teach", "--save", named]);
         assert_eq!(output.status.code(), Some(2), "{what}");
@@ -474,9 +484,14 @@ fn save_refuses_a_fifo_a_socket_and_a_directory_and_leaves_them() {
     let mut left: Vec<String> = std::fs::read_dir(tmp.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name != "null")
         .collect();
     left.sort();
     assert_eq!(left, ["fifo", "folder", "socket"], "no temporary file left");
+    if made == 0 {
+        let kind = std::fs::symlink_metadata(&device).unwrap().file_type();
+        assert!(kind.is_char_device(), "the device node is left as it was");
+    }
 }
 
 /// A lesson saved over a file of 0600 keeps 0600 (it once became 0644), and is replaced
