@@ -437,6 +437,58 @@ pub fn write_atomically(
     result
 }
 
+/// Writes `path`, a file the user named (`teach --save FILE`), as [`write_atomically`]
+/// does, without destroying what is there: renaming over a FIFO, a device, a socket or a
+/// directory would replace it, so they are refused; an existing file keeps its
+/// permissions (a 0600 file stays 0600); a link the user named is written through, the
+/// link kept. A new file gets the usual permissions.
+pub fn write_user_file(
+    path: &Path,
+    write: impl FnOnce(&mut io::BufWriter<File>) -> io::Result<()>,
+) -> io::Result<()> {
+    let target = match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => std::fs::canonicalize(path).map_err(|e| {
+            refused(&format!(
+                "a symbolic link to nothing ({e}): name the file itself"
+            ))
+        })?,
+        _ => path.to_path_buf(),
+    };
+    let permissions = match std::fs::metadata(&target) {
+        Ok(m) if m.is_file() => Some(m.permissions()),
+        Ok(m) => {
+            return Err(refused(&format!(
+                "{}, not a regular file: sapnet writes only a regular file (replaced \
+                 whole) or a new one",
+                kind_name(m.file_type())
+            )))
+        }
+        Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+        Err(e) => return Err(e),
+    };
+    write_atomically(&target, |out| {
+        if let Some(permissions) = permissions {
+            out.get_ref().set_permissions(permissions)?;
+        }
+        write(out)
+    })
+}
+
+/// What a file that is not a regular file is, for refusals.
+fn kind_name(kind: std::fs::FileType) -> &'static str {
+    if kind.is_fifo() {
+        "a FIFO"
+    } else if kind.is_dir() {
+        "a directory"
+    } else if kind.is_char_device() || kind.is_block_device() {
+        "a device"
+    } else if kind.is_socket() {
+        "a socket"
+    } else {
+        "not a file"
+    }
+}
+
 /// `write_atomically` of `bytes`.
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_atomically(path, |out| out.write_all(bytes))

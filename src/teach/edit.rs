@@ -291,7 +291,9 @@ impl TeachConfig {
         }
     }
 
-    /// Writes the lesson to `path` in the format `teach --config` reads, atomically.
+    /// Writes the lesson to `path` in the format `teach --config` reads, atomically; a
+    /// FIFO, a device, a socket or a directory at `path` is refused, and a file there keeps
+    /// its permissions (see [`crate::safe_io::write_user_file`]).
     pub fn save(&self, path: &Path) -> Result<()> {
         // Written as it is read (a saved walk is `Some(activate: 1, calls: 5)`).
         let body = crate::ron_file::ron_options()
@@ -301,10 +303,8 @@ impl TeachConfig {
             "// A sapnet lesson (`sapnet teach --config {}`).\n{body}\n",
             path.display()
         );
-        crate::safe_io::write_atomically(path, |out| {
-            std::io::Write::write_all(out, text.as_bytes())
-        })
-        .with_context(|| format!("writing {}", path.display()))
+        crate::safe_io::write_user_file(path, |out| std::io::Write::write_all(out, text.as_bytes()))
+            .with_context(|| format!("writing {}", path.display()))
     }
 }
 
@@ -523,5 +523,36 @@ mod tests {
         let text = std::fs::read_to_string(&path).unwrap();
         let back: TeachConfig = crate::ron_file::parse_ron(&text, "lesson.ron").unwrap();
         assert_eq!(back, lesson);
+    }
+
+    /// A link the user names is written through, the link kept; a link planted where the
+    /// temporary file goes is replaced, never followed; a link to nothing is refused.
+    #[test]
+    fn a_lesson_is_saved_through_a_named_link_never_a_planted_one() {
+        use std::os::unix::fs::symlink;
+        let dir = tempfile::tempdir().unwrap();
+        let real = dir.path().join("real.ron");
+        std::fs::write(&real, "old").unwrap();
+        let named = dir.path().join("named.ron");
+        symlink(&real, &named).unwrap();
+        fig2().save(&named).unwrap();
+        assert!(std::fs::symlink_metadata(&named)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        let text = std::fs::read_to_string(&real).unwrap();
+        assert!(text.starts_with("// A sapnet lesson"), "{text}");
+
+        let victim = dir.path().join("victim");
+        std::fs::write(&victim, "keep").unwrap();
+        symlink(&victim, dir.path().join(".real.tmp.ron")).unwrap();
+        fig2().save(&real).unwrap();
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep");
+        assert!(!dir.path().join(".real.tmp.ron").exists());
+
+        let dangling = dir.path().join("dangling.ron");
+        symlink(dir.path().join("nowhere/lesson.ron"), &dangling).unwrap();
+        let error = format!("{:#}", fig2().save(&dangling).unwrap_err());
+        assert!(error.contains("a symbolic link to nothing"), "{error}");
     }
 }

@@ -54,48 +54,91 @@ pub fn run_lesson(
             net.len().saturating_sub(1)
         );
     }
-
-    let mut per_activation = Vec::with_capacity(args.activate.len());
-    let mut through_time = Vec::with_capacity(args.activate.len());
-    match (args.activate.is_empty(), walk) {
-        (true, Some(position)) => {
-            let (trace, row) = saved_walk(&names, &mut net, position);
-            per_activation.push((position.activate, trace));
-            through_time.push(row);
-        }
-        _ => {
-            for (k, &i) in args.activate.iter().enumerate() {
-                if k > 0 && decay > 0.0 {
-                    let kept = 1.0 - decay;
-                    let decayed = net.activations().iter().map(|a| a * kept).collect();
-                    net.set_activations(decayed)
-                        .expect("activations of the same graph, scaled down");
-                }
-                let mut trace = Vec::new();
-                net.activate_traced(i, true, &mut trace);
-                per_activation.push((i, trace));
-                through_time.push(TimeRow {
-                    activated: i,
-                    activations: net.activations().to_vec(),
-                    probabilities: net.probabilities(),
-                });
-            }
-        }
-    }
-    let probabilities = net.probabilities();
-
+    // A lesson may come from anyone: its names reach the terminal as data, an escape
+    // sequence in one printed as visible escapes, never acted on.
+    let names: Vec<String> = names.iter().map(|name| escape_controls(name)).collect();
+    let walks = make_walks(&names, &mut net, &args.activate, walk, decay);
     if args.json {
         let report = JsonTrace {
             activations: net.activations(),
-            probabilities: &probabilities,
-            trace: per_activation.into_iter().flat_map(|(_, t)| t).collect(),
-            through_time: &through_time,
+            probabilities: &net.probabilities(),
+            trace: walks.traces.into_iter().flat_map(|(_, t)| t).collect(),
+            through_time: &walks.through_time,
         };
         serde_json::to_writer(&mut *out, &report)?;
         writeln!(out)?;
         return Ok(());
     }
+    write_report(out, &net, &names, &walks, decay)
+}
 
+/// `text` with each control character written as its escape (`\u{1b}`, `\n`): this prints
+/// straight to the terminal, where ratatui would have dropped them.
+fn escape_controls(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
+/// The walks made: each activation's calls, and A and P after each walk.
+struct Walks {
+    traces: Vec<(usize, Vec<TraceStep>)>,
+    through_time: Vec<TimeRow>,
+}
+
+/// Activates `activate` in order on `net` (decayed by D between two), or, without any and
+/// with a saved walk, makes that walk as far as it was.
+fn make_walks(
+    names: &[String],
+    net: &mut crate::sapnet::SapNet,
+    activate: &[usize],
+    saved: Option<WalkPosition>,
+    decay: f64,
+) -> Walks {
+    let mut walks = Walks {
+        traces: Vec::with_capacity(activate.len()),
+        through_time: Vec::with_capacity(activate.len()),
+    };
+    if let (true, Some(position)) = (activate.is_empty(), saved) {
+        let (trace, row) = saved_walk(names, net, position);
+        walks.traces.push((position.activate, trace));
+        walks.through_time.push(row);
+        return walks;
+    }
+    for (k, &i) in activate.iter().enumerate() {
+        if k > 0 && decay > 0.0 {
+            let kept = 1.0 - decay;
+            let decayed = net.activations().iter().map(|a| a * kept).collect();
+            net.set_activations(decayed)
+                .expect("activations of the same graph, scaled down");
+        }
+        let mut trace = Vec::new();
+        net.activate_traced(i, true, &mut trace);
+        walks.traces.push((i, trace));
+        walks.through_time.push(TimeRow {
+            activated: i,
+            activations: net.activations().to_vec(),
+            probabilities: net.probabilities(),
+        });
+    }
+    walks
+}
+
+/// The table: the net, each activation's calls, the final A and P, and A and P through
+/// time where there was more than one walk.
+fn write_report(
+    out: &mut impl Write,
+    net: &crate::sapnet::SapNet,
+    names: &[String],
+    walks: &Walks,
+    decay: f64,
+) -> Result<()> {
     let p = net.params();
     writeln!(
         out,
@@ -113,7 +156,7 @@ pub fn run_lesson(
         .max()
         .unwrap_or(0)
         .max(4);
-    for (i, trace) in &per_activation {
+    for (i, trace) in &walks.traces {
         let k = net.graph().degree(*i);
         writeln!(out)?;
         let name = &names[*i];
@@ -130,7 +173,7 @@ pub fn run_lesson(
             )?;
         }
         writeln!(out)?;
-        write_trace(out, trace, &names, width).context("writing the trace")?;
+        write_trace(out, trace, names, width).context("writing the trace")?;
     }
     writeln!(out)?;
     writeln!(
@@ -138,12 +181,13 @@ pub fn run_lesson(
         "{:<width$}  {:>12}  {:>11}",
         "policy", "activation", "probability"
     )?;
+    let probabilities = net.probabilities();
     for ((name, a), prob) in names.iter().zip(net.activations()).zip(&probabilities) {
         writeln!(out, "{name:<width$}  {a:>12.6}  {prob:>11.6}")?;
     }
-    if through_time.len() > 1 {
+    if walks.through_time.len() > 1 {
         writeln!(out)?;
-        write_through_time(out, &through_time, &names, decay)?;
+        write_through_time(out, &walks.through_time, names, decay)?;
     }
     Ok(())
 }
@@ -242,6 +286,15 @@ fn write_trace(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 52, item 12: an OSC title and a screen clear in a name print as escapes.
+    #[test]
+    fn control_characters_are_printed_as_escapes() {
+        assert_eq!(
+            escape_controls("\u{1b}]0;owned\u{7}π1\u{1b}[2J\n×"),
+            "\\u{1b}]0;owned\\u{7}π1\\u{1b}[2J\\n×"
+        );
+    }
 
     /// Issue 27: past 99,999 calls the numbers pushed the row's columns right of the
     /// header's; the column now widens with the last number.

@@ -2,8 +2,10 @@
 //! time, with every quantity of eq. 8–11 shown.
 //!
 //! - [`config`]: the teach file (RON), a graph given by its edges or by policy categories.
-//! - [`session`]: a lesson being taught: the picked policy, one activation's spreading
-//!   stepped a call at a time, with undo (teach mode's state; the terminal UI draws it).
+//! - [`session`]: a lesson being taught (teach mode's state; the terminal UI draws it),
+//!   a room per job under `session/`: the walk with undo and `r`/`R`, the policies' names,
+//!   the graph's edits by key and mouse, the line typed, the quiz, the lesson written
+//!   back.
 //! - [`knobs`]: the session's live edits (T_ω, 𝒜, τ, paths, an edge's weight) and what
 //!   each changed.
 //! - [`labels`]: short names for policies and tasks, for a graph node or a narrow column.
@@ -43,6 +45,19 @@ mod tests {
             ("knobs.rs", include_str!("knobs.rs")),
             ("labels.rs", include_str!("labels.rs")),
             ("session.rs", include_str!("session.rs")),
+            ("session/walk.rs", include_str!("session/walk.rs")),
+            ("session/playback.rs", include_str!("session/playback.rs")),
+            ("session/names.rs", include_str!("session/names.rs")),
+            (
+                "session/graph_edits.rs",
+                include_str!("session/graph_edits.rs"),
+            ),
+            ("session/prompt.rs", include_str!("session/prompt.rs")),
+            ("session/quiz.rs", include_str!("session/quiz.rs")),
+            (
+                "session/lesson_file.rs",
+                include_str!("session/lesson_file.rs"),
+            ),
         ];
         // The paths are put together, so that this test does not find them in itself.
         let front_ends = [["crate", "tui::"], ["ratatui", ""], ["crossterm", ""]];

@@ -1,59 +1,63 @@
-//! Teach mode's state: one activation's spreading recursion, stepped a `spread` call at a
-//! time (Algorithms 1 and 2), with undo.
+//! Teach mode's state: a lesson being taught, the policy picked, the activation in
+//! progress. Each of its jobs has a room of its own under `session/`, and `Teach` owns
+//! their state:
 //!
-//! The walk keeps the recursion's state ([`SpreadState`]: the pending calls and the path)
-//! and its own activations, so a step costs O(1) whatever the walk's length. Undo rebuilds
-//! the walk from its start, one call fewer. `r` runs the rest in slices of
-//! [`Teach::advance`], so a walk of millions of calls leaves the screen and the keys
-//! responsive.
+//! - `walk`: one activation stepped a `spread` call at a time, with undo, and A and P
+//!   through time;
+//! - `playback`: `r` and `R`, calls made between frames;
+//! - `names`: what the screen calls the policies (`p`);
+//! - `graph_edits`: knobs turned, edges and policies edited by key and by mouse (`M`);
+//! - `prompt`: the line typed, and what Enter does with it;
+//! - `quiz`: the exercise's predictions and the lesson's questions;
+//! - `lesson_file`: the lesson written back (`w`).
+//!
+//! This file holds what they share: the net, the cursor, the notice, the panel shown. The
+//! rooms are its children, so that they read its fields and it reads theirs without the
+//! files importing each other in a circle.
 
-use std::path::PathBuf;
-use std::time::{Duration, Instant};
+mod graph_edits;
+mod lesson_file;
+mod names;
+mod playback;
+mod prompt;
+mod quiz;
+mod walk;
 
-use serde::Serialize;
-
-use super::edit::GraphEdit;
-use super::knobs::{refusal, walk_end, EditReport, Knob};
-use super::labels;
 use super::lesson::TeachConfig;
-use super::lesson::WalkPosition;
-use super::questions::Question;
-use crate::sapnet::{Call, SapNet, SpreadState, Spreader, TraceStep};
+use crate::sapnet::SapNet;
+use graph_edits::Editing;
+use names::Names;
+use playback::Playback;
+use quiz::Questions;
+use walk::{Timeline, Walk};
 
-/// Calls `r` makes between two frames: a few milliseconds' worth.
-pub const CALLS_PER_FRAME: usize = 50_000;
+pub use graph_edits::MOUSE_EDGE_WEIGHT;
+pub use playback::{CALLS_PER_FRAME, SPEEDS};
+pub use prompt::{Prompt, PromptKind, LESSON_FILE};
+pub use quiz::{Score, ANSWER_TOLERANCE};
+pub use walk::{TimeRow, WalkView};
 
 /// Where teach mode stands: which policy is picked, and the activation in progress.
 #[derive(Debug, Clone)]
 pub struct Teach {
-    names: Vec<String>,
-    /// The names the lesson gave, where they could not tell the policies apart on the
-    /// graph (`1×100`, `2×100` both read `100`): the policies are then called π0…, and the
-    /// activations table gives these beside.
-    descriptions: Option<Vec<String>>,
-    /// The names as the paper numbers policies, π1…πN, where the given ones are π0…πN−1.
-    paper_names: Option<Vec<String>>,
-    /// Show `paper_names` (`p`).
-    paper_numbering: bool,
+    /// The lesson's net, with the activations as they stand after the calls made so far.
     net: SapNet,
+    names: Names,
     /// The activations before the first activation of this lesson (`c` goes back to them).
     initial: Vec<f64>,
     /// The policy the arrows point at.
     cursor: usize,
     walk: Option<Walk>,
-    /// `r` was pressed: the front end calls [`Teach::advance`] between frames.
-    running: bool,
+    playback: Playback,
+    /// The walks finished so far, and the decay between two.
+    timeline: Timeline,
     /// Category of each policy, to draw related policies together.
     groups: Option<Vec<usize>>,
     /// Per policy, whether the live run had its category out of the candidates when teach
     /// mode opened on its net (empty: none, or a lesson).
     excluded: Vec<bool>,
-    /// What `+` and `−` change (`1`…`5`).
-    knob: Knob,
-    /// Which of the picked policy's edges a weight edit changes (`e` moves it).
-    edge: usize,
-    /// The last edit and what it changed.
-    last_edit: Option<EditReport>,
+    /// The knob and edge the next edit acts on, the last edit, the mouse's `M` mode.
+    editing: Editing,
     /// Something the last key did that the screen must say: an edit refused, pending
     /// calls made before a new activation.
     notice: Option<String>,
@@ -61,36 +65,14 @@ pub struct Teach {
     prompt: Option<Prompt>,
     /// Exercise mode (`X`): before each call the student types its ΔA; the score so far.
     exercise: Option<Score>,
+    /// The lesson's questions, asked one after another when a walk ends.
+    questions: Questions,
     /// The lesson file this session was opened from, for what the net does not hold: the
     /// policies' descriptions where categories build M, and what `w` writes back.
     source: TeachConfig,
-    /// `M`: clicks edit edges — a first click picks a policy, a second joins it to the
-    /// one clicked or cuts their edge.
-    linking: bool,
-    /// In `M` mode, the policy the first click picked.
-    link_from: Option<usize>,
-    /// D: the share of every activation lost between two activations (0: the paper).
-    decay: f64,
-    /// A and P at the end of each walk finished since the lesson (or `c`) started.
-    history: Vec<TimeRow>,
-    /// The lesson's questions, asked one after another when a walk ends.
-    questions: Vec<Question>,
-    /// The next question to ask.
-    next_question: usize,
-    /// The questions' score.
-    quiz: Score,
-    /// `r`: calls made one at a time at [`Teach::speed`], the next when this is due.
-    animation: Option<Instant>,
-    /// Index into [`SPEEDS`].
-    speed: usize,
     /// What the panel under the edits shows (`v` cycles).
     panel: WalkPanel,
 }
-
-/// Calls a second `r` makes along the edges (`<` and `>` choose).
-pub const SPEEDS: [f64; 6] = [0.5, 1.0, 2.0, 4.0, 8.0, 16.0];
-/// `r`'s speed at the start: two calls a second, slow enough to follow on the graph.
-const DEFAULT_SPEED: usize = 2;
 
 /// What the panel under the edits shows; `v` goes to the next.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -128,146 +110,24 @@ impl WalkPanel {
     }
 }
 
-/// A and P of every policy at the end of one activation's walk (`through_time` in
-/// `--json`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct TimeRow {
-    /// The policy activated.
-    pub activated: usize,
-    pub activations: Vec<f64>,
-    pub probabilities: Vec<f64>,
-}
-
-/// The weight of an edge added by the mouse (`M`): Fig. 2's; `5` and `+`/`−` change it.
-pub const MOUSE_EDGE_WEIGHT: f64 = 0.4;
-
-/// An exercise's score: answers right of answers given.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Score {
-    pub right: usize,
-    pub asked: usize,
-}
-
-/// How far a typed ΔA may be from the call's and count as right: the screen gives ΔA to
-/// six decimals, a student working by hand to three or four.
-pub const ANSWER_TOLERANCE: f64 = 1e-3;
-
-/// A line the user types in teach mode, and what Enter does with it.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Prompt {
-    pub kind: PromptKind,
-    pub text: String,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PromptKind {
-    /// `E`: `I J W`, an edge of weight W between policies I and J (0-based, as
-    /// `--add-edge` takes them), added or reweighted.
-    AddEdge,
-    /// `w`: the path the lesson is written to.
-    Save,
-    /// Exercise mode: the ΔA the next call deposits, or `stop` where eq. 10 stops it.
-    Predict,
-    /// `n` in a lesson of categories: the new policy's category.
-    AddPolicy,
-    /// `C`: the picked policy's new category.
-    SetCategory,
-    /// The lesson's `k`-th question, at a walk's end.
-    Question(usize),
-}
-
-impl PromptKind {
-    /// What the prompt asks, on screen.
-    pub fn question(self) -> &'static str {
-        match self {
-            PromptKind::AddEdge => "add edge I J W (0-based, as --add-edge):",
-            PromptKind::Save => "save the lesson to:",
-            PromptKind::Predict => "ΔA of the next call (a number, or stop)?",
-            PromptKind::AddPolicy => "category of the new policy (as --add-policy):",
-            PromptKind::SetCategory => "new category of the picked policy (as --set-category):",
-            PromptKind::Question(_) => "the lesson asks:",
-        }
-    }
-}
-
-/// The file `w` offers.
-pub const LESSON_FILE: &str = "lesson.ron";
-
-/// One activation being stepped.
-#[derive(Debug, Clone)]
-struct Walk {
-    policy: usize,
-    /// The activations just before `A[policy] += 𝒜`.
-    before: Vec<f64>,
-    /// The calls made so far, in order.
-    trace: Vec<TraceStep>,
-    /// The recursion after those calls.
-    state: SpreadState,
-    /// The activations after those calls (the net's, once synced).
-    activations: Vec<f64>,
-    /// `activations − before`, kept with them.
-    deposited: Vec<f64>,
-}
-
-/// What a front end draws of the walk in progress.
-#[derive(Debug, Clone, PartialEq)]
-pub struct WalkView<'a> {
-    pub policy: usize,
-    /// The calls made so far.
-    pub trace: &'a [TraceStep],
-    /// The pending calls, the next one last (the recursion's stack).
-    pub pending: &'a [Call],
-    /// The walk from the activated policy to the last call's target.
-    pub path: &'a [usize],
-    pub done: bool,
-    /// What the walk has added to each activation so far, eq. 8's 𝒜 included: eq. 11's
-    /// sum of ΔA.
-    pub deposited: &'a [f64],
-}
-
 impl Teach {
     pub fn new(names: Vec<String>, net: SapNet) -> Self {
-        let initial = net.activations().to_vec();
-        let (names, descriptions) = match labels::distinct_labels(&names) {
-            Some(_) => (names, None),
-            None => (
-                (0..names.len()).map(|i| format!("π{i}")).collect(),
-                Some(names),
-            ),
-        };
-        let zero_based = names
-            .iter()
-            .enumerate()
-            .all(|(i, name)| *name == format!("π{i}"));
-        let paper_names = zero_based.then(|| (1..=names.len()).map(|i| format!("π{i}")).collect());
         Self {
-            paper_names,
-            paper_numbering: false,
-            names,
-            descriptions,
+            names: Names::new(names),
+            initial: net.activations().to_vec(),
             net,
-            initial,
             cursor: 0,
             walk: None,
-            running: false,
+            playback: Playback::default(),
+            timeline: Timeline::default(),
             groups: None,
             excluded: Vec::new(),
-            knob: Knob::default(),
-            edge: 0,
-            last_edit: None,
+            editing: Editing::default(),
             notice: None,
             prompt: None,
             exercise: None,
+            questions: Questions::default(),
             source: TeachConfig::default(),
-            linking: false,
-            link_from: None,
-            decay: 0.0,
-            history: Vec::new(),
-            questions: Vec::new(),
-            next_question: 0,
-            quiz: Score::default(),
-            animation: None,
-            speed: DEFAULT_SPEED,
             panel: WalkPanel::default(),
         }
     }
@@ -275,149 +135,65 @@ impl Teach {
     /// The lesson file the session was opened from: its policies' descriptions, where
     /// categories build M, are kept for the category edits and for `w`.
     pub fn with_source(mut self, source: TeachConfig) -> Self {
-        self.decay = source.decay;
-        self.questions = source.questions.clone();
+        self.timeline.decay = source.decay;
+        self.questions = Questions::new(source.questions.clone());
         self.source = source;
         self
     }
 
     /// D between activations (`--decay`; 0 is the paper).
     pub fn with_decay(mut self, decay: f64) -> Self {
-        self.decay = decay;
+        self.timeline.decay = decay;
         self
     }
 
-    pub fn decay(&self) -> f64 {
-        self.decay
+    /// Draws policies of the same category together (the graph's categories).
+    pub fn with_groups(mut self, groups: Vec<usize>) -> Self {
+        self.groups = (groups.len() == self.net.len()).then_some(groups);
+        self
     }
 
-    /// A and P after each walk so far, and the walk on screen's as it stands last (`true`
-    /// while it is still in progress).
-    pub fn through_time(&self) -> (Vec<TimeRow>, bool) {
-        let mut rows = self.history.clone();
-        let mut in_progress = false;
-        if let Some(walk) = &self.walk {
-            rows.push(TimeRow {
-                activated: walk.policy,
-                activations: self.net.activations().to_vec(),
-                probabilities: self.net.probabilities(),
-            });
-            in_progress = !walk.state.is_done();
-        }
-        (rows, in_progress)
+    /// The live run's excluded policies, shown on the graph (spreading by hand ignores them:
+    /// exclusion acts on eq. 6's draw, not on eq. 8–11).
+    pub fn with_excluded(mut self, excluded: Vec<bool>) -> Self {
+        self.excluded = excluded;
+        self
     }
 
-    /// Reopens a saved walk (`walk` of a lesson file): activates its policy and makes its
-    /// calls.
-    pub fn resume_walk(&mut self, position: WalkPosition) {
-        if position.activate >= self.net.len() {
-            return;
-        }
-        self.cursor = position.activate;
-        self.activate();
-        for _ in 0..position.calls {
-            self.call();
-        }
-        self.sync();
+    /// The net with the activations as they stand after the calls made so far.
+    pub fn net(&self) -> &SapNet {
+        &self.net
     }
 
-    /// What the panel under the edits shows.
-    pub fn panel(&self) -> WalkPanel {
-        self.panel
+    pub fn groups(&self) -> Option<&[usize]> {
+        self.groups.as_deref()
     }
 
-    /// `v`: the trace, the tree, the chart, A and P through time, in turn.
-    pub fn next_panel(&mut self) {
-        self.panel = self.panel.following();
+    pub fn excluded(&self) -> &[bool] {
+        &self.excluded
     }
 
-    /// `r`'s speed, in calls a second.
-    pub fn speed(&self) -> f64 {
-        SPEEDS[self.speed]
+    /// The policies' names as shown: π0… as the lesson gives them, or π1… (`p`).
+    pub fn names(&self) -> &[String] {
+        self.names.shown()
     }
 
-    /// `<` / `>`: `r` slower or faster.
-    pub fn change_speed(&mut self, faster: bool) {
-        self.speed = if faster {
-            (self.speed + 1).min(SPEEDS.len() - 1)
-        } else {
-            self.speed.saturating_sub(1)
-        };
-        self.notice = Some(format!("r walks {} calls a second", self.speed()));
+    /// What the lesson called each policy, where the screen calls them π0… instead (the
+    /// lesson's names would label two nodes alike).
+    pub fn descriptions(&self) -> Option<&[String]> {
+        self.names.descriptions()
     }
 
-    /// `r`: the walk's calls made one at a time at [`speed`](Self::speed), lit on the
-    /// graph as they go; `r` again pauses.
-    pub fn animate(&mut self) {
-        self.running = false;
-        let going = self.walk.as_ref().is_some_and(|w| !w.state.is_done());
-        self.animation = match self.animation {
-            Some(_) => None,
-            None if going => Some(Instant::now()),
-            None => None,
-        };
+    /// `p`: the paper's numbering π1…πN, or back to π0…; `false` when the lesson names
+    /// its policies itself.
+    pub fn toggle_numbering(&mut self) -> bool {
+        self.names.toggle_numbering()
     }
 
-    /// Whether `r` is walking.
-    pub fn is_animating(&self) -> bool {
-        self.animation.is_some()
-    }
-
-    /// The questions' score, once one is answered.
-    pub fn quiz(&self) -> Option<Score> {
-        (self.quiz.asked > 0).then_some(self.quiz)
-    }
-
-    /// How many questions the lesson holds, and how many are asked.
-    pub fn questions(&self) -> (usize, usize) {
-        (self.questions.len(), self.next_question)
-    }
-
-    /// What the prompt asks, on screen: a question's own text.
-    pub fn prompt_question(&self) -> Option<String> {
-        let prompt = self.prompt.as_ref()?;
-        Some(match prompt.kind {
-            PromptKind::Question(k) => self.questions.get(k).map(Question::prompt)?,
-            kind => kind.question().to_string(),
-        })
-    }
-
-    /// At a walk's end, the next of the lesson's questions is asked.
-    fn ask_at_walk_end(&mut self) {
-        let done = self.walk.as_ref().is_some_and(|w| w.state.is_done());
-        if done && self.prompt.is_none() && self.next_question < self.questions.len() {
-            self.running = false;
-            self.animation = None;
-            self.prompt = Some(Prompt {
-                kind: PromptKind::Question(self.next_question),
-                text: String::new(),
-            });
-        }
-    }
-
-    /// Checks the answer to question `k`, says right or the answer, and asks the next.
-    fn check_question(&mut self, k: usize, typed: &str) {
-        let Some(question) = self.questions.get(k) else {
-            return;
-        };
-        let verdict = question.check(typed, self.names());
-        self.next_question = k + 1;
-        self.quiz.asked += 1;
-        if verdict.right {
-            self.quiz.right += 1;
-        }
-        let said = if verdict.right {
-            format!("right: {}", verdict.answer)
-        } else if typed.trim().is_empty() {
-            format!("no answer: it is {}", verdict.answer)
-        } else {
-            format!("not {}: it is {}", typed.trim(), verdict.answer)
-        };
-        self.notice = Some(format!(
-            "{said} · questions {}/{}",
-            self.quiz.right, self.quiz.asked
-        ));
-        self.ask_at_walk_end();
+    /// Which numbering is on screen, for the status bar: `π0…` or `π1…` (none for names
+    /// the lesson gives).
+    pub fn numbering(&self) -> Option<&'static str> {
+        self.names.numbering()
     }
 
     /// Whether the lesson's graph is built from categories (eq. 3–5), so that the policies
@@ -433,78 +209,6 @@ impl Teach {
         Some(super::category::key(&prototype, policy))
     }
 
-    /// The names as the lesson gives them, and how the screen calls the policies from them.
-    fn set_names(&mut self, given: Vec<String>) {
-        let fresh = Teach::new(given, self.net.clone());
-        self.names = fresh.names;
-        self.descriptions = fresh.descriptions;
-        self.paper_names = fresh.paper_names;
-        if self.paper_names.is_none() {
-            self.paper_numbering = false;
-        }
-    }
-
-    /// Draws policies of the same category together (the graph's categories).
-    pub fn with_groups(mut self, groups: Vec<usize>) -> Self {
-        self.groups = (groups.len() == self.net.len()).then_some(groups);
-        self
-    }
-
-    pub fn groups(&self) -> Option<&[usize]> {
-        self.groups.as_deref()
-    }
-
-    /// The live run's excluded policies, shown on the graph (spreading by hand ignores them:
-    /// exclusion acts on eq. 6's draw, not on eq. 8–11).
-    pub fn with_excluded(mut self, excluded: Vec<bool>) -> Self {
-        self.excluded = excluded;
-        self
-    }
-
-    pub fn excluded(&self) -> &[bool] {
-        &self.excluded
-    }
-
-    /// The policies' names as shown: π0… as the lesson gives them, or π1… (`p`).
-    pub fn names(&self) -> &[String] {
-        match (&self.paper_names, self.paper_numbering) {
-            (Some(paper), true) => paper,
-            _ => &self.names,
-        }
-    }
-
-    /// What the lesson called each policy, where the screen calls them π0… instead (see
-    /// [`new`](Self::new)).
-    pub fn descriptions(&self) -> Option<&[String]> {
-        self.descriptions.as_deref()
-    }
-
-    /// `p`: the paper's numbering π1…πN, or back to π0…; `false` when the lesson names
-    /// its policies itself.
-    pub fn toggle_numbering(&mut self) -> bool {
-        if self.paper_names.is_some() {
-            self.paper_numbering = !self.paper_numbering;
-        }
-        self.paper_names.is_some()
-    }
-
-    /// Which numbering is on screen, for the status bar: `π0…` or `π1…` (none for names
-    /// the lesson gives).
-    pub fn numbering(&self) -> Option<&'static str> {
-        self.paper_names.as_ref().map(|_| {
-            if self.paper_numbering {
-                "π1…"
-            } else {
-                "π0…"
-            }
-        })
-    }
-
-    /// The net with the activations as they stand after the calls made so far.
-    pub fn net(&self) -> &SapNet {
-        &self.net
-    }
-
     pub fn cursor(&self) -> usize {
         self.cursor
     }
@@ -514,145 +218,8 @@ impl Teach {
         let n = self.net.len() as isize;
         if n > 0 {
             self.cursor = (self.cursor as isize + delta).rem_euclid(n) as usize;
-            self.edge = 0;
+            self.editing.edge = 0;
         }
-    }
-
-    /// Picks policy `i` (a click on its node or row); out of range changes nothing. In
-    /// `M` mode a second click on another policy joins the two (weight
-    /// [`MOUSE_EDGE_WEIGHT`]) or cuts their edge, and a second click on the same one lets
-    /// it go.
-    pub fn pick(&mut self, i: usize) {
-        if i >= self.net.len() {
-            return;
-        }
-        match self.link_from.take() {
-            Some(from) if self.linking && from != i => {
-                let edit = if self.net.graph().weight(from, i).is_some() {
-                    GraphEdit::Cut { i: from, j: i }
-                } else {
-                    GraphEdit::Add {
-                        i: from,
-                        j: i,
-                        w: MOUSE_EDGE_WEIGHT,
-                    }
-                };
-                self.edit_graph(edit);
-                self.select_edge_to(i);
-                return;
-            }
-            Some(_) => {
-                self.notice = Some(format!("{} let go", self.names()[i]));
-            }
-            None if self.linking => {
-                self.link_from = Some(i);
-                self.notice = Some(format!(
-                    "{} picked: click another policy to join them or cut their edge",
-                    self.names()[i]
-                ));
-            }
-            None => {}
-        }
-        self.cursor = i;
-        self.edge = 0;
-    }
-
-    /// `M`: clicks edit edges, or pick as before.
-    pub fn toggle_linking(&mut self) {
-        self.linking = !self.linking;
-        self.link_from = None;
-        self.notice = Some(if self.linking {
-            "M: click a policy, then another: joined at 0.4 (5 and +/− reweigh) or their \
-             edge cut; M again ends it"
-                .to_string()
-        } else {
-            "M ended: a click picks a policy".to_string()
-        });
-    }
-
-    /// Whether clicks edit edges (`M`).
-    pub fn is_linking(&self) -> bool {
-        self.linking
-    }
-
-    /// Selects the picked policy's edge to `j`, if there is one, for `5` and `x`.
-    fn select_edge_to(&mut self, j: usize) {
-        if let Some(at) = self
-            .net
-            .graph()
-            .neighbours(self.cursor)
-            .position(|(k, _)| k == j)
-        {
-            self.edge = at;
-            self.knob = Knob::EdgeWeight;
-        }
-    }
-
-    /// `n`: adds a policy — at once where the lesson gives its edges (joined to nothing),
-    /// or asking its category where categories build M.
-    pub fn add_policy(&mut self) {
-        if self.has_categories() {
-            self.open_prompt(PromptKind::AddPolicy);
-        } else {
-            self.edit_graph(GraphEdit::AddPolicy {
-                category: super::edit::NO_CATEGORY.to_string(),
-            });
-        }
-    }
-
-    /// `D`: removes the picked policy and its edges.
-    pub fn remove_policy(&mut self) {
-        self.edit_graph(GraphEdit::RemovePolicy { i: self.cursor });
-    }
-
-    /// `C`: asks the picked policy's new category (refused where there are none).
-    pub fn change_category(&mut self) {
-        if self.has_categories() {
-            self.open_prompt(PromptKind::SetCategory);
-        } else {
-            self.edit_graph(GraphEdit::SetCategory {
-                i: self.cursor,
-                category: super::edit::NO_CATEGORY.to_string(),
-            });
-        }
-    }
-
-    /// What `+` and `−` change.
-    pub fn knob(&self) -> Knob {
-        self.knob
-    }
-
-    /// `1`…`5`: chooses what `+` and `−` change.
-    pub fn choose_knob(&mut self, knob: Knob) {
-        self.knob = knob;
-    }
-
-    /// The edge a weight edit changes: the picked policy's `e`-th, as `(picked, other)`.
-    pub fn selected_edge(&self) -> Option<(usize, usize)> {
-        let degree = self.net.graph().degree(self.cursor);
-        (degree > 0).then(|| {
-            let (j, _) = self
-                .net
-                .graph()
-                .neighbours(self.cursor)
-                .nth(self.edge % degree)
-                .expect("within the degree");
-            (self.cursor, j)
-        })
-    }
-
-    /// `e`: selects the picked policy's next edge (and chooses the weight knob).
-    pub fn next_edge(&mut self) {
-        let degree = self.net.graph().degree(self.cursor);
-        if degree > 0 {
-            self.edge = (self.edge + 1) % degree;
-        }
-        self.knob = Knob::EdgeWeight;
-    }
-
-    /// The last edit and what it changed, until the next one.
-    pub fn last_edit(&self) -> Option<&EditReport> {
-        self.last_edit.as_ref()
     }
 
     /// What the last key did that needs saying, if anything.
@@ -660,600 +227,32 @@ impl Teach {
         self.notice.as_deref()
     }
 
-    /// `+` / `−`: turns the chosen knob one step. The walk on screen restarts from the
-    /// activations it started from, and [`last_edit`](Self::last_edit) compares its end
-    /// before and after. A value the net refuses changes nothing and is said.
-    pub fn edit(&mut self, up: bool) {
-        self.running = false;
-        self.animation = None;
-        self.notice = None;
-        let (policy, before) = match &self.walk {
-            Some(w) => (Some(w.policy), w.before.clone()),
-            None => (None, self.net.activations().to_vec()),
-        };
-        let mut start = self.net.clone();
-        start
-            .set_activations(before.clone())
-            .expect("activations of the same graph");
-        let from = self.knob.value(&start, self.selected_edge());
-        let turned = match self.knob.turn(&start, self.selected_edge(), up) {
-            Ok(net) => net,
-            Err(refused) => {
-                // In the screen's names: the net's message numbers the policies from 0.
-                let names = self.names();
-                let (what, why) = match (self.knob, self.selected_edge()) {
-                    (Knob::EdgeWeight, Some((i, j))) => (
-                        format!("M({},{})", names[i], names[j]),
-                        refusal(&refused, names),
-                    ),
-                    (Knob::EdgeWeight, None) => (
-                        "M".to_string(),
-                        format!("{} has no edge to change", names[self.cursor]),
-                    ),
-                    (knob, _) => (knob.symbol().to_string(), refusal(&refused, names)),
-                };
-                self.notice = Some(format!("{what} stays {from}: {why}"));
-                return;
-            }
-        };
-        let (old_a, old_p, old_calls) = walk_end(&start, policy, &before);
-        let (new_a, new_p, new_calls) = walk_end(&turned, policy, &before);
-        self.last_edit = Some(EditReport {
-            knob: self.knob,
-            edge: self
-                .selected_edge()
-                .filter(|_| self.knob == Knob::EdgeWeight),
-            to: self.knob.value(&turned, self.selected_edge()),
-            from,
-            policy,
-            calls: (old_calls, new_calls),
-            activations: (old_a, new_a),
-            probabilities: (old_p, new_p),
-        });
-        self.net = turned;
-        if self.knob == Knob::EdgeWeight && self.has_categories() {
-            // M is now set by hand, not by the categories: the lesson gives its edges.
-            self.source.descriptions.clear();
-            self.notice = Some(
-                "M set by hand: the lesson now gives its graph by its edges, not by categories"
-                    .to_string(),
-            );
-        }
-        if let Some(policy) = policy {
-            self.walk = Some(self.start(policy, before));
-            self.sync();
-        }
+    /// What the panel under the edits shows.
+    pub fn panel(&self) -> WalkPanel {
+        self.panel
     }
 
-    /// `a`: activates the policy under the cursor as after a positive transition (eq. 8),
-    /// queueing the first `spread` calls. A walk still in progress is finished first, so
-    /// its deposits are not lost, and the screen says so.
-    pub fn activate(&mut self) {
-        self.notice = None;
-        let pending = self
-            .walk
-            .as_ref()
-            .filter(|w| !w.state.is_done())
-            .map(|w| w.policy);
-        let made_before = self.walk.as_ref().map_or(0, |w| w.trace.len());
-        self.run_to_end();
-        if let Some(policy) = pending {
-            let made = self.walk.as_ref().map_or(0, |w| w.trace.len()) - made_before;
-            self.notice = Some(format!(
-                "{}'s walk was not done: its {made} remaining calls were made first",
-                self.names()[policy]
-            ));
-        }
-        if let Some(walk) = &self.walk {
-            // The walk before this one ends here: a row of the table through time, then
-            // the decay between the two activations.
-            self.history.push(TimeRow {
-                activated: walk.policy,
-                activations: self.net.activations().to_vec(),
-                probabilities: self.net.probabilities(),
-            });
-            if self.decay > 0.0 {
-                let kept = 1.0 - self.decay;
-                let decayed = self.net.activations().iter().map(|a| a * kept).collect();
-                self.set_activations(decayed);
-            }
-        }
-        let before = self.net.activations().to_vec();
-        let walk = self.start(self.cursor, before);
-        self.walk = Some(walk);
-        self.sync();
-    }
-
-    /// `s`: makes the next `spread` call. Returns it, or `None` when there is nothing to
-    /// step.
-    pub fn step(&mut self) -> Option<TraceStep> {
-        self.running = false;
-        self.animation = None;
-        self.notice = None;
-        let call = self.call();
-        self.sync();
-        self.ask_at_walk_end();
-        call
-    }
-
-    /// Makes every remaining call of the walk in progress.
-    pub fn run_to_end(&mut self) {
-        self.running = false;
-        self.animation = None;
-        while self.call().is_some() {}
-        self.sync();
-    }
-
-    /// `R` in a front end: the remaining calls are made by [`advance`](Self::advance), as
-    /// fast as it goes.
-    pub fn run(&mut self) {
-        self.animation = None;
-        self.running = self.walk.as_ref().is_some_and(|w| !w.state.is_done());
-        self.ask_at_walk_end();
-    }
-
-    /// Whether `r` is still making calls.
-    pub fn is_running(&self) -> bool {
-        self.running
-    }
-
-    /// Makes up to `calls` of the remaining calls while running; returns how many.
-    pub fn advance(&mut self, calls: usize) -> usize {
-        self.advance_at(calls, Instant::now())
-    }
-
-    /// [`advance`](Self::advance) at the time `now`: `r`'s walk makes the calls due by
-    /// then at its speed (at most one a frame, so each is seen on the graph).
-    pub fn advance_at(&mut self, calls: usize, now: Instant) -> usize {
-        if let Some(due) = self.animation {
-            if now < due {
-                return 0;
-            }
-            let made = usize::from(self.call().is_some());
-            self.sync();
-            let going = self.walk.as_ref().is_some_and(|w| !w.state.is_done());
-            self.animation = going.then(|| now + Duration::from_secs_f64(1.0 / SPEEDS[self.speed]));
-            self.ask_at_walk_end();
-            return made;
-        }
-        if !self.running {
-            return 0;
-        }
-        let mut made = 0;
-        while made < calls && self.call().is_some() {
-            made += 1;
-        }
-        if made < calls {
-            self.running = false;
-        }
-        self.sync();
-        self.ask_at_walk_end();
-        made
-    }
-
-    /// `u`: takes back the last call (or, before any, the activation itself).
-    pub fn undo(&mut self) {
-        self.running = false;
-        self.animation = None;
-        self.notice = None;
-        let Some(walk) = self.walk.take() else {
-            return;
-        };
-        let mut trace = walk.trace;
-        if trace.pop().is_none() {
-            self.set_activations(walk.before);
-            return;
-        }
-        let mut rebuilt = self.start(walk.policy, walk.before);
-        for _ in 0..trace.len() {
-            let mut spreader = Spreader::resume(self.net.graph(), rebuilt.state);
-            spreader.step(&mut rebuilt.activations);
-            rebuilt.state = spreader.suspend();
-        }
-        rebuilt.trace = trace;
-        self.walk = Some(rebuilt);
-        self.sync();
+    /// `v`: the trace, the tree, the chart, A and P through time, in turn.
+    pub fn next_panel(&mut self) {
+        self.panel = self.panel.following();
     }
 
     /// `c`: back to the activations the lesson started with.
     pub fn reset(&mut self) {
-        self.running = false;
-        self.animation = None;
+        self.playback.stop();
         self.notice = None;
         self.walk = None;
-        self.history.clear();
+        self.timeline.rows.clear();
         self.set_activations(self.initial.clone());
-    }
-
-    /// The walk in progress, if any.
-    pub fn walk(&self) -> Option<WalkView<'_>> {
-        let walk = self.walk.as_ref()?;
-        Some(WalkView {
-            policy: walk.policy,
-            trace: &walk.trace,
-            pending: walk.state.pending(),
-            path: walk.state.path(),
-            done: walk.state.is_done(),
-            deposited: &walk.deposited,
-        })
-    }
-
-    /// The line being typed, if any: while there is one every key goes to it.
-    pub fn prompt(&self) -> Option<&Prompt> {
-        self.prompt.as_ref()
-    }
-
-    /// `E` or `w`: starts typing an edge to add, or the file to save to (`lesson.ron`
-    /// offered).
-    pub fn open_prompt(&mut self, kind: PromptKind) {
-        self.running = false;
-        self.notice = None;
-        let text = match kind {
-            PromptKind::AddEdge | PromptKind::Predict | PromptKind::Question(_) => String::new(),
-            PromptKind::Save => LESSON_FILE.to_string(),
-            PromptKind::AddPolicy | PromptKind::SetCategory => {
-                self.category_of(self.cursor).unwrap_or_default()
-            }
-        };
-        self.prompt = Some(Prompt { kind, text });
-    }
-
-    /// A character typed into the prompt.
-    pub fn prompt_type(&mut self, c: char) {
-        if let Some(prompt) = &mut self.prompt {
-            prompt.text.push(c);
-        }
-    }
-
-    /// Backspace in the prompt.
-    pub fn prompt_backspace(&mut self) {
-        if let Some(prompt) = &mut self.prompt {
-            prompt.text.pop();
-        }
-    }
-
-    /// Esc in the prompt: nothing is done.
-    pub fn prompt_cancel(&mut self) {
-        if let Some(PromptKind::Question(k)) = self.prompt.take().map(|p| p.kind) {
-            // Skipped: its answer stays hidden, the next is asked.
-            self.next_question = k + 1;
-            self.notice = Some("question skipped".to_string());
-            self.ask_at_walk_end();
-        }
-    }
-
-    /// Enter in the prompt: adds the edge or writes the lesson; what went wrong (a value
-    /// not read, an edit the lesson or the net refuses, a file not written) is said and
-    /// changes nothing.
-    pub fn prompt_submit(&mut self) {
-        let Some(prompt) = self.prompt.take() else {
-            return;
-        };
-        match prompt.kind {
-            PromptKind::AddEdge => {
-                let values: Vec<String> =
-                    prompt.text.split_whitespace().map(str::to_string).collect();
-                match GraphEdit::parse("--add-edge", &values) {
-                    Ok(edit) => self.edit_graph(edit),
-                    Err(why) => {
-                        self.notice = Some(format!("no edge added: {why}"));
-                    }
-                }
-            }
-            PromptKind::Predict => self.check_answer(&prompt.text),
-            PromptKind::Question(k) => self.check_question(k, &prompt.text),
-            PromptKind::AddPolicy => self.edit_graph(GraphEdit::AddPolicy {
-                category: prompt.text.trim().to_string(),
-            }),
-            PromptKind::SetCategory => self.edit_graph(GraphEdit::SetCategory {
-                i: self.cursor,
-                category: prompt.text.trim().to_string(),
-            }),
-            PromptKind::Save => {
-                let path = PathBuf::from(prompt.text.trim());
-                self.notice = Some(match self.lesson_file().save(&path) {
-                    Ok(()) => format!(
-                        "wrote {}: `sapnet teach --config {}` opens it{}",
-                        path.display(),
-                        path.display(),
-                        self.walk
-                            .as_ref()
-                            .map(|w| format!(
-                                " at call {} of {}'s walk",
-                                w.trace.len(),
-                                self.names()[w.policy]
-                            ))
-                            .unwrap_or_default()
-                    ),
-                    Err(error) => format!("not saved: {error:#}"),
-                });
-            }
-        }
-    }
-
-    /// `X`: exercise mode on (the score from 0) or off.
-    pub fn toggle_exercise(&mut self) {
-        self.exercise = match self.exercise {
-            Some(_) => None,
-            None => Some(Score::default()),
-        };
-        self.notice = Some(match self.exercise {
-            Some(_) => format!(
-                "exercise: s asks the next call's ΔA first (right within {ANSWER_TOLERANCE}); \
-                 X ends it"
-            ),
-            None => "exercise ended".to_string(),
-        });
-    }
-
-    /// The exercise's score, in exercise mode.
-    pub fn score(&self) -> Option<Score> {
-        self.exercise
-    }
-
-    /// `s`: in exercise mode, asks the next call's ΔA before making it; else makes it.
-    pub fn step_or_ask(&mut self) {
-        let next = self.walk.as_ref().and_then(|w| w.state.pending().last());
-        if self.exercise.is_some() && next.is_some() {
-            self.open_prompt(PromptKind::Predict);
-        } else {
-            self.step();
-        }
-    }
-
-    /// Checks `answer` against the next call (eq. 10: ΔA = η/(h×Ω) where Ω < T_ω, else
-    /// the call stops), says right or the working, counts it, then makes the call.
-    fn check_answer(&mut self, answer: &str) {
-        let Some(call) = self
-            .walk
-            .as_ref()
-            .and_then(|w| w.state.pending().last().copied())
-        else {
-            return;
-        };
-        let threshold = self.net.params().threshold;
-        let stops = call.omega >= threshold;
-        let delta = call.eta / (call.h as f64 * call.omega);
-        let answer = answer.trim();
-        let said_stop = ["stop", "stops", "stopped"].contains(&answer.to_lowercase().as_str());
-        let right = match (stops, said_stop, answer.parse::<f64>()) {
-            (true, true, _) => true,
-            (false, false, Ok(x)) => (x - delta).abs() <= ANSWER_TOLERANCE,
-            _ => false,
-        };
-        let names = self.names();
-        let working = if stops {
-            format!(
-                "eq. 10: Ω < T_ω is {:.4} < {threshold}, false: the call stops, ΔA = 0",
-                call.omega
-            )
-        } else {
-            format!(
-                "eq. 10: Ω < T_ω is {:.4} < {threshold}, true: ΔA[{}] = η/(h×Ω) = \
-                 {:.6}/({}×{:.4}) = {delta:.6}",
-                call.omega, names[call.to], call.eta, call.h, call.omega
-            )
-        };
-        let score = self.exercise.get_or_insert_with(Score::default);
-        score.asked += 1;
-        if right {
-            score.right += 1;
-        }
-        let score = *score;
-        let verdict = if right {
-            format!("right ({working})")
-        } else if answer.is_empty() {
-            format!("no answer: {working}")
-        } else {
-            format!("not {answer}: {working}")
-        };
-        self.step();
-        self.notice = Some(format!("{verdict} · score {}/{}", score.right, score.asked));
-    }
-
-    /// `x`: cuts the picked policy's selected edge (`e` selects it).
-    pub fn cut_selected_edge(&mut self) {
-        self.running = false;
-        match self.selected_edge() {
-            Some((i, j)) => self.edit_graph(GraphEdit::Cut { i, j }),
-            None => self.notice = Some(format!("{} has no edge to cut", self.names()[self.cursor])),
-        }
-    }
-
-    /// Edits the graph or its policies as `sapnet teach --add-edge`, `--cut-edge`,
-    /// `--add-policy`, `--remove-policy` and `--set-category` do (the same checks, the
-    /// same refusals), then builds the net the lesson file would: a refusal changes
-    /// nothing and is said. The walk on screen restarts from the activations it started
-    /// from (a new policy's 0, a removed one's dropped), as a knob's turn restarts it.
-    pub fn edit_graph(&mut self, edit: GraphEdit) {
-        self.running = false;
-        self.animation = None;
-        self.notice = None;
-        let (policy, before) = match &self.walk {
-            Some(w) => (Some(w.policy), w.before.clone()),
-            None => (None, self.net.activations().to_vec()),
-        };
-        let mut lesson = self.lesson_file();
-        // The walk restarts on the edited graph: no position to check against it.
-        lesson.walk = None;
-        let built = lesson.apply(&edit).and_then(|()| lesson.lesson());
-        let built = match built {
-            Ok(built) => built,
-            Err(why) => {
-                self.notice = Some(format!("{}: {why}", edit.flag()));
-                return;
-            }
-        };
-        let old_calls = walk_end(&self.net, policy, &before).2;
-        let moved = policy.and_then(|p| edit.renumbered(p));
-        // The built net holds the lesson's `initial`: the walk's starting activations,
-        // renumbered.
-        let before = built.net.activations().to_vec();
-        let new_calls = walk_end(&built.net, moved, &before).2;
-        let count_changed = built.net.len() != self.net.len();
-        self.net = built.net;
-        self.source = lesson;
-        self.set_names(built.names);
-        self.groups = match built.groups {
-            Some(groups) => Some(groups),
-            None if count_changed => None,
-            None => self.groups.take(),
-        };
-        self.initial = edit.renumber(&self.initial, 0.0);
-        if !self.excluded.is_empty() {
-            self.excluded = edit.renumber(&self.excluded, false);
-        }
-        self.cursor = edit
-            .renumbered(self.cursor)
-            .unwrap_or(self.cursor)
-            .min(self.net.len() - 1);
-        if matches!(edit, GraphEdit::AddPolicy { .. }) {
-            self.cursor = self.net.len() - 1;
-        }
-        self.edge = 0;
-        self.notice = Some(match (policy, moved) {
-            (Some(_), Some(p)) => format!(
-                "{} done: {}'s walk {old_calls} → {new_calls} calls, restarted",
-                edit.flag(),
-                self.names()[p]
-            ),
-            (Some(_), None) => format!(
-                "{} done: the walk's own policy is gone, so is its walk",
-                edit.flag()
-            ),
-            (None, _) => format!("{} done", edit.flag()),
-        });
-        match moved {
-            Some(policy) => {
-                self.walk = Some(self.start(policy, before));
-                self.sync();
-            }
-            None => {
-                self.walk = None;
-                self.set_activations(before);
-            }
-        }
-    }
-
-    /// The lesson as it stands, in the format `sapnet teach --config` reads: the graph
-    /// (its edges, or the policies' descriptions where categories build it), T_ω, 𝒜, τ
-    /// and the paths as edited, the policies' names as the lesson gave them, and as
-    /// `initial` the activations the walk on screen started from (so `--activate` of its
-    /// policy replays it), or those on screen without a walk.
-    pub fn lesson_file(&self) -> TeachConfig {
-        let params = self.net.params();
-        let activations = match &self.walk {
-            Some(w) => w.before.clone(),
-            None => self.net.activations().to_vec(),
-        };
-        let names = self
-            .descriptions
-            .clone()
-            .unwrap_or_else(|| self.names.clone());
-        let default_names = names
-            .iter()
-            .enumerate()
-            .all(|(i, name)| *name == format!("π{i}"));
-        let defaults = TeachConfig::default();
-        let by_categories = self.has_categories();
-        TeachConfig {
-            policies: self.net.len(),
-            names: if default_names { Vec::new() } else { names },
-            edges: if by_categories {
-                Vec::new()
-            } else {
-                self.net.graph().edges().collect()
-            },
-            descriptions: self.source.descriptions.clone(),
-            prototypes: if by_categories {
-                params.prototypes.clone()
-            } else {
-                defaults.prototypes
-            },
-            delta: if by_categories {
-                params.delta
-            } else {
-                defaults.delta
-            },
-            base_graph: if by_categories {
-                params.base_graph
-            } else {
-                defaults.base_graph
-            },
-            threshold: params.threshold,
-            coefficient: params.coefficient,
-            temperature: params.temperature,
-            paths: params.paths,
-            initial: activations.iter().any(|&a| a != 0.0).then_some(activations),
-            walk: self.walk.as_ref().map(|w| WalkPosition {
-                activate: w.policy,
-                calls: w.trace.len(),
-            }),
-            decay: self.decay,
-            questions: self.questions.clone(),
-        }
-    }
-
-    /// A walk activating `policy` from the activations `before` (eq. 8, the first calls
-    /// queued).
-    fn start(&self, policy: usize, before: Vec<f64>) -> Walk {
-        let mut activations = before.clone();
-        let state = Spreader::activate(
-            self.net.graph(),
-            self.net.spreading(),
-            policy,
-            self.net.params().coefficient,
-            &mut activations,
-        )
-        .suspend();
-        Walk {
-            policy,
-            before,
-            trace: Vec::new(),
-            state,
-            activations,
-            deposited: Vec::new(),
-        }
-    }
-
-    /// The next call of the walk, on the walk's own activations; O(1).
-    fn call(&mut self) -> Option<TraceStep> {
-        let walk = self.walk.as_mut()?;
-        let state = std::mem::take(&mut walk.state);
-        let mut spreader = Spreader::resume(self.net.graph(), state);
-        let call = spreader.step(&mut walk.activations);
-        walk.state = spreader.suspend();
-        walk.trace.extend(call);
-        call
-    }
-
-    /// Shows the walk's activations on the net.
-    fn sync(&mut self) {
-        if let Some(walk) = &mut self.walk {
-            walk.deposited = walk
-                .activations
-                .iter()
-                .zip(&walk.before)
-                .map(|(a, b)| a - b)
-                .collect();
-            let activations = walk.activations.clone();
-            self.set_activations(activations);
-        }
-    }
-
-    fn set_activations(&mut self, activations: Vec<f64>) {
-        // The net's bounds keep every activation finite (see `SapNet::with_activations`)
-        // and the count is the graph's: `set_activations` cannot refuse these.
-        self.net
-            .set_activations(activations)
-            .expect("activations from the same graph");
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::teach::lesson::TeachConfig;
+    use crate::teach::knobs::Knob;
+    use crate::teach::lesson::{TeachConfig, WalkPosition};
+    use std::time::{Duration, Instant};
 
     fn fig2() -> Teach {
         let lesson = TeachConfig::load(None).expect("embedded Fig. 2");

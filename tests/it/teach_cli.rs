@@ -432,3 +432,117 @@ fn policies_added_and_recategorised_by_flag() {
         "{said}"
     );
 }
+
+/// Issue 52, item 7: `teach --save` once renamed over whatever PATH was. A FIFO, a socket,
+/// a directory and (as root) a device node are refused naming the path and what was
+/// expected (exit 2), and left as they were; nothing is left beside them.
+#[test]
+fn save_refuses_a_fifo_a_socket_and_a_directory_and_leaves_them() {
+    use std::os::unix::fs::FileTypeExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let fifo = tmp.path().join("fifo");
+    let path = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: a NUL-terminated path and a mode, as mkfifo(3) takes them.
+    assert_eq!(unsafe { libc::mkfifo(path.as_ptr(), 0o644) }, 0);
+    let socket = tmp.path().join("socket");
+    let _listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
+    let directory = tmp.path().join("folder");
+    std::fs::create_dir(&directory).unwrap();
+    // /dev/null's twin (major 1, minor 3), made here rather than risking /dev/null itself:
+    // only root may make one, as only root could have had /dev/null replaced.
+    let device = tmp.path().join("null");
+    let path = std::ffi::CString::new(device.to_str().unwrap()).unwrap();
+    // SAFETY: a NUL-terminated path, a mode and a device number, as mknod(2) takes them.
+    let made = unsafe { libc::mknod(path.as_ptr(), libc::S_IFCHR | 0o666, libc::makedev(1, 3)) };
+    let mut refused = vec![
+        (&fifo, "a FIFO"),
+        (&socket, "a socket"),
+        (&directory, "a directory"),
+    ];
+    if made == 0 {
+        refused.push((&device, "a device"));
+    }
+    for (target, what) in refused {
+        let named = target.to_str().unwrap();
+        let output = sapnet(&["teach", "--save", named]);
+        assert_eq!(output.status.code(), Some(2), "{what}");
+        let error = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            error.contains(named) && error.contains(what) && error.contains("a regular file"),
+            "{what}: {error}"
+        );
+    }
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+    assert!(std::fs::symlink_metadata(&socket)
+        .unwrap()
+        .file_type()
+        .is_socket());
+    assert_eq!(std::fs::read_dir(&directory).unwrap().count(), 0);
+    let mut left: Vec<String> = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name != "null")
+        .collect();
+    left.sort();
+    assert_eq!(left, ["fifo", "folder", "socket"], "no temporary file left");
+    if made == 0 {
+        let kind = std::fs::symlink_metadata(&device).unwrap().file_type();
+        assert!(kind.is_char_device(), "the device node is left as it was");
+    }
+}
+
+/// A lesson saved over a file of 0600 keeps 0600 (it once became 0644), and is replaced
+/// whole; a new file is made as any other.
+#[test]
+fn save_keeps_an_existing_files_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let private = tmp.path().join("private.ron");
+    std::fs::write(
+        &private,
+        "an older lesson, much longer than the new one ".repeat(100),
+    )
+    .unwrap();
+    std::fs::set_permissions(&private, std::fs::Permissions::from_mode(0o600)).unwrap();
+    let output = sapnet(&["teach", "--save", private.to_str().unwrap()]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let mode = std::fs::metadata(&private).unwrap().permissions().mode();
+    assert_eq!(mode & 0o7777, 0o600);
+    let text = std::fs::read_to_string(&private).unwrap();
+    assert!(text.starts_with("// A sapnet lesson"), "{text}");
+    assert!(!text.contains("an older lesson"), "{text}");
+}
+
+/// Issue 52, item 12: a received lesson whose names hold an OSC title and a screen clear.
+/// `--headless` prints them as visible escapes, never as the bytes a terminal acts on.
+#[test]
+fn control_characters_in_a_lessons_names_are_printed_as_escapes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let lesson = tmp.path().join("hostile.ron");
+    std::fs::write(
+        &lesson,
+        "(names: [\"\u{1b}]0;owned\u{7}\", \"\u{1b}[2J\u{1b}[H\"], edges: [(0, 1, 0.4)])",
+    )
+    .unwrap();
+    let config = lesson.to_str().unwrap();
+    let out = sapnet(&["teach", "--headless", "--config", config, "--activate", "0"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(!text.contains(['\u{1b}', '\u{7}']), "{text:?}");
+    assert!(
+        text.contains("activate \\u{1b}]0;owned\\u{7}: A[\\u{1b}]0;owned\\u{7}] += 𝒜 = 1"),
+        "{text}"
+    );
+    assert!(text.contains("\\u{1b}[2J\\u{1b}[H"), "{text}");
+}

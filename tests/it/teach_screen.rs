@@ -177,9 +177,9 @@ fn the_trace_shows_four_calls_at_the_smallest_size() {
     }
 }
 
-/// Table II's π3 activated at 80×24, where the activations table has four rows for ten
-/// policies: the policies the walk deposits on (π4, π5, π6, its category) are in view
-/// beside π3, not π0…π2 (the rows nearest π3 by index).
+/// Table II's π3 activated: the policies the walk deposits on (π4, π5, π6, its category)
+/// are in view beside π3. At 80×24 the activations table once had four rows for ten
+/// policies and kept these in view; a grid now shows all ten.
 #[test]
 fn the_policies_receiving_delta_a_stay_in_the_table() {
     let mut teach = table2();
@@ -207,16 +207,19 @@ fn the_policies_receiving_delta_a_stay_in_the_table() {
             .take_while(|l| !l.contains("pending spread calls"))
             .collect();
         let text = table.join("\n");
+        // A row's first cell, or a cell of the grid's second column.
+        let shows = |i: usize| {
+            ["│π", "│ π"]
+                .iter()
+                .any(|at| text.contains(&format!("{at}{i} ")))
+        };
         for i in [3, 4, 5, 6] {
-            assert!(
-                text.contains(&format!("│π{i} ")),
-                "π{i} at {size:?}:\n{text}"
-            );
+            assert!(shows(i), "π{i} at {size:?}:\n{text}");
         }
-        if size == (80, 24) {
-            assert!(!text.contains("│π0 "), "{text}");
-            assert!(text.contains("6 of 10 not shown"), "{text}");
-        }
+        // Issue 51, item 5: at 80×24 a table of four rows once hid six policies; a grid
+        // shows all ten.
+        assert!((0..10).all(shows), "{size:?}:\n{text}");
+        assert!(!text.contains("not shown"), "{text}");
         insta::assert_snapshot!(
             format!("teach_receivers_in_view_{}x{}", size.0, size.1),
             terminal.backend()
@@ -488,4 +491,155 @@ fn a_question_is_asked_at_the_walks_end_and_its_answer_hidden() {
     "7.25".chars().for_each(|c| teach.prompt_type(c));
     teach.prompt_submit();
     assert_eq!(teach.notice(), Some("right: 7.25 ± 0.01 · questions 1/1"));
+}
+
+/// Issue 51, item 5: the exercise once printed the answer beside its question. Fig. 2
+/// from π1: the first call deposits (1/3)/(1×0.4) = 0.833333, the second
+/// (1/6)/(2×0.8) = 0.104167, the third stops (Ω = 1.2 ≥ T_ω = 1). Each is nowhere on the
+/// screen while it is asked, and said once answered.
+#[test]
+fn the_exercise_hides_the_answer_until_it_is_given() {
+    let mut teach = fig2();
+    teach.move_cursor(1);
+    teach.activate();
+    teach.toggle_exercise();
+    let answer = |teach: &mut Teach, typed: &str| {
+        typed.chars().for_each(|c| teach.prompt_type(c));
+        teach.prompt_submit();
+    };
+    teach.step_or_ask();
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = text(&terminal);
+        assert!(
+            screen.contains("ΔA of the next call"),
+            "{size:?}:\n{screen}"
+        );
+        assert!(!screen.contains("0.833"), "{size:?}:\n{screen}");
+        assert!(!screen.contains("true"), "{size:?}:\n{screen}");
+        insta::assert_snapshot!(
+            format!("teach_exercise_asked_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+    answer(&mut teach, "0.8333");
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = text(&terminal);
+        assert!(screen.contains("0.833333"), "{size:?}:\n{screen}");
+        assert!(!screen.contains("0.104"), "the next answer:\n{screen}");
+        insta::assert_snapshot!(
+            format!("teach_exercise_answered_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+    teach.step_or_ask();
+    answer(&mut teach, "0.1");
+    teach.step_or_ask();
+    for size in SIZES {
+        let screen = text(&draw(&teach, size));
+        assert!(
+            !screen.contains("stop (") && !screen.contains("stopped"),
+            "{screen}"
+        );
+        assert!(!screen.contains("the call stops"), "{size:?}:\n{screen}");
+    }
+    answer(&mut teach, "stop");
+    for size in SIZES {
+        let screen = text(&draw(&teach, size));
+        assert!(screen.contains("stopped"), "{size:?}:\n{screen}");
+        assert!(screen.contains("score 2/3"), "{size:?}:\n{screen}");
+    }
+}
+
+/// At 80×24 Table II's activations are a grid of two columns: a click on a cell picks its
+/// policy, a click on the gap between the columns picks none.
+#[test]
+fn a_click_on_a_cell_of_the_activations_grid_picks_its_policy() {
+    let teach = table2();
+    let size = (80, 24);
+    let screen = lines(&draw(&teach, size));
+    let screen_area = ratatui::layout::Rect::new(0, 0, size.0, size.1);
+    let click = |column: usize, row: usize| {
+        teach_view::clicked(&teach, screen_area, column as u16, row as u16)
+    };
+    for i in 0..10 {
+        let (row, column) = screen
+            .iter()
+            .enumerate()
+            .find_map(|(row, l)| {
+                let table = right(l, size.0);
+                let at = table.find(&format!("π{i} 0."))?;
+                Some((
+                    row,
+                    usize::from(size.0) * 45 / 100 + table[..at].chars().count(),
+                ))
+            })
+            .unwrap_or_else(|| panic!("π{i}'s cell:\n{}", screen.join("\n")));
+        assert_eq!(click(column, row), Some(i), "π{i}");
+        assert_eq!(click(column + 8, row), Some(i), "π{i}'s A");
+    }
+    let row = screen.iter().position(|l| l.contains("π0 0.")).unwrap();
+    let gap = right(&screen[row], size.0).find(" │ ").unwrap();
+    let gap = usize::from(size.0) * 45 / 100 + right(&screen[row], size.0)[..gap].chars().count();
+    assert_eq!(click(gap + 1, row), None, "the gap");
+}
+
+/// Issue 51, item 5: Table II's chart had ten curves and no legend (no room for one).
+/// Each curve's end is named beside it: π3's walk ends with π3 highest in A and P, π4…π6
+/// (its category) sharing a row in A, the other six the bottom one; names that do not
+/// fit are counted (`π4 +2`).
+#[test]
+fn the_charts_curves_are_named_at_their_ends() {
+    let mut teach = table2();
+    teach.move_cursor(3);
+    teach.activate();
+    teach.run_to_end();
+    teach.next_panel();
+    teach.next_panel();
+    for size in SIZES {
+        let terminal = draw(&teach, size);
+        let screen = lines(&terminal);
+        let chart: Vec<String> = screen
+            .iter()
+            .map(|l| right(l, size.0))
+            .skip_while(|l| !l.contains("chart (v: through time)"))
+            .collect();
+        let text = chart.join("\n");
+        // π3 ends highest in both charts, A's and P's, alone on its row.
+        assert_eq!(text.matches(" π3 ").count(), 2, "{size:?}:\n{text}");
+        for named in ["π4", "π0"] {
+            assert!(text.contains(named), "{size:?} {named}:\n{text}");
+        }
+        insta::assert_snapshot!(
+            format!("teach_table2_chart_{}x{}", size.0, size.1),
+            terminal.backend()
+        );
+    }
+}
+
+/// Table II through time at 80×24 has room for four of ten policies' rows: it once cut
+/// the rest silently. The picked policy's row stays in view as the arrows move, and the
+/// border counts the rows left out.
+#[test]
+fn through_time_keeps_the_picked_policy_in_view_and_counts_the_rest() {
+    let mut teach = table2();
+    teach.move_cursor(3);
+    teach.activate();
+    teach.run_to_end();
+    teach.move_cursor(5);
+    for _ in 0..3 {
+        teach.next_panel();
+    }
+    let terminal = draw(&teach, (80, 24));
+    let panel: Vec<String> = lines(&terminal)
+        .iter()
+        .map(|l| right(l, 80))
+        .skip_while(|l| !l.contains("through time"))
+        .collect();
+    let text = panel.join("\n");
+    assert!(text.contains("│π8 "), "{text}");
+    assert!(!text.contains("│π0 "), "{text}");
+    assert!(text.contains("▲ 5 more · ▼ 1 more"), "{text}");
+    insta::assert_snapshot!("teach_table2_through_time_80x24", terminal.backend());
 }

@@ -25,7 +25,6 @@ use crate::tui::screen::{draw_help, too_small, MIN_HEIGHT, MIN_WIDTH};
 use crate::tui::theme::Theme;
 use crate::tui::{graph_layout, graph_view};
 pub(crate) use help::teach_help;
-use values::values_rows;
 
 /// Draws stand-alone teach mode (`sapnet teach`).
 pub fn draw(frame: &mut Frame, teach: &Teach, help: bool, theme: Theme) {
@@ -163,10 +162,8 @@ pub fn policy_at(area: Rect, teach: &Teach, column: u16, row: u16) -> Option<usi
         return graph_layout::canvas_point(panels.graph, column, row)
             .and_then(|point| graph_layout::node_at(&positions, point, graph_layout::CLICK_REACH));
     }
-    if panels.values.contains(at) && row < panels.values.bottom() - 1 {
-        // The rows as drawn, below the border and the header row.
-        let line = usize::from(row.checked_sub(panels.values.y + 2)?);
-        return values_rows(panels.values, teach).row_at(line);
+    if panels.values.contains(at) {
+        return values::policy_at(panels.values, teach, column, row);
     }
     None
 }

@@ -1,6 +1,7 @@
 //! A and P of every policy through time: a row per policy, a column per walk (after each
 //! activation's walk, the decay D between two said in the title), the latest walks kept
-//! where they do not all fit; the walk in progress marked.
+//! where they do not all fit, and the picked policy's row where the rows do not (the
+//! border counts the others); the walk in progress marked.
 
 use ratatui::layout::{Constraint, Rect};
 use ratatui::text::{Line, Span};
@@ -9,6 +10,7 @@ use ratatui::Frame;
 
 use super::figures::name_width;
 use crate::teach::{labels, Teach};
+use crate::tui::row_window::RowWindow;
 use crate::tui::theme::Theme;
 
 /// A walk's column: `A` to four decimals and `P` to two.
@@ -45,25 +47,49 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme, t
         };
         Cell::from(format!("{}:{}{mark}", t + 1, names[rows[t].activated]))
     }));
-    let body = (0..names.len()).map(|i| {
-        Row::new(
-            std::iter::once(Cell::from(names[i].clone())).chain(rows[first..].iter().map(|row| {
+    // The policies' rows that fit under the header, the picked one kept in view (the
+    // arrows scroll it) and marked.
+    let window = RowWindow::new(
+        names.len(),
+        usize::from(area.height.saturating_sub(3)),
+        [teach.cursor()],
+    );
+    let body = window.rows().map(|i| {
+        let row = Row::new(std::iter::once(Cell::from(names[i].clone())).chain(
+            rows[first..].iter().map(|row| {
                 Cell::from(format!(
                     "{:.4} ({:.2})",
                     row.activations[i], row.probabilities[i]
                 ))
-            })),
-        )
+            }),
+        ));
+        if i == teach.cursor() {
+            row.style(theme.cursor())
+        } else {
+            row
+        }
     });
     let widths = std::iter::once(Constraint::Length(width))
         .chain(std::iter::repeat_n(Constraint::Length(COLUMN), shown));
-    let hidden = (first > 0).then(|| format!("◀ {first} earlier"));
+    let left_out = left_out(first, &window);
     frame.render_widget(
         Table::new(body, widths)
             .header(Row::new(header).style(theme.title()))
-            .block(block.title_bottom(
-                Line::styled(hidden.unwrap_or_default(), theme.title()).right_aligned(),
-            )),
+            .block(block.title_bottom(Line::styled(left_out, theme.title()).right_aligned())),
         area,
     );
+}
+
+/// ` ◀ 1 earlier · ▼ 6 more `: the walks and the policies left out, for the bottom border.
+fn left_out(earlier: usize, window: &RowWindow) -> String {
+    let parts: Vec<String> = (earlier > 0)
+        .then(|| format!("◀ {earlier} earlier"))
+        .into_iter()
+        .chain(window.marker().map(|m| m.trim().to_string()))
+        .collect();
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!(" {} ", parts.join(" · "))
+    }
 }
