@@ -1,12 +1,13 @@
 //! The DQN learner (ChainerRL's `DQN` agent, with the hyper-parameters of `DqnConfig`).
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use rand::Rng;
 
 use super::backprop::Workspace;
 use super::kernels::Isa;
+use super::round::{round, Interrupt};
 use super::scratch::{with_scratch, UpdateWork};
 use super::{
     distillation_loss, td_huber_loss, Adam, Batch, DqnError, EpsilonGreedy, QNet, ReplayBuffer,
@@ -64,7 +65,7 @@ pub struct DqnAgent {
     /// Whether each report carries the TD error of the latest transition ([`TdError`]).
     measure_td: bool,
     /// Raised when the run is asked to stop: a round of many updates ends at the next.
-    interrupt: Option<Arc<AtomicBool>>,
+    interrupt: Interrupt,
     /// The teacher whose Q-values every update distils, if any (QDagger).
     teacher: Option<Teacher>,
     /// The policy whose value the learner estimates, if not its own greedy one: its
@@ -99,7 +100,7 @@ impl DqnAgent {
             statistic_loss: 0.0,
             last_loss: None,
             measure_td: false,
-            interrupt: None,
+            interrupt: Interrupt::default(),
             teacher: None,
             evaluated_policy: None,
             batch: Batch::new(),
@@ -159,11 +160,7 @@ impl DqnAgent {
         if replay.len() < self.config.replay_start_size.max(1) {
             return Ok(None);
         }
-        let mut batch = std::mem::take(&mut self.batch);
-        replay.sample_into(self.config.batch_size, &mut batch, rng);
-        let result = self.update(&batch);
-        self.batch = batch;
-        let loss = result?;
+        let loss = self.sampled_update(replay, rng)?;
         if self.updates.is_multiple_of(target_interval.max(1)) {
             self.sync_target()?;
         }
@@ -181,28 +178,17 @@ impl DqnAgent {
         target_interval: u64,
         rng: &mut impl Rng,
     ) -> Result<Option<f64>, DqnError> {
-        let mut loss = None;
         if replay.is_empty() {
-            return Ok(loss);
+            return Ok(None);
         }
-        for k in 1..=updates {
-            if self
-                .interrupt
-                .as_ref()
-                .is_some_and(|f| f.load(Ordering::Relaxed))
-            {
-                break;
-            }
-            let mut batch = std::mem::take(&mut self.batch);
-            replay.sample_into(self.config.batch_size, &mut batch, rng);
-            let result = self.update(&batch);
-            self.batch = batch;
-            loss = Some(result?);
-            if k.is_multiple_of(target_interval.max(1)) {
+        let interrupt = self.interrupt.clone();
+        round(updates, true, &interrupt, |k| {
+            let loss = self.sampled_update(replay, rng)?;
+            if (k + 1).is_multiple_of(target_interval.max(1)) {
                 self.sync_target()?;
             }
-        }
-        Ok(loss)
+            Ok(loss)
+        })
     }
 
     /// From now on, every [`UpdateReport`] carries the [`TdError`] of the transition stored
@@ -215,7 +201,7 @@ impl DqnAgent {
     /// A round of updates (up to `gradient_steps`) ends early, its learning kept, once
     /// `flag` is raised: how the run that owns this learner tells it to stop.
     pub fn interrupt_rounds_with(&mut self, flag: Arc<AtomicBool>) {
-        self.interrupt = Some(flag);
+        self.interrupt = Interrupt::new(flag);
     }
 
     /// `max_a Q_online(obs, a)`: the online net's value estimate of `obs`.
@@ -259,24 +245,11 @@ impl DqnAgent {
             Some((y, t)) => Some(self.td_error(*y, t)?),
             None => None,
         };
-        let mut loss = 0.0;
-        for k in 0..self.config.gradient_steps {
-            // A round of many updates (gradient_steps up to 10,000) hears a stop between two
-            // of them: what it learned so far is kept, the run stops at its step's end.
-            if k > 0
-                && self
-                    .interrupt
-                    .as_ref()
-                    .is_some_and(|f| f.load(Ordering::Relaxed))
-            {
-                break;
-            }
-            let mut batch = std::mem::take(&mut self.batch);
-            replay.sample_into(self.config.batch_size, &mut batch, rng);
-            let result = self.update(&batch);
-            self.batch = batch;
-            loss = result?;
-        }
+        // The run stops at its step's end; what the round learned so far is kept.
+        let interrupt = self.interrupt.clone();
+        let steps = u64::from(self.config.gradient_steps);
+        let loss = round(steps, false, &interrupt, |_| self.sampled_update(replay, rng))?
+            .unwrap_or(0.0);
         let td = match (td_target, td_before) {
             (Some((y, t)), Some(before)) => Some(TdError {
                 before,
@@ -308,6 +281,15 @@ impl DqnAgent {
     fn td_error(&self, y: f32, t: &Transition<'_>) -> Result<f64, DqnError> {
         let q = self.online.q_values(t.obs)?[t.action];
         Ok(f64::from(y - q))
+    }
+
+    /// One gradient update on a minibatch sampled from `replay`.
+    fn sampled_update(&mut self, replay: &ReplayBuffer, rng: &mut impl Rng) -> Result<f64, DqnError> {
+        let mut batch = std::mem::take(&mut self.batch);
+        replay.sample_into(self.config.batch_size, &mut batch, rng);
+        let result = self.update(&batch);
+        self.batch = batch;
+        result
     }
 
     /// One gradient update on `batch`; returns the loss and folds it into the statistic loss.

@@ -16,13 +16,14 @@
 //! when it arrives, and read by every update that samples it ([`super::source_values`]):
 //! the same bits as running the sources on each minibatch, for less (BENCHMARKS.md, issue 40).
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use rand::Rng;
 
 use super::backprop::Workspace;
 use super::kernels::Isa;
+use super::round::{round, Interrupt};
 use super::source_values::SourceValues;
 use super::{huber, Adam, Architecture, Batch, DqnConfig, DqnError, Init, QNet, ReplayBuffer};
 
@@ -35,7 +36,7 @@ pub struct AttentionLearner {
     config: DqnConfig,
     steps: u64,
     updates: u64,
-    interrupt: Option<Arc<AtomicBool>>,
+    interrupt: Interrupt,
     batch: Batch,
     /// The attention's passes, and every other network's (copied out of `scratch`).
     work: Workspace,
@@ -68,7 +69,7 @@ impl AttentionLearner {
             config: config.clone(),
             steps: 0,
             updates: 0,
-            interrupt: None,
+            interrupt: Interrupt::default(),
             batch: Batch::new(),
             work: Workspace::default(),
             scratch: Workspace::default(),
@@ -88,7 +89,7 @@ impl AttentionLearner {
 
     /// A stop raised on `flag` ends nothing mid-update, but is heard between updates.
     pub fn interrupt_rounds_with(&mut self, flag: Arc<AtomicBool>) {
-        self.interrupt = Some(flag);
+        self.interrupt = Interrupt::new(flag);
     }
 
     /// `w(s)`: the weights of the sources, then the base's, for one observation.
@@ -134,22 +135,14 @@ impl AttentionLearner {
         {
             return Ok(None);
         }
-        let mut loss = None;
-        for k in 0..self.config.gradient_steps {
-            if k > 0
-                && self
-                    .interrupt
-                    .as_ref()
-                    .is_some_and(|f| f.load(Ordering::Relaxed))
-            {
-                break;
-            }
+        let interrupt = self.interrupt.clone();
+        let loss = round(u64::from(self.config.gradient_steps), false, &interrupt, |_| {
             let mut batch = std::mem::take(&mut self.batch);
             replay.sample_into(self.config.batch_size, &mut batch, rng);
             let result = self.update(&batch, sources, base);
             self.batch = batch;
-            loss = Some(result?);
-        }
+            result
+        })?;
         Ok(loss)
     }
 

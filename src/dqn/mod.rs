@@ -21,6 +21,7 @@ mod optim;
 mod q_values;
 mod qnet;
 mod replay;
+mod round;
 mod scratch;
 mod source_values;
 
