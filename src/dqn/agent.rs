@@ -248,8 +248,10 @@ impl DqnAgent {
         // The run stops at its step's end; what the round learned so far is kept.
         let interrupt = self.interrupt.clone();
         let steps = u64::from(self.config.gradient_steps);
-        let loss = round(steps, false, &interrupt, |_| self.sampled_update(replay, rng))?
-            .unwrap_or(0.0);
+        let loss = round(steps, false, &interrupt, |_| {
+            self.sampled_update(replay, rng)
+        })?
+        .unwrap_or(0.0);
         let td = match (td_target, td_before) {
             (Some((y, t)), Some(before)) => Some(TdError {
                 before,
@@ -284,7 +286,11 @@ impl DqnAgent {
     }
 
     /// One gradient update on a minibatch sampled from `replay`.
-    fn sampled_update(&mut self, replay: &ReplayBuffer, rng: &mut impl Rng) -> Result<f64, DqnError> {
+    fn sampled_update(
+        &mut self,
+        replay: &ReplayBuffer,
+        rng: &mut impl Rng,
+    ) -> Result<f64, DqnError> {
         let mut batch = std::mem::take(&mut self.batch);
         replay.sample_into(self.config.batch_size, &mut batch, rng);
         let result = self.update(&batch);

@@ -136,13 +136,18 @@ impl AttentionLearner {
             return Ok(None);
         }
         let interrupt = self.interrupt.clone();
-        let loss = round(u64::from(self.config.gradient_steps), false, &interrupt, |_| {
-            let mut batch = std::mem::take(&mut self.batch);
-            replay.sample_into(self.config.batch_size, &mut batch, rng);
-            let result = self.update(&batch, sources, base);
-            self.batch = batch;
-            result
-        })?;
+        let loss = round(
+            u64::from(self.config.gradient_steps),
+            false,
+            &interrupt,
+            |_| {
+                let mut batch = std::mem::take(&mut self.batch);
+                replay.sample_into(self.config.batch_size, &mut batch, rng);
+                let result = self.update(&batch, sources, base);
+                self.batch = batch;
+                result
+            },
+        )?;
         Ok(loss)
     }
 

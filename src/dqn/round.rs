@@ -60,8 +60,14 @@ mod tests {
         .unwrap();
         assert_eq!((made, loss), (vec![0, 1, 2], Some(2.0)));
         // Raised before the round: the first update still runs, unless heard before it.
-        assert_eq!(round(3, false, &interrupt, |k| Ok(k as f64)).unwrap(), Some(0.0));
+        assert_eq!(
+            round(3, false, &interrupt, |k| Ok(k as f64)).unwrap(),
+            Some(0.0)
+        );
         assert_eq!(round(3, true, &interrupt, |k| Ok(k as f64)).unwrap(), None);
-        assert_eq!(round(2, true, &Interrupt::default(), |k| Ok(k as f64)).unwrap(), Some(1.0));
+        assert_eq!(
+            round(2, true, &Interrupt::default(), |k| Ok(k as f64)).unwrap(),
+            Some(1.0)
+        );
     }
 }

@@ -212,16 +212,12 @@ impl Selector for A2t {
     /// Scores: each source's mean weight over the run; probabilities: its weight at the
     /// latest step (the base holds the rest).
     fn view(&self) -> SelectorView {
-        let n = self.latest.len();
         let steps = self.steps.max(1) as f64;
-        SelectorView {
-            score_name: "w̄",
-            scores: self.sums.iter().map(|s| s / steps).collect(),
-            probabilities: self.latest.clone(),
-            positive: vec![0; n],
-            negative: vec![0; n],
-            excluded: Vec::new(),
-        }
+        SelectorView::unjudged(
+            "w̄",
+            self.sums.iter().map(|s| s / steps).collect(),
+            self.latest.clone(),
+        )
     }
 
     fn chosen(&self) -> Option<usize> {

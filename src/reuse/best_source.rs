@@ -53,14 +53,7 @@ impl Selector for BestSource {
         let n = self.scores.len();
         let mut probabilities = vec![0.0; n];
         probabilities[self.best] = 1.0;
-        SelectorView {
-            score_name: "score",
-            scores: self.scores.clone(),
-            probabilities,
-            positive: vec![0; n],
-            negative: vec![0; n],
-            excluded: Vec::new(),
-        }
+        SelectorView::unjudged("score", self.scores.clone(), probabilities)
     }
 
     fn top_probability(&self) -> Option<f64> {

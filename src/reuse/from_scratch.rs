@@ -20,14 +20,7 @@ impl Selector for Scratch {
     }
 
     fn view(&self) -> SelectorView {
-        SelectorView {
-            score_name: "",
-            scores: Vec::new(),
-            probabilities: Vec::new(),
-            positive: Vec::new(),
-            negative: Vec::new(),
-            excluded: Vec::new(),
-        }
+        SelectorView::unjudged("", Vec::new(), Vec::new())
     }
 
     fn chosen(&self) -> Option<usize> {

@@ -297,21 +297,14 @@ impl FollowedCounts {
 
     /// The counts as the scores, their share of all steps as the probabilities.
     pub fn view(&self, score_name: &'static str) -> SelectorView {
-        let n = self.sources.len();
         let total = (self.sources.iter().sum::<u64>() + self.learner) as f64;
         let probabilities = self
             .sources
             .iter()
             .map(|&c| if total > 0.0 { c as f64 / total } else { 0.0 })
             .collect();
-        SelectorView {
-            score_name,
-            scores: self.sources.iter().map(|&c| c as f64).collect(),
-            probabilities,
-            positive: vec![0; n],
-            negative: vec![0; n],
-            excluded: Vec::new(),
-        }
+        let scores = self.sources.iter().map(|&c| c as f64).collect();
+        SelectorView::unjudged(score_name, scores, probabilities)
     }
 }
 

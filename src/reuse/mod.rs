@@ -212,6 +212,22 @@ pub struct SelectorView {
     pub excluded: Vec<bool>,
 }
 
+impl SelectorView {
+    /// The view of a selector that judges nothing and excludes no source: no judgments,
+    /// one zero per source.
+    pub fn unjudged(score_name: &'static str, scores: Vec<f64>, probabilities: Vec<f64>) -> Self {
+        let n = scores.len();
+        Self {
+            score_name,
+            scores,
+            probabilities,
+            positive: vec![0; n],
+            negative: vec![0; n],
+            excluded: Vec::new(),
+        }
+    }
+}
+
 /// The change of the scores that a positive judgment made: on the judged source (eq. 8,
 /// plus whatever the walk brought back to it) and on all the others together (eq. 10–11).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

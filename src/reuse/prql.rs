@@ -272,15 +272,11 @@ impl Selector for Prql {
 
     /// Scores: W of each source, in [0, 1] (the learner's is not a source's).
     fn view(&self) -> SelectorView {
-        let n = self.w.len() - 1;
-        SelectorView {
-            score_name: "W",
-            scores: self.w[1..].to_vec(),
-            probabilities: self.probabilities()[1..].to_vec(),
-            positive: vec![0; n],
-            negative: vec![0; n],
-            excluded: Vec::new(),
-        }
+        SelectorView::unjudged(
+            "W",
+            self.w[1..].to_vec(),
+            self.probabilities()[1..].to_vec(),
+        )
     }
 
     fn top_probability(&self) -> Option<f64> {

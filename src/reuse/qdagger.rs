@@ -370,14 +370,7 @@ impl Selector for QDagger {
         if self.steps > 0 {
             probabilities[self.teacher] = self.teacher_steps_acted as f64 / self.steps as f64;
         }
-        SelectorView {
-            score_name: "λ",
-            scores,
-            probabilities,
-            positive: vec![0; n],
-            negative: vec![0; n],
-            excluded: Vec::new(),
-        }
+        SelectorView::unjudged("λ", scores, probabilities)
     }
 
     fn chosen(&self) -> Option<usize> {

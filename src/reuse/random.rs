@@ -73,14 +73,11 @@ impl Selector for Random {
             probabilities.iter_mut().for_each(|p| *p = 0.0);
             probabilities[i] = 1.0;
         }
-        SelectorView {
-            score_name: "acted",
-            scores: self.acted.iter().map(|&n| n as f64).collect(),
+        SelectorView::unjudged(
+            "acted",
+            self.acted.iter().map(|&n| n as f64).collect(),
             probabilities,
-            positive: vec![0; self.n],
-            negative: vec![0; self.n],
-            excluded: Vec::new(),
-        }
+        )
     }
 
     /// The source drawn at the first choice (source 0 for a run that never chose, which

@@ -83,14 +83,7 @@ impl Selector for Ucb1 {
             .current
             .unwrap_or_else(|| super::argmax(&self.indices()));
         probabilities[next] = 1.0;
-        SelectorView {
-            score_name: "mean",
-            scores: self.means.clone(),
-            probabilities,
-            positive: vec![0; n],
-            negative: vec![0; n],
-            excluded: Vec::new(),
-        }
+        SelectorView::unjudged("mean", self.means.clone(), probabilities)
     }
 
     /// The source played most (the best mean on a tie).
