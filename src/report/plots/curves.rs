@@ -221,38 +221,6 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
         ),
         data.return_range,
     );
-    let (area, legend_area) = beside_legend(&root);
-    let caption = format!(
-        "{}: episode return, moving average of {w}, mean over runs",
-        data.task
-    );
-    let mut chart = episode_chart(
-        &area,
-        legend::title(data.subject.as_deref(), &caption),
-        format!("episode return, MA{w}"),
-        x_axis(data, last),
-        &fit,
-    )?;
-    let pens = pens(&data.curves);
-    for (i, points) in efficiency.iter().enumerate() {
-        if banded(i) && !pens[i].faint {
-            let band = points.iter().map(|p| (p.at, p.mean));
-            chart.draw_series(std::iter::once(band_polygon(band, &fit, pens[i])))?;
-        }
-    }
-    // The lines over every band, the faint ones under the others.
-    for i in in_drawing_order(&pens) {
-        legend::draw_line(&mut chart, lines[i].clone(), pens[i])?;
-    }
-    let entries: Vec<Entry> = data
-        .curves
-        .iter()
-        .zip(&pens)
-        .map(|(c, &pen)| Entry {
-            label: legend::with_runs(&c.label, c.runs.len()),
-            swatch: Swatch::Line(pen),
-        })
-        .collect();
     let mut notes = vec![];
     let banded_runs: Vec<usize> = (0..data.curves.len())
         .filter(|&i| banded(i))
@@ -267,6 +235,87 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
     if banded_runs.len() < data.curves.len() {
         notes.push("a method of 1 run has no band".into());
     }
+    let bands = efficiency
+        .iter()
+        .enumerate()
+        .map(|(i, points)| banded(i).then(|| points.iter().map(|p| (p.at, p.mean)).collect()))
+        .collect();
+    curves_chart(
+        root,
+        data,
+        Curves {
+            caption: format!(
+                "{}: episode return, moving average of {w}, mean over runs",
+                data.task
+            ),
+            y_desc: format!("episode return, MA{w}"),
+            last,
+            fit,
+            lines,
+            bands,
+            notes,
+        },
+    )
+}
+
+/// What a chart of curves over the budget's axis draws: one line per method of the data
+/// and, where a method has one, its band.
+pub(super) struct Curves {
+    pub caption: String,
+    pub y_desc: String,
+    /// The last point of the axis drawn (the budget's end, under a step budget).
+    pub last: u64,
+    pub fit: Fit,
+    pub lines: Vec<Vec<(f64, f64)>>,
+    /// Each method's band, `(x, interval)`; none for a method without one.
+    pub bands: Vec<Option<Vec<(u64, Estimate)>>>,
+    /// The legend's notes before the faint pens' and the fit's.
+    pub notes: Vec<String>,
+}
+
+/// The frame the learning curve and the sample-efficiency curve share: the chart beside
+/// its legend, each method's band (the faint ones without), the lines over every band
+/// (the faint under the others), the legend of methods with their runs, and its notes.
+pub(super) fn curves_chart<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    data: &PlotData,
+    curves: Curves,
+) -> Drawn<DB> {
+    let Curves {
+        caption,
+        y_desc,
+        last,
+        fit,
+        lines,
+        bands,
+        mut notes,
+    } = curves;
+    let (area, legend_area) = beside_legend(&root);
+    let mut chart = episode_chart(
+        &area,
+        legend::title(data.subject.as_deref(), &caption),
+        y_desc,
+        x_axis(data, last),
+        &fit,
+    )?;
+    let pens = pens(&data.curves);
+    for (band, pen) in bands.into_iter().zip(&pens) {
+        if let Some(band) = band.filter(|_| !pen.faint) {
+            chart.draw_series(std::iter::once(band_polygon(band.into_iter(), &fit, *pen)))?;
+        }
+    }
+    for i in in_drawing_order(&pens) {
+        legend::draw_line(&mut chart, lines[i].clone(), pens[i])?;
+    }
+    let entries: Vec<Entry> = data
+        .curves
+        .iter()
+        .zip(&pens)
+        .map(|(c, &pen)| Entry {
+            label: legend::with_runs(&c.label, c.runs.len()),
+            swatch: Swatch::Line(pen),
+        })
+        .collect();
     notes.extend(emphasis_note(&pens));
     notes.extend(fit.note().map(|n| format!("band {n}")));
     legend::draw(&legend_area, &entries, &notes)?;
