@@ -223,6 +223,19 @@ impl DqnAgent {
         replay: &ReplayBuffer,
         rng: &mut impl Rng,
     ) -> Result<Option<UpdateReport>, DqnError> {
+        self.observe_joined(replay, rng, &[])
+    }
+
+    /// [`observe`](Self::observe), every target bootstrapping on the action that `joined`
+    /// and this learner's online network value most at `s′`, `argmax_a max(Q(s′, a),
+    /// max_i Q_i(s′, a))`, valued by the target network: SFQL's bootstrap on the GPI
+    /// action, the networks of `joined` being its sources' values.
+    pub fn observe_joined(
+        &mut self,
+        replay: &ReplayBuffer,
+        rng: &mut impl Rng,
+        joined: &[&QNet],
+    ) -> Result<Option<UpdateReport>, DqnError> {
         self.steps += 1;
         if self
             .steps
@@ -249,7 +262,7 @@ impl DqnAgent {
         let interrupt = self.interrupt.clone();
         let steps = u64::from(self.config.gradient_steps);
         let loss = round(steps, false, &interrupt, |_| {
-            self.sampled_update(replay, rng)
+            self.sampled_update_joined(replay, rng, joined)
         })?
         .unwrap_or(0.0);
         let td = match (td_target, td_before) {
@@ -291,9 +304,20 @@ impl DqnAgent {
         replay: &ReplayBuffer,
         rng: &mut impl Rng,
     ) -> Result<f64, DqnError> {
+        self.sampled_update_joined(replay, rng, &[])
+    }
+
+    /// [`sampled_update`](Self::sampled_update), bootstrapping as
+    /// [`observe_joined`](Self::observe_joined) says.
+    fn sampled_update_joined(
+        &mut self,
+        replay: &ReplayBuffer,
+        rng: &mut impl Rng,
+        joined: &[&QNet],
+    ) -> Result<f64, DqnError> {
         let mut batch = std::mem::take(&mut self.batch);
         replay.sample_into(self.config.batch_size, &mut batch, rng);
-        let result = self.update(&batch);
+        let result = self.update_joined(&batch, joined);
         self.batch = batch;
         result
     }
@@ -304,16 +328,25 @@ impl DqnAgent {
     /// # Panics
     /// If `batch` is empty.
     pub fn update(&mut self, batch: &Batch) -> Result<f64, DqnError> {
+        self.update_joined(batch, &[])
+    }
+
+    fn update_joined(&mut self, batch: &Batch, joined: &[&QNet]) -> Result<f64, DqnError> {
         assert!(!batch.is_empty(), "cannot learn from an empty batch");
         with_scratch(|scratch| {
             let work = scratch.for_shape(self.online.architecture(), batch.len());
-            self.update_with(batch, work)
+            self.update_with(batch, work, joined)
         })
     }
 
     /// [`update`](Self::update) with this thread's buffers for the network's shape.
-    fn update_with(&mut self, batch: &Batch, work: &mut UpdateWork) -> Result<f64, DqnError> {
-        self.compute_td_targets(batch, &mut work.target)?;
+    fn update_with(
+        &mut self,
+        batch: &Batch,
+        work: &mut UpdateWork,
+        joined: &[&QNet],
+    ) -> Result<f64, DqnError> {
+        self.compute_td_targets(batch, &mut work.target, joined)?;
         let isa = Isa::current();
         // The targets are copied out: the target's buffers can take the teacher's pass.
         let target_work = &mut work.target;
@@ -361,8 +394,15 @@ impl DqnAgent {
     /// `y = r + γ·max_a' Q_target(s', a')` for every transition of `batch` (or, for a
     /// learner that evaluates another policy, `γ·Q_target(s′, π(s′))`), without the
     /// bootstrap after a terminal state (or a truncation, if `truncation_as_terminal`).
-    fn compute_td_targets(&mut self, batch: &Batch, work: &mut Workspace) -> Result<(), DqnError> {
-        if let Some(policy) = &self.evaluated_policy {
+    fn compute_td_targets(
+        &mut self,
+        batch: &Batch,
+        work: &mut Workspace,
+        joined: &[&QNet],
+    ) -> Result<(), DqnError> {
+        if !joined.is_empty() {
+            self.gpi_actions(batch, work, joined)?;
+        } else if let Some(policy) = &self.evaluated_policy {
             let q = policy.forward_with(Isa::current(), batch.next_obs(), batch.len(), work)?;
             self.next_actions.clear();
             self.next_actions.extend(
@@ -375,7 +415,7 @@ impl DqnAgent {
                 .forward_with(Isa::current(), batch.next_obs(), batch.len(), work)?;
         let gamma = self.config.gamma as f32;
         let truncation_is_terminal = self.config.truncation_as_terminal;
-        let evaluated = self.evaluated_policy.is_some();
+        let evaluated = self.evaluated_policy.is_some() || !joined.is_empty();
         self.targets.clear();
         let rows = next_q.chunks_exact(next_q.len() / batch.len());
         for (b, row) in rows.enumerate() {
@@ -390,6 +430,29 @@ impl DqnAgent {
             };
             self.targets.push(batch.rewards()[b] + bootstrap);
         }
+        Ok(())
+    }
+
+    /// The action at each `s′` of `batch` that this learner's online network and `joined`
+    /// value most, into `next_actions`.
+    fn gpi_actions(
+        &mut self,
+        batch: &Batch,
+        work: &mut Workspace,
+        joined: &[&QNet],
+    ) -> Result<(), DqnError> {
+        let isa = Isa::current();
+        let (obs, n) = (batch.next_obs(), batch.len());
+        let mut best = self.online.forward_with(isa, obs, n, work)?.to_vec();
+        for net in joined {
+            let q = net.forward_with(isa, obs, n, work)?;
+            best.iter_mut().zip(q).for_each(|(b, &v)| *b = b.max(v));
+        }
+        self.next_actions.clear();
+        self.next_actions.extend(
+            best.chunks_exact(best.len() / n)
+                .map(super::q_values::argmax),
+        );
         Ok(())
     }
 

@@ -35,6 +35,13 @@ pub trait ReuseMethod {
         None
     }
 
+    /// Whether its learner's targets bootstrap on the action its combination (GPI's
+    /// maximum over the learner and the sources' values) picks at `s′`, SFQL's, rather than
+    /// on the learner's own maximum.
+    fn gpi_bootstrap(&self) -> bool {
+        false
+    }
+
     /// The ranges of its knobs that serde cannot check; `field` is where it sits in the
     /// config (`protocol.methods[2]`).
     fn validate(&self, _field: &str) -> Result<(), String> {

@@ -35,8 +35,10 @@
 //!   (100 by default: evaluating a fixed policy has no maximum to over-estimate, and with
 //!   Table I's 10,000 an estimate that wins rarely would bootstrap on its initial
 //!   over-estimate for the whole run);
-//! - the learner's update is DQN's own (`max_a' Q_target(s', a')` of the learner), not
-//!   SFQL's bootstrap on the GPI action at `s'`;
+//! - the learner's update is by default DQN's own (`max_a' Q_target(s', a')` of the
+//!   learner), the config's learner as every method's; `learner_bootstrap: Gpi` (label
+//!   `gpi-sfql`) bootstraps on the GPI action at `s'` as SFQL does, valued by the
+//!   learner's target network;
 //! - ties between Q-values go to the learner, then to the lowest source index.
 
 use serde::{Deserialize, Serialize};
@@ -61,6 +63,16 @@ pub enum Evaluation {
     Off,
 }
 
+/// What the learner's targets bootstrap on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LearnerBootstrap {
+    /// Its own maximum, `max_a' Q_L⁻(s′, a′)`: DQN's.
+    Own,
+    /// `Q_L⁻(s′, a*)` at GPI's action `a* = argmax_a max(Q_L(s′, a), max_i Q̂_i(s′, a))`:
+    /// SFQL's bootstrap on the GPI action.
+    Gpi,
+}
+
 /// GPI's knobs (`Gpi()` in `protocol.methods`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -72,6 +84,9 @@ pub struct GpiKnobs {
     pub evaluate: Evaluation,
     /// The estimates' target copy interval, in their own updates.
     pub evaluation_target_interval: u64,
+    /// `Own` (default): the learner's targets bootstrap on its own maximum, DQN's; `Gpi`:
+    /// on the action GPI picks at `s′` from the learner's and the sources' values, SFQL's.
+    pub learner_bootstrap: LearnerBootstrap,
     /// The label of results; default `gpi` (`gpi-all`, `gpi-unevaluated` for the other
     /// evaluations), or `gpi[64,64]` for another learner.
     pub label: Option<String>,
@@ -83,6 +98,7 @@ impl Default for GpiKnobs {
             hidden: vec![100],
             evaluate: Evaluation::Winner,
             evaluation_target_interval: 100,
+            learner_bootstrap: LearnerBootstrap::Own,
             label: None,
         }
     }
@@ -102,15 +118,23 @@ pub const KIND: MethodKind = MethodKind {
 impl ReuseMethod for GpiKnobs {
     fn label(&self) -> String {
         let label = learner_label("gpi", &self.hidden, self.label.as_deref());
-        match (self.evaluate, &self.label) {
+        let label = match (self.evaluate, &self.label) {
             (Evaluation::All, None) => format!("{label}-all"),
             (Evaluation::Off, None) => format!("{label}-unevaluated"),
+            _ => label,
+        };
+        match (self.learner_bootstrap, &self.label) {
+            (LearnerBootstrap::Gpi, None) => format!("{label}-sfql"),
             _ => label,
         }
     }
 
     fn source_evaluation(&self) -> Option<u64> {
         (self.evaluate != Evaluation::Off).then_some(self.evaluation_target_interval)
+    }
+
+    fn gpi_bootstrap(&self) -> bool {
+        self.learner_bootstrap == LearnerBootstrap::Gpi
     }
 
     fn kind(&self) -> MethodKind {
@@ -393,6 +417,14 @@ mod tests {
         assert_eq!(unevaluated.label(), "gpi-unevaluated");
         assert_eq!(unevaluated.source_evaluation(), None);
         assert_eq!(GpiKnobs::default().source_evaluation(), Some(100));
+        let sfql = GpiKnobs {
+            learner_bootstrap: LearnerBootstrap::Gpi,
+            ..GpiKnobs::default()
+        };
+        assert_eq!(
+            (sfql.label().as_str(), sfql.gpi_bootstrap()),
+            ("gpi-sfql", true)
+        );
         let err = GpiKnobs {
             hidden: vec![],
             ..GpiKnobs::default()

@@ -8,7 +8,9 @@ use rand::SeedableRng;
 
 use super::spec::{RunSpec, SourcePolicy};
 use super::CommandReceiver;
-use crate::dqn::{Architecture, AttentionLearner, DqnAgent, DqnError, QNet, ReplayBuffer};
+use crate::dqn::{
+    Architecture, AttentionLearner, DqnAgent, DqnError, QNet, ReplayBuffer, UpdateReport,
+};
 use crate::env::Environment;
 use crate::reuse::{Actor, Combined, Evaluate, Learning, Selector, StateValues};
 
@@ -22,6 +24,9 @@ pub(super) struct RunNetworks<'a> {
     /// method that evaluates its sources (GPI), and its target copy interval in updates.
     evaluators: Vec<DqnAgent>,
     evaluation_interval: u64,
+    /// Whether the learner's targets bootstrap on the action the combination of the
+    /// learner and the sources' values picks at `s′` (SFQL's), not on its own maximum.
+    gpi_bootstrap: bool,
     /// The Q-values a combining method chooses from, kept between steps.
     values: ValueBuffers,
     /// Steps whose action was not the method's own learner's greedy action at the state:
@@ -173,6 +178,7 @@ impl<'a> RunNetworks<'a> {
             attention,
             evaluators,
             evaluation_interval: evaluation_interval.unwrap_or(1),
+            gpi_bootstrap: spec.reuse.definition().gpi_bootstrap(),
             values: ValueBuffers::default(),
             non_greedy: 0,
         })
@@ -186,6 +192,31 @@ impl<'a> RunNetworks<'a> {
             evaluated: &self.evaluators,
             attention: self.attention.as_ref(),
         }
+    }
+
+    /// The round of `learner` (a source's copy, or the method's own for `None`) on the step
+    /// just stored in `replay`; the method's own bootstraps on the GPI action when the
+    /// method asks, the sources' values being their estimates on the target task (or, not
+    /// evaluated, their networks as recorded).
+    pub fn observe_learner(
+        &mut self,
+        learner: Option<usize>,
+        replay: &ReplayBuffer,
+        rng: &mut StdRng,
+    ) -> Result<Option<UpdateReport>, DqnError> {
+        let Some(i) = learner else {
+            let own = self.learner.as_mut().expect("the method has a learner");
+            if !self.gpi_bootstrap {
+                return own.observe(replay, rng);
+            }
+            let joined: Vec<&QNet> = if self.evaluators.is_empty() {
+                self.sources.iter().map(|s| &s.net).collect()
+            } else {
+                self.evaluators.iter().map(DqnAgent::online).collect()
+            };
+            return own.observe_joined(replay, rng, &joined);
+        };
+        self.agents[i].observe(replay, rng)
     }
 
     /// The round of the sources' value estimates on the step just stored in `replay`:

@@ -341,12 +341,11 @@ impl<'a> Run<'a> {
                 .agent_mut(None)
                 .set_distillation_weight(distillation.weight);
         }
-        let agent = self.networks.agent_mut(learner);
         let result = match round {
             LearnerRound::Online => {
                 let evaluate = self.selector.evaluate();
-                agent
-                    .observe(&self.replay, &mut self.rng)
+                self.networks
+                    .observe_learner(learner, &self.replay, &mut self.rng)
                     .and_then(|report| {
                         self.networks
                             .observe_attention(&self.replay, &mut self.rng)
@@ -363,6 +362,7 @@ impl<'a> Run<'a> {
                 updates,
                 target_interval,
             } => {
+                let agent = self.networks.agent_mut(learner);
                 let offline =
                     agent.offline_round(&self.replay, updates, target_interval, &mut self.rng);
                 // The online phase learns from a buffer of its own (CleanRL's).

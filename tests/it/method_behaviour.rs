@@ -441,3 +441,49 @@ fn a2ts_base_learns_during_a_run() {
     assert_eq!(updates, 2 * (600 - 9));
     assert_ne!(before, after, "the base learned");
 }
+
+/// SFQL's bootstrap: on the bandit's two-step variant, a learner that knows nothing
+/// bootstraps, with GPI's action, on the action a source values most at `s′`, valued by
+/// the learner's own target network; with DQN's, on its own maximum. Here the source
+/// prefers action 1 at `s′`, where the learner's target values (5, 2): GPI's target is
+/// γ·2 = 1, DQN's γ·5 = 2.5.
+#[test]
+fn gpis_sfql_bootstrap_takes_the_gpi_action_at_the_next_state() {
+    let source = net_with([0.0, 9.0]);
+    let train = |joined: &[&QNet]| {
+        let mut learner = DqnAgent::new(
+            net_with([5.0, 2.0]),
+            &DqnConfig {
+                learning_rate: 0.05,
+                gamma: 0.5,
+                target_update_interval: 1_000_000,
+                ..config()
+            },
+        )
+        .unwrap();
+        let mut replay = ReplayBuffer::new(10, 1);
+        replay.push(Transition {
+            obs: &STATE,
+            action: 0,
+            reward: 0.0,
+            next_obs: &STATE,
+            terminated: false,
+            truncated: false,
+        });
+        let mut rng = StdRng::seed_from_u64(1);
+        for _ in 0..600 {
+            learner.observe_joined(&replay, &mut rng, joined).unwrap();
+        }
+        learner.online().q_values(&STATE).unwrap()[0]
+    };
+    let gpi = train(&[&source]);
+    let dqn = train(&[]);
+    assert!(
+        (gpi - 1.0).abs() < 0.05,
+        "GPI's bootstrap: Q(s, 0) = {gpi}, expected ½·2"
+    );
+    assert!(
+        (dqn - 2.5).abs() < 0.05,
+        "DQN's: Q(s, 0) = {dqn}, expected ½·5"
+    );
+}
