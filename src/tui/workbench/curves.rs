@@ -119,7 +119,10 @@ impl Curves {
         let Some(label) = folder.config.protocol.methods.get(index).map(|m| m.label()) else {
             return Vec::new();
         };
-        let training: Vec<TrainingEpisodes> = runs.iter().map(|r| r.training.clone()).collect();
+        let training: Vec<TrainingEpisodes> = runs
+            .iter()
+            .map(|r| TrainingEpisodes::clone(&r.training))
+            .collect();
         let protocol = &folder.config.protocol;
         let points =
             sample_efficiency::curve(&label, &training, protocol.moving_average, protocol.budget);

@@ -61,11 +61,7 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
     let episodes_width = folder
         .runs
         .iter()
-        .map(|r| {
-            let mut full = r.clone();
-            full.training.lengths.clear();
-            full.progress_text().len().max(r.progress_text().len())
-        })
+        .map(|r| r.full_text().len().max(r.progress_text().len()))
         .max()
         .unwrap_or(8)
         .max(8);
