@@ -90,12 +90,18 @@ pub fn help_lines<C>(table: &[Binding<C>]) -> Vec<(&'static str, &'static str)> 
 }
 
 /// `?`: every key; the overlay closes on any key.
-pub static HELP_KEYS: [Key; 1] = [ch('?')];
 pub const HELP_BAR: (&str, &str) = ("?", "keys");
 pub const HELP_LINE: (&str, &str) = ("?", "every key (any key closes this; q still quits)");
 
-/// Quitting: `q`, Esc on a view (Esc closes an overlay or leaves a mode first), Ctrl-C.
-pub static QUIT_KEYS: [Key; 3] = [ch('q'), code(KeyCode::Esc), ctrl('c')];
+/// Quitting, on every screen: `q`, Esc on a view (Esc closes an overlay or leaves a mode
+/// first), Ctrl-C; as a screen's table lists them, each doing its `quit`.
+pub const fn quit_keys<C: Copy>(quit: C) -> [(Key, C); 3] {
+    [
+        (ch('q'), quit),
+        (code(KeyCode::Esc), quit),
+        (ctrl('c'), quit),
+    ]
+}
 pub const QUIT_BAR: (&str, &str) = ("q", "quit");
 pub const QUIT_KEYS_SAID: &str = "q, Esc, Ctrl-C";
 

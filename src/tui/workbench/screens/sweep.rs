@@ -7,11 +7,11 @@ use std::path::Path;
 use std::sync::mpsc;
 
 use anyhow::{Context, Result};
-use crossterm::event::{KeyCode, KeyEvent};
+use crossterm::event::KeyEvent;
 use ratatui::Frame;
 
 use crate::tui::event_loop::{self, Flow, Screen};
-use crate::tui::keys::{self, ch, code, ctrl, Binding, OnHelp};
+use crate::tui::keys::{self, ch, Binding, OnHelp};
 use crate::tui::theme::Theme;
 use crate::tui::view::{Outcome, View};
 use crate::tui::workbench::folder::REFRESH;
@@ -26,6 +26,8 @@ pub enum SweepScreenCommand {
     Quit,
 }
 
+const QUIT_KEYS: [(keys::Key, SweepScreenCommand); 3] = keys::quit_keys(SweepScreenCommand::Quit);
+
 /// The sweep screen's keys (one view: no tabs).
 pub const SWEEP_KEYS: &[Binding<SweepScreenCommand>] = &[
     Binding {
@@ -34,11 +36,7 @@ pub const SWEEP_KEYS: &[Binding<SweepScreenCommand>] = &[
         bar: Some(keys::HELP_BAR),
     },
     Binding {
-        keys: &[
-            (ch('q'), SweepScreenCommand::Quit),
-            (code(KeyCode::Esc), SweepScreenCommand::Quit),
-            (ctrl('c'), SweepScreenCommand::Quit),
-        ],
+        keys: &QUIT_KEYS,
         help: (
             keys::QUIT_KEYS_SAID,
             "quit (the folder is only read: nothing in it changes)",

@@ -15,7 +15,7 @@ use ratatui::Frame;
 
 use crate::report::Report;
 use crate::results::folder_state::{FolderState, RunStatus};
-use crate::tui::keys::{self, ch, code, ctrl, Binding, OnHelp};
+use crate::tui::keys::{self, ch, Binding, OnHelp};
 use crate::tui::theme::Theme;
 use crate::tui::view::{Outcome, View};
 use crate::tui::workbench::folder::Folder;
@@ -86,18 +86,14 @@ const HELP: Binding<ScreenCommand> = Binding {
 };
 
 /// `q`, Esc and Ctrl-C quit, from a view (Esc closes an overlay or leaves a mode first).
-const QUIT_KEYS: &[(keys::Key, ScreenCommand)] = &[
-    (ch('q'), S::Quit),
-    (code(KeyCode::Esc), S::Quit),
-    (ctrl('c'), S::Quit),
-];
+const QUIT_KEYS: [(keys::Key, ScreenCommand); 3] = keys::quit_keys(S::Quit);
 
 /// `sapnet open`'s keys: it only reads.
 pub const OPEN_KEYS: &[Binding<ScreenCommand>] = &[
     TABS,
     HELP,
     Binding {
-        keys: QUIT_KEYS,
+        keys: &QUIT_KEYS,
         help: (
             keys::QUIT_KEYS_SAID,
             "quit (the folder is only read: nothing in it changes)",
@@ -126,7 +122,7 @@ pub const SESSION_KEYS: &[Binding<ScreenCommand>] = &[
     },
     HELP,
     Binding {
-        keys: QUIT_KEYS,
+        keys: &QUIT_KEYS,
         help: (
             keys::QUIT_KEYS_SAID,
             "quit; asks first while a protocol trains",
