@@ -1,19 +1,30 @@
-//! What the Curves view keeps and what its keys do: the statistic over runs (IQM or
+//! The Curves view: what it keeps and what its keys do — the statistic over runs (IQM or
 //! mean), the methods shown, the picked one, the episodes in view, and the run shown
 //! alone when its method's runs are read one by one. Each method's curve is the one
 //! `sample_efficiency.csv` holds ([`sample_efficiency::curve`]: the same points, the same
-//! bootstrap seeds), made again only when that method's runs have grown.
+//! bootstrap seeds), made again only when that method's runs have grown. `chart.rs` draws
+//! it.
+
+mod chart;
 
 use std::cell::RefCell;
 use std::collections::BTreeSet;
 
-use crossterm::event::{KeyCode, KeyEvent};
+use crossterm::event::{KeyCode, MouseButton, MouseEvent, MouseEventKind};
+use ratatui::layout::Rect;
+use ratatui::Frame;
 
 use crate::config::Budget;
 use crate::report::sample_efficiency::{self, EfficiencyPoint};
 use crate::report::TrainingEpisodes;
 use crate::results::folder_state::{FolderState, RunProgress, RunStatus};
 use crate::stats::Estimate;
+use crate::tui::keys::{ch, code, Binding};
+use crate::tui::theme::Theme;
+use crate::tui::view::{Outcome, View};
+use crate::tui::workbench::folder::Folder;
+
+pub use chart::MARKERS;
 
 /// The fewest episodes the view zooms in to: a moving average's span or so.
 const NARROWEST: f64 = 20.0;
@@ -43,7 +54,7 @@ impl Statistic {
 
 /// The Curves view's choices.
 #[derive(Debug)]
-pub struct Curves {
+pub struct CurvesView {
     pub statistic: Statistic,
     /// Methods (by their place in the protocol) switched off.
     pub hidden: BTreeSet<usize>,
@@ -62,7 +73,7 @@ pub struct Curves {
 /// worths, whether each had ended): made again when that changes.
 type Cached = (Vec<(u64, bool)>, Vec<EfficiencyPoint>);
 
-impl Default for Curves {
+impl Default for CurvesView {
     fn default() -> Self {
         Self {
             statistic: Statistic::Iqm,
@@ -94,7 +105,7 @@ pub fn planned(folder: &FolderState) -> f64 {
     }
 }
 
-impl Curves {
+impl CurvesView {
     /// The curve of method `index` over its runs so far: on a finished folder, that
     /// method's rows of `sample_efficiency.csv`.
     pub fn curve(&self, folder: &FolderState, index: usize) -> Vec<EfficiencyPoint> {
@@ -136,62 +147,6 @@ impl Curves {
         self.zoom.map_or(all, |zoom| clamp(zoom, all))
     }
 
-    /// Acts on a key of the Curves view; `false` for a key it does not take (the
-    /// workbench's own: views, help, quit).
-    pub fn on_key(&mut self, key: KeyEvent, folder: &FolderState) -> bool {
-        let methods = folder.config.protocol.methods.len();
-        let all = (1.0, planned(folder));
-        let (from, to) = self.range(folder);
-        let width = to - from;
-        match key.code {
-            KeyCode::Up | KeyCode::Char('k') if self.run.is_none() => {
-                self.cursor = self.cursor.saturating_sub(1);
-            }
-            KeyCode::Down | KeyCode::Char('j') if self.run.is_none() => {
-                self.cursor = (self.cursor + 1).min(methods.saturating_sub(1));
-            }
-            KeyCode::Char(' ') => self.toggle(self.cursor),
-            KeyCode::Char('m') => {
-                self.statistic = match self.statistic {
-                    Statistic::Iqm => Statistic::Mean,
-                    Statistic::Mean => Statistic::Iqm,
-                };
-            }
-            KeyCode::Char('+' | '=') => {
-                let centre = (from + to) / 2.0;
-                let half = (width / 4.0).max(NARROWEST / 2.0);
-                self.zoom = Some(clamp((centre - half, centre + half), all));
-            }
-            KeyCode::Char('-') => {
-                let centre = (from + to) / 2.0;
-                self.zoom = Some(clamp((centre - width, centre + width), all));
-            }
-            KeyCode::Left | KeyCode::Char('h') => {
-                self.zoom = Some(clamp((from - width / 4.0, to - width / 4.0), all));
-            }
-            KeyCode::Right | KeyCode::Char('l') => {
-                self.zoom = Some(clamp((from + width / 4.0, to + width / 4.0), all));
-            }
-            KeyCode::Char('0') => self.zoom = None,
-            KeyCode::Enter => {
-                self.run = match self.run {
-                    Some(_) => None,
-                    None => Some(0),
-                };
-            }
-            KeyCode::Esc if self.run.is_some() => self.run = None,
-            KeyCode::Char(']') | KeyCode::Tab if self.run.is_some() => {
-                let runs = runs_of(folder, self.cursor).len();
-                self.run = self.run.map(|r| (r + 1).min(runs.saturating_sub(1)));
-            }
-            KeyCode::Char('[') | KeyCode::BackTab if self.run.is_some() => {
-                self.run = self.run.map(|r| r.saturating_sub(1));
-            }
-            _ => return false,
-        }
-        true
-    }
-
     /// Shows method `index` if hidden, hides it if shown.
     pub fn toggle(&mut self, index: usize) {
         if !self.hidden.remove(&index) {
@@ -209,24 +164,198 @@ fn clamp((from, to): (f64, f64), (first, last): (f64, f64)) -> (f64, f64) {
     (from, from + width)
 }
 
-/// Every key of the Curves view, for `?`.
-pub const KEYS: [(&str, &str); 6] = [
-    ("v", "Curves: MA10 over runs with its 95% band"),
-    ("↑ ↓, space", "Curves: pick a method; show or hide it"),
-    ("m", "Curves: IQM or mean over runs"),
-    ("+ -, ← →, 0", "Curves: zoom, move along the episodes, all"),
-    ("Enter, [ ]", "Curves: the picked method's runs one by one"),
-    ("click", "a view's name, a run, a method, a legend entry"),
+/// What the Curves view's keys do.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CurvesCommand {
+    /// The legend's cursor by one method.
+    Pick(isize),
+    Toggle,
+    Statistic,
+    ZoomIn,
+    ZoomOut,
+    /// Along the episodes by this many quarters of the view.
+    Pan(i8),
+    All,
+    /// The picked method's runs one by one, or back to every method.
+    Runs,
+    /// Back to every method from its runs.
+    Back,
+    /// The next or previous run of the picked method.
+    Run(isize),
+}
+
+use CurvesCommand as C;
+
+/// The Curves view's keys.
+const KEYS: &[Binding<CurvesCommand>] = &[
+    Binding {
+        keys: &[
+            (code(KeyCode::Up), C::Pick(-1)),
+            (ch('k'), C::Pick(-1)),
+            (code(KeyCode::Down), C::Pick(1)),
+            (ch('j'), C::Pick(1)),
+        ],
+        help: ("↑ ↓ j k", "pick a method (its runs one by one: Enter)"),
+        bar: Some(("↑↓", "method")),
+    },
+    Binding {
+        keys: &[(ch(' '), C::Toggle)],
+        help: ("space", "show or hide the picked method"),
+        bar: Some(("␣", "on/off")),
+    },
+    Binding {
+        keys: &[(ch('m'), C::Statistic)],
+        help: ("m", "IQM or mean over runs"),
+        bar: Some(("m", "IQM/mean")),
+    },
+    Binding {
+        keys: &[
+            (ch('+'), C::ZoomIn),
+            (ch('='), C::ZoomIn),
+            (ch('-'), C::ZoomOut),
+            (code(KeyCode::Left), C::Pan(-1)),
+            (ch('h'), C::Pan(-1)),
+            (code(KeyCode::Right), C::Pan(1)),
+            (ch('l'), C::Pan(1)),
+            (ch('0'), C::All),
+        ],
+        help: (
+            "+ -, ← → h l, 0",
+            "zoom in and out, move along the episodes, all of them",
+        ),
+        bar: Some(("+-←→", "zoom")),
+    },
+    Binding {
+        keys: &[(code(KeyCode::Enter), C::Runs)],
+        help: (
+            "Enter",
+            "the picked method's runs one by one, each over its band; again, every method",
+        ),
+        bar: Some(("⏎", "runs")),
+    },
+    Binding {
+        keys: &[
+            (ch(']'), C::Run(1)),
+            (code(KeyCode::Tab), C::Run(1)),
+            (ch('['), C::Run(-1)),
+            (code(KeyCode::BackTab), C::Run(-1)),
+        ],
+        help: ("] [, Tab Shift-Tab", "its runs: the next, the previous"),
+        bar: Some(("[ ]", "run")),
+    },
+    Binding {
+        keys: &[(code(KeyCode::Esc), C::Back)],
+        help: ("Esc", "from its runs, back to every method"),
+        bar: None,
+    },
 ];
 
-/// The Curves view's keys in the status bar.
-pub const COMMANDS: [(&str, &str); 5] = [
-    ("↑↓", "method"),
-    ("␣", "on/off"),
-    ("m", "IQM/mean"),
-    ("+-←→", "zoom"),
-    ("⏎", "runs"),
-];
+impl View for CurvesView {
+    type Model = Folder;
+    type Command = CurvesCommand;
+    type Intent = super::Intent;
+
+    fn keys(&self) -> &'static [Binding<CurvesCommand>] {
+        KEYS
+    }
+
+    fn apply(&mut self, folder: &Folder, command: CurvesCommand) -> Outcome<super::Intent> {
+        let folder = &folder.state;
+        let methods = folder.config.protocol.methods.len();
+        let all = (1.0, planned(folder));
+        let (from, to) = self.range(folder);
+        let width = to - from;
+        match command {
+            // Reading one method's runs, the method stays put; with every method shown,
+            // there is no run to move to or come back from (Esc is then the screen's).
+            C::Pick(_) if self.run.is_some() => return Outcome::Ignored,
+            C::Back | C::Run(_) if self.run.is_none() => return Outcome::Ignored,
+            C::Pick(by) => {
+                let last = methods.saturating_sub(1) as isize;
+                self.cursor = (self.cursor as isize + by).clamp(0, last) as usize;
+            }
+            C::Toggle => self.toggle(self.cursor),
+            C::Statistic => {
+                self.statistic = match self.statistic {
+                    Statistic::Iqm => Statistic::Mean,
+                    Statistic::Mean => Statistic::Iqm,
+                };
+            }
+            C::ZoomIn => {
+                let centre = (from + to) / 2.0;
+                let half = (width / 4.0).max(NARROWEST / 2.0);
+                self.zoom = Some(clamp((centre - half, centre + half), all));
+            }
+            C::ZoomOut => {
+                let centre = (from + to) / 2.0;
+                self.zoom = Some(clamp((centre - width, centre + width), all));
+            }
+            C::Pan(by) => {
+                let shift = width / 4.0 * f64::from(by);
+                self.zoom = Some(clamp((from + shift, to + shift), all));
+            }
+            C::All => self.zoom = None,
+            C::Runs => {
+                self.run = match self.run {
+                    Some(_) => None,
+                    None => Some(0),
+                };
+            }
+            C::Back => self.run = None,
+            C::Run(by) => {
+                let runs = runs_of(folder, self.cursor).len();
+                let last = runs.saturating_sub(1) as isize;
+                self.run = self.run.map(|r| (r as isize + by).clamp(0, last) as usize);
+            }
+        }
+        Outcome::Done
+    }
+
+    fn draw(&self, folder: &Folder, frame: &mut Frame, area: Rect, theme: Theme) {
+        chart::draw(frame, area, self, &folder.state, theme);
+    }
+
+    /// Reading one method's runs, the arrows pick nothing and `[ ]` move; else the
+    /// reverse.
+    fn offers(&self, _: &Folder, command: CurvesCommand) -> bool {
+        match command {
+            C::Pick(_) => self.run.is_none(),
+            C::Run(_) => self.run.is_some(),
+            _ => true,
+        }
+    }
+
+    fn words(&self, _: &Folder, command: CurvesCommand) -> Option<&'static str> {
+        (command == C::Runs && self.run.is_some()).then_some("methods")
+    }
+
+    fn legend(&self, _: &Folder) -> Vec<(&'static str, &'static str)> {
+        vec![(
+            "click",
+            "a method in the legend picks it and shows or hides it; a view's name below \
+             shows it",
+        )]
+    }
+
+    fn on_mouse(
+        &mut self,
+        folder: &Folder,
+        mouse: MouseEvent,
+        area: Rect,
+    ) -> Outcome<super::Intent> {
+        if mouse.kind != MouseEventKind::Down(MouseButton::Left) {
+            return Outcome::Ignored;
+        }
+        match chart::legend_method_at(area, self, &folder.state, mouse.column, mouse.row) {
+            Some(method) => {
+                self.cursor = method;
+                self.toggle(method);
+                Outcome::Done
+            }
+            None => Outcome::Ignored,
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests {
