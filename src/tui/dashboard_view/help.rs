@@ -23,7 +23,7 @@ const SYMBOLS: &[(&str, &str)] = &[
 pub fn legend(score: Option<ScoreColumn>) -> Vec<(&'static str, &'static str)> {
     let mut lines = SYMBOLS.to_vec();
     if let Some(score) = score.filter(|s| !s.meaning.is_empty()) {
-        lines.push((score.name, score.meaning));
+        lines.push(("score, P", score.meaning));
     }
     lines
 }
@@ -36,8 +36,7 @@ mod tests {
     fn the_followed_methods_column_is_said_by_its_selector() {
         let lines = legend(Some(crate::reuse::gpi::SCORE));
         assert_eq!(lines.len(), SYMBOLS.len() + 1);
-        assert_eq!(lines[SYMBOLS.len()].0, "wins");
-        assert!(lines[SYMBOLS.len()].1.contains("won the max"));
+        assert!(lines[SYMBOLS.len()].1.starts_with("wins: steps its Q won the max"));
         let dqn = crate::reuse::ScoreColumn::NONE;
         assert_eq!(legend(Some(dqn)).len(), SYMBOLS.len(), "no score, no line");
         assert_eq!(legend(None).len(), SYMBOLS.len());
