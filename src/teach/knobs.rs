@@ -41,7 +41,7 @@ impl Knob {
     ];
 
     /// The key that chooses it.
-    pub fn key(self) -> char {
+    pub const fn key(self) -> char {
         match self {
             Knob::Threshold => '1',
             Knob::Coefficient => '2',
@@ -49,10 +49,6 @@ impl Knob {
             Knob::Paths => '4',
             Knob::EdgeWeight => '5',
         }
-    }
-
-    pub fn from_key(key: char) -> Option<Self> {
-        Self::ALL.into_iter().find(|k| k.key() == key)
     }
 
     /// Its symbol on screen.

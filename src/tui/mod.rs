@@ -26,7 +26,8 @@
 //! - [`graph_layout`]: the graph's geometry, which the state (moving the cursor) and the
 //!   views share. The state modules import no view.
 //!
-//! - [`teach_screen`]: stand-alone teach mode ([`run_teach`]), a screen of the same loop.
+//! - [`teach_screen`]: stand-alone teach mode ([`run_teach`]), a screen of the same loop;
+//!   [`teach_keys`]: teach mode's one key table, alone or on the dashboard.
 
 pub mod dashboard;
 pub mod dashboard_view;
@@ -38,6 +39,7 @@ pub mod keys;
 pub mod reference;
 pub mod row_window;
 pub mod screen;
+pub mod teach_keys;
 pub mod teach_screen;
 pub mod teach_view;
 pub mod theme;
@@ -123,6 +125,7 @@ mod tests {
             ("reference.rs", include_str!("reference.rs")),
             ("row_window.rs", include_str!("row_window.rs")),
             ("graph_layout.rs", include_str!("graph_layout.rs")),
+            ("teach_keys.rs", include_str!("teach_keys.rs")),
         ];
         for (file, text) in state {
             for view in ["dashboard_view", "teach_view", "graph_view", "screen"] {

@@ -4,14 +4,13 @@
 
 use crossterm::event::{KeyCode, KeyEvent};
 
-use crate::teach::knobs::Knob;
-use crate::teach::session::PromptKind;
 use crate::teach::Teach;
 use crate::trainer::Command;
 
 use super::{Dashboard, Focus, Mode, SPEEDS};
 use crate::tui::graph_layout;
 use crate::tui::keys::{self, ch, code, Binding};
+use crate::tui::teach_keys::apply_teach_key;
 
 /// What the UI loop must do after a key.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -298,56 +297,4 @@ impl Dashboard {
         }
         Some(Action::None)
     }
-}
-
-/// Applies a teach-mode key (arrows, `a`, `s`, `r`, `R`, `<`, `>`, `v`, `u`, `c`, `p`, the edits `1`…`5`, `+`,
-/// `−`, `e`, the graph's `E`, `x`, `n`, `D`, `C`, `M`, `w`, `X`); `false` if it is not one.
-pub fn apply_teach_key(teach: &mut Teach, key: KeyEvent) -> bool {
-    // A line being typed takes every key until Enter or Esc.
-    if teach.prompt().is_some() {
-        match key.code {
-            KeyCode::Enter => teach.prompt_submit(),
-            KeyCode::Esc => teach.prompt_cancel(),
-            KeyCode::Backspace => teach.prompt_backspace(),
-            KeyCode::Char(c) => teach.prompt_type(c),
-            _ => {}
-        }
-        return true;
-    }
-    match key.code {
-        KeyCode::Char('w') => teach.open_prompt(PromptKind::Save),
-        KeyCode::Char('E') => teach.open_prompt(PromptKind::AddEdge),
-        KeyCode::Char('x') => teach.cut_selected_edge(),
-        KeyCode::Char('n') => teach.add_policy(),
-        KeyCode::Char('D') => teach.remove_policy(),
-        KeyCode::Char('C') => teach.change_category(),
-        KeyCode::Char('M') => teach.toggle_linking(),
-        KeyCode::Char(c) if Knob::from_key(c).is_some() => {
-            teach.choose_knob(Knob::from_key(c).expect("checked"));
-        }
-        KeyCode::Char('+') | KeyCode::Char('=') => teach.edit(true),
-        KeyCode::Char('-') => teach.edit(false),
-        KeyCode::Char('e') => teach.next_edge(),
-        KeyCode::Up | KeyCode::Char('k') | KeyCode::Left | KeyCode::Char('h') => {
-            teach.move_cursor(-1)
-        }
-        KeyCode::Down | KeyCode::Char('j') | KeyCode::Right | KeyCode::Char('l') => {
-            teach.move_cursor(1)
-        }
-        KeyCode::Char('a') => teach.activate(),
-        KeyCode::Char('s') => teach.step_or_ask(),
-        KeyCode::Char('X') => teach.toggle_exercise(),
-        KeyCode::Char('r') => teach.animate(),
-        KeyCode::Char('R') => teach.run(),
-        KeyCode::Char('<') | KeyCode::Char(',') => teach.change_speed(false),
-        KeyCode::Char('>') | KeyCode::Char('.') => teach.change_speed(true),
-        KeyCode::Char('v') => teach.next_panel(),
-        KeyCode::Char('u') => teach.undo(),
-        KeyCode::Char('c') => teach.reset(),
-        KeyCode::Char('p') => {
-            teach.toggle_numbering();
-        }
-        _ => return false,
-    }
-    true
 }

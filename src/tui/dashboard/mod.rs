@@ -13,7 +13,8 @@ mod run_views;
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
-pub use keys::{apply_teach_key, Action, Clicked, DashboardCommand, KEYS};
+pub use crate::tui::teach_keys::apply_teach_key;
+pub use keys::{Action, Clicked, DashboardCommand, KEYS};
 pub use live_curve::{LiveCurve, CURVE_POINTS};
 pub use run_views::{LibraryView, PolicyRow, RunView, HISTORY};
 

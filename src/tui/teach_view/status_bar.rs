@@ -8,11 +8,8 @@ use ratatui::widgets::Paragraph;
 use ratatui::Frame;
 
 use crate::teach::Teach;
+use crate::tui::teach_keys;
 use crate::tui::theme::Theme;
-
-const TEACH_HINTS: &str =
-    "↑↓ a s · r walk R run · u c · 1–5 ± · E x M edges · n D C policy · v view · w save · X exercise · ? q";
-const TEACH_HINTS_SHORT: &str = "a s r R u c · 1–5 ± · E x M n D C · v w X · ? q";
 
 /// Draws the status line of `teach` in `area`, a row as wide as the screen.
 pub(super) fn draw(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
@@ -64,10 +61,11 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, teach: &Teach, theme: Theme) {
     // The keys' words where they fit beside the modes said, else the keys alone.
     let used: usize = spans.iter().map(|s| s.content.chars().count()).sum();
     let room = usize::from(area.width).saturating_sub(used);
-    let hints = if wide && TEACH_HINTS.chars().count() <= room {
-        TEACH_HINTS
+    let with_words = format!("{} · ? q", teach_keys::bar(true));
+    let hints = if wide && with_words.chars().count() <= room {
+        with_words
     } else {
-        TEACH_HINTS_SHORT
+        format!("{} · ? q", teach_keys::bar(false))
     };
     spans.push(Span::styled(hints, theme.dim()));
     let line = Line::from(spans);
