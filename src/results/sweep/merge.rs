@@ -45,18 +45,7 @@ pub struct MergeReport {
 /// Merges the finished cells of `sweep` into `sweep/merged/`.
 pub fn merge(sweep: &Path) -> Result<MergeReport> {
     let manifest = Manifest::read(sweep)?;
-    let mut done = Vec::new();
-    let mut missing = Vec::new();
-    for cell in &manifest.cells {
-        let dir = cell_results(sweep, cell.id);
-        if super::status::state(sweep, cell.id) == super::status::CellState::Done {
-            let results = results::read_results(&dir)
-                .with_context(|| format!("reading cell {}", cell_name(cell.id)))?;
-            done.push((cell, results));
-        } else {
-            missing.push(cell.id);
-        }
-    }
+    let (done, missing) = finished_cells(sweep, &manifest)?;
     anyhow::ensure!(
         !done.is_empty(),
         "no cell of {} has finished: nothing to merge (`sapnet sweep status {}` says where \
@@ -78,36 +67,7 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
         .first()
         .map(|c| c.axes.iter().map(|(p, _)| p.clone()).collect())
         .unwrap_or_default();
-
-    // Every episode, long format.
-    let episodes = out.join("episodes.csv");
-    let mut writer = csv::Writer::from_writer(
-        crate::safe_io::create(&episodes)
-            .with_context(|| format!("creating {}", episodes.display()))?,
-    );
-    let mut header_written = false;
-    for (cell, _) in &done {
-        let path = cell_results(sweep, cell.id).join("episodes.csv");
-        let mut reader = crate::safe_io::csv_reader(&path)
-            .with_context(|| format!("reading {}", path.display()))?;
-        if !header_written {
-            let mut header = vec!["cell".to_string()];
-            header.extend(axes.iter().cloned());
-            header.extend(reader.headers()?.iter().map(String::from));
-            writer.write_record(&header)?;
-            header_written = true;
-        }
-        for row in reader.records() {
-            let row = row.with_context(|| format!("reading {}", path.display()))?;
-            let mut record = vec![cell.id.to_string()];
-            record.extend(cell.axes.iter().map(|(_, v)| v.clone()));
-            record.extend(row.iter().map(String::from));
-            writer.write_record(&record)?;
-        }
-    }
-    writer
-        .flush()
-        .with_context(|| format!("writing {}", episodes.display()))?;
+    write_episodes(sweep, &out, &axes, &done)?;
 
     // The comparison per axis value (pooled over its tasks when its cells have several),
     // and over every cell when the sweep spans several tasks.
@@ -118,8 +78,7 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
     let mut plotted: Vec<SweepAxis> = Vec::new();
     let mut task_titles: Vec<String> = Vec::new();
     let done_refs: Vec<(&super::CellEntry, &Results)> = done.iter().map(|(c, r)| (*c, r)).collect();
-    let groups = groups(&axes, &done_refs);
-    for (axis, value, group) in &groups {
+    for (axis, value, group) in &groups(&axes, &done_refs) {
         let (report, strata) = value_report(axis, value, group);
         for title in &report.task_titles {
             if !task_titles.contains(title) {
@@ -127,48 +86,14 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
             }
         }
         if axis != ACROSS_TASKS {
-            let at = match plotted.iter().position(|p| &p.axis == axis) {
-                Some(at) => at,
-                None => {
-                    plotted.push(SweepAxis {
-                        axis: axis.clone(),
-                        values: Vec::new(),
-                        comparisons: Vec::new(),
-                    });
-                    plotted.len() - 1
-                }
-            };
-            plotted[at].values.push(value.clone());
-            plotted[at]
-                .comparisons
-                .push((report.comparison.clone(), report.units));
+            plot_value(&mut plotted, axis, value, &report);
         }
         let lead = [axis.clone(), value.clone(), group.len().to_string()];
         let (header, records) = comparison::csv_records(&report.comparison, report.units);
         comparisons.extend(&["axis", "value", "cells"], &lead, &header, records);
         let (header, records) = improvement::records(&report.improvement, &report.tasks);
         improvements.extend(&["axis", "value"], &lead[..2], &header, records);
-        let dir = if axis == ACROSS_TASKS {
-            out.join(ACROSS_TASKS_FOLDER)
-        } else {
-            out.join(folder_name(axis, value))
-        };
-        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-        report
-            .write(&dir)
-            .with_context(|| format!("writing the report in {}", dir.display()))?;
-        for (task, pooled) in &strata {
-            // One task's curves in the value's folder; several tasks' each in its own.
-            let curves = if strata.len() == 1 {
-                dir.clone()
-            } else {
-                dir.join(folder_name("task", task))
-            };
-            std::fs::create_dir_all(&curves)
-                .with_context(|| format!("creating {}", curves.display()))?;
-            report::write_plots(&curves, &plot_data(pooled, report.subject.clone()))
-                .with_context(|| format!("drawing the plots in {}", curves.display()))?;
-        }
+        write_value(&out, axis, value, &report, &strata)?;
         let mut title = format!("{axis} = {value}");
         if !report.left_out.is_empty() {
             title.push_str(&format!(
@@ -194,6 +119,115 @@ pub fn merge(sweep: &Path) -> Result<MergeReport> {
         missing,
         tables,
     })
+}
+
+/// The cells that finished, with their results, and the ids of the others.
+type FinishedCells<'a> = (Vec<(&'a super::CellEntry, Results)>, Vec<usize>);
+
+fn finished_cells<'a>(sweep: &Path, manifest: &'a Manifest) -> Result<FinishedCells<'a>> {
+    let mut done = Vec::new();
+    let mut missing = Vec::new();
+    for cell in &manifest.cells {
+        let dir = cell_results(sweep, cell.id);
+        if super::status::state(sweep, cell.id) == super::status::CellState::Done {
+            let results = results::read_results(&dir)
+                .with_context(|| format!("reading cell {}", cell_name(cell.id)))?;
+            done.push((cell, results));
+        } else {
+            missing.push(cell.id);
+        }
+    }
+    Ok((done, missing))
+}
+
+/// Every episode of the finished cells in one long `episodes.csv`: each row led by its
+/// cell and the cell's axis values.
+fn write_episodes(
+    sweep: &Path,
+    out: &Path,
+    axes: &[String],
+    done: &[(&super::CellEntry, Results)],
+) -> Result<()> {
+    let episodes = out.join("episodes.csv");
+    let mut writer = csv::Writer::from_writer(
+        crate::safe_io::create(&episodes)
+            .with_context(|| format!("creating {}", episodes.display()))?,
+    );
+    let mut header_written = false;
+    for (cell, _) in done {
+        let path = cell_results(sweep, cell.id).join("episodes.csv");
+        let mut reader = crate::safe_io::csv_reader(&path)
+            .with_context(|| format!("reading {}", path.display()))?;
+        if !header_written {
+            let mut header = vec!["cell".to_string()];
+            header.extend(axes.iter().cloned());
+            header.extend(reader.headers()?.iter().map(String::from));
+            writer.write_record(&header)?;
+            header_written = true;
+        }
+        for row in reader.records() {
+            let row = row.with_context(|| format!("reading {}", path.display()))?;
+            let mut record = vec![cell.id.to_string()];
+            record.extend(cell.axes.iter().map(|(_, v)| v.clone()));
+            record.extend(row.iter().map(String::from));
+            writer.write_record(&record)?;
+        }
+    }
+    writer
+        .flush()
+        .with_context(|| format!("writing {}", episodes.display()))?;
+    Ok(())
+}
+
+/// Adds a value's comparison to its axis's, for `sweep.png`.
+fn plot_value(plotted: &mut Vec<SweepAxis>, axis: &str, value: &str, report: &Report) {
+    let at = match plotted.iter().position(|p| p.axis == axis) {
+        Some(at) => at,
+        None => {
+            plotted.push(SweepAxis {
+                axis: axis.to_string(),
+                values: Vec::new(),
+                comparisons: Vec::new(),
+            });
+            plotted.len() - 1
+        }
+    };
+    plotted[at].values.push(value.to_string());
+    plotted[at]
+        .comparisons
+        .push((report.comparison.clone(), report.units));
+}
+
+/// A value's folder: its report, and its curves (one task's in the folder, several tasks'
+/// each in its own).
+fn write_value(
+    out: &Path,
+    axis: &str,
+    value: &str,
+    report: &Report,
+    strata: &[(String, Results)],
+) -> Result<()> {
+    let dir = if axis == ACROSS_TASKS {
+        out.join(ACROSS_TASKS_FOLDER)
+    } else {
+        out.join(folder_name(axis, value))
+    };
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    report
+        .write(&dir)
+        .with_context(|| format!("writing the report in {}", dir.display()))?;
+    for (task, pooled) in strata {
+        let curves = if strata.len() == 1 {
+            dir.clone()
+        } else {
+            dir.join(folder_name("task", task))
+        };
+        std::fs::create_dir_all(&curves)
+            .with_context(|| format!("creating {}", curves.display()))?;
+        report::write_plots(&curves, &plot_data(pooled, report.subject.clone()))
+            .with_context(|| format!("drawing the plots in {}", curves.display()))?;
+    }
+    Ok(())
 }
 
 /// The finished cells grouped as the merge reports them: per axis, each value's cells (in
