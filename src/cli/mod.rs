@@ -445,7 +445,8 @@ pub enum Command {
     Plot(PlotArgs),
     /// Open a results folder in the terminal UI, read only: finished, stopped, or live and
     /// being written by another process (`sapnet --headless --out DIR` running). Views:
-    /// Runs (r) and Comparison (c); `?` lists the keys. Nothing in the folder changes.
+    /// Runs (r), Comparison (c) and Curves (v), Enter a finished run's dashboard; a sweep
+    /// folder opens in the Sweep view. `?` lists the keys. Nothing in the folder changes.
     Open(OpenArgs),
     /// One comparison of finished protocols on different tasks (e.g. the variants of
     /// CartPole and of MountainCar): each method's scores normalised by each task's range
