@@ -54,7 +54,7 @@ fn protocol(runs: u32) -> Protocol {
             summaries.push(RunSummary::new(record, &returns, 10));
             rewards.insert(
                 (method.clone(), run),
-                TrainingEpisodes::uniform(&returns, 20),
+                std::sync::Arc::new(TrainingEpisodes::uniform(&returns, 20)),
             );
         }
     }

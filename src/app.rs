@@ -57,10 +57,10 @@ pub fn run(cli: Cli) -> Result<()> {
             // SIGINT, SIGTERM or SIGHUP leave as `q` does, the terminal restored.
             let _stop = crate::signals::stop_on_signals()?;
             // A sweep folder opens in the Sweep view, any other in the workbench's views.
-            if tui::workbench::sweep::is_sweep(&args.dir) {
-                tui::workbench::sweep_screen::run(&args.dir)
+            if tui::workbench::sweep_folder::is_sweep(&args.dir) {
+                tui::workbench::screens::sweep::run(&args.dir)
             } else {
-                tui::workbench::run(&args.dir)
+                tui::workbench::screens::opened::run(&args.dir)
             }
         }
         Some(Command::Plot(args)) => {
@@ -455,19 +455,19 @@ fn run_in_ui(cli: &Cli, config: Config) -> Result<()> {
         }
         Ok(config)
     };
-    let settings = tui::workbench::live::Settings {
+    let settings = tui::workbench::screens::session::live::Settings {
         options: run_options(cli),
         python: cli.run.python_settings(),
         load: &load,
         reference,
     };
-    let start = tui::workbench::live::Start {
+    let start = tui::workbench::screens::session::live::Start {
         config,
         output,
         opened,
         followed,
     };
-    match tui::workbench::live::run(start, &settings)? {
+    match tui::workbench::screens::session::live::run(start, &settings)? {
         Some((Ok(summary), dir)) => headless::print_summary(&summary, &dir),
         Some((Err(error), _)) => Err(error),
         None => Ok(()),

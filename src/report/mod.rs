@@ -302,7 +302,7 @@ fn run_scores<'a>(task: &TaskRuns<'a>, label: &str) -> Vec<(&'a RunSummary, RunS
             let episodes = task
                 .episodes
                 .get(&(r.record.method.clone(), r.record.run))
-                .unwrap_or(&none);
+                .map_or(&none, |e| e.as_ref());
             let scores = RunScores::of(
                 r,
                 task.task,

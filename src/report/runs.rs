@@ -2,6 +2,7 @@
 //! returns, and the library it drew on.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
@@ -51,8 +52,9 @@ impl TrainingEpisodes {
     }
 }
 
-/// Every run's training episodes, by method and run.
-pub type TrainingRuns = BTreeMap<(MethodId, u32), TrainingEpisodes>;
+/// Every run's training episodes, by method and run: shared, since a folder's returns are
+/// its largest data and a reader keeps them beside its views of the runs.
+pub type TrainingRuns = BTreeMap<(MethodId, u32), Arc<TrainingEpisodes>>;
 
 /// A source policy as `summary.json` lists it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

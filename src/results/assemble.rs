@@ -9,6 +9,7 @@ use std::fs::OpenOptions;
 use std::io::{BufRead, BufReader, Write};
 use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use serde::Deserialize;
@@ -147,7 +148,7 @@ pub fn training_episodes(folders: &[RunFolder]) -> Result<TrainingRuns> {
         }
         let record = &folder.summary.record;
         plot_data::some_returns(&path, record, episodes.len())?;
-        runs.insert((record.method.clone(), record.run), episodes);
+        runs.insert((record.method.clone(), record.run), Arc::new(episodes));
     }
     Ok(runs)
 }

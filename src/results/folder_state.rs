@@ -12,6 +12,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use serde::Deserialize;
@@ -62,8 +63,9 @@ pub struct RunProgress {
     pub method: MethodId,
     pub run: u32,
     pub status: RunStatus,
-    /// Training episodes so far, episode 1 first.
-    pub training: TrainingEpisodes,
+    /// Training episodes so far, episode 1 first (a finished run's shared with the
+    /// report's).
+    pub training: Arc<TrainingEpisodes>,
     /// The episodes or steps the protocol gives each run.
     pub planned: Budget,
     /// The source it handed over (a finished run's chosen one), else the one that acted
@@ -91,6 +93,14 @@ impl RunProgress {
         match self.planned {
             Budget::Episodes(n) => format!("{}/{n}", self.episodes()),
             Budget::Steps(n) => format!("{}/{}", short_count(self.done()), short_count(n)),
+        }
+    }
+
+    /// Its progress text at its budget's end: the widest it will be.
+    pub fn full_text(&self) -> String {
+        match self.planned {
+            Budget::Episodes(n) => format!("{n}/{n}"),
+            Budget::Steps(n) => format!("{0}/{0}", short_count(n)),
         }
     }
 
@@ -179,7 +189,7 @@ impl FolderState {
 /// returns once: a record in `runs/` never changes while its folder is there.
 pub struct FolderReader {
     dir: PathBuf,
-    finished_returns: BTreeMap<(String, u32), TrainingEpisodes>,
+    finished_returns: BTreeMap<(String, u32), Arc<TrainingEpisodes>>,
 }
 
 impl FolderReader {
@@ -237,7 +247,7 @@ impl FolderReader {
                             status,
                             source: partial.most_acting(),
                             wall_s: partial.wall_s,
-                            training: partial.training,
+                            training: Arc::new(partial.training),
                             planned: config.protocol.budget,
                         }
                     }
@@ -258,7 +268,7 @@ impl FolderReader {
         })
     }
 
-    fn finished_returns(&mut self, folder: &RunFolder) -> Result<TrainingEpisodes> {
+    fn finished_returns(&mut self, folder: &RunFolder) -> Result<Arc<TrainingEpisodes>> {
         let record = &folder.summary.record;
         let key = (record.method.label().to_string(), record.run);
         if let Some(returns) = self.finished_returns.get(&key) {
@@ -302,7 +312,7 @@ fn shipped(dir: &Path, header: super::SummaryHeader) -> Result<FolderState> {
                     method: method.clone(),
                     run,
                     status: RunStatus::NotRun,
-                    training: TrainingEpisodes::default(),
+                    training: Arc::default(),
                     planned: config.protocol.budget,
                     source: None,
                     wall_s: None,
@@ -335,7 +345,7 @@ pub fn short_count(n: u64) -> String {
 
 fn finished_run(
     summary: &RunSummary,
-    training: TrainingEpisodes,
+    training: Arc<TrainingEpisodes>,
     names: &[&str],
     planned: Budget,
 ) -> RunProgress {
@@ -520,7 +530,7 @@ mod tests {
             method: MethodId::new(0, &crate::reuse::Method::the_papers()),
             run: 0,
             status: RunStatus::Running,
-            training: episodes.training,
+            training: Arc::new(episodes.training),
             planned: Budget::Episodes(10),
             source: None,
             wall_s: episodes.wall_s,

@@ -7,13 +7,14 @@
 //! were. `sapnet open` reads the same runs ([`runs`]) and writes nothing.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 
 use super::plot_data;
 use super::summary::{self, Status, Summary, SummaryHeader, MAX_SUMMARY_BYTES};
-use crate::report::{plots, Report, RunSummary, TaskRuns, TrainingEpisodes, TrainingRuns};
+use crate::report::{plots, Report, RunSummary, TaskRuns, TrainingRuns};
 use crate::safe_io::{self, Links};
 use crate::trainer::MethodId;
 
@@ -77,7 +78,7 @@ pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
     let episodes = episodes(&dir.join("episodes.csv"), &methods)?;
     for run in &runs {
         let key = (run.record.method.clone(), run.record.run);
-        let count = episodes.get(&key).map_or(0, TrainingEpisodes::len);
+        let count = episodes.get(&key).map_or(0, |e| e.len());
         plot_data::some_returns(&dir.join("episodes.csv"), &run.record, count)?;
     }
     Ok(ShippedRuns { runs, episodes })
@@ -130,7 +131,7 @@ fn episodes(path: &Path, methods: &[MethodId]) -> Result<TrainingRuns> {
                     path.display()
                 );
             };
-            Ok(((method.clone(), run), episodes))
+            Ok(((method.clone(), run), Arc::new(episodes)))
         })
         .collect()
 }

@@ -115,9 +115,9 @@ impl CommandReceiver {
         Arc::clone(&self.stop)
     }
 
-    /// The commands sent and not yet read (a front end's tests).
-    #[cfg(test)]
-    pub(crate) fn pending(&self) -> Vec<Command> {
+    /// The commands sent and not yet read: what a front end's tests read (the key tables'
+    /// walk sends the Run view's keys to runs of its own).
+    pub fn pending(&self) -> Vec<Command> {
         self.receiver.try_iter().collect()
     }
 }

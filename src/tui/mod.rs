@@ -1,13 +1,17 @@
 //! The terminal UI: a protocol run in the workbench (its views, and the live dashboard of
-//! the run it follows, over the trainer's event stream), and teach mode.
+//! the run it follows, over the trainer's event stream), a results or sweep folder opened
+//! in it, and teach mode.
 //!
 //! The UI thread only reads keys, drains events and draws; training runs on the trainer's
 //! threads and never waits for the screen. Each frame drains the whole channel (never
 //! parking on it, so a send never has to wake this thread) and draws at most
 //! [`FRAME`]ly.
 //!
-//! - [`dashboard`]: what the UI keeps of the stream, and what keys do (teach mode's keys
-//!   too: its state, [`Teach`], lives in [`crate::teach`], which draws nothing).
+//! - [`event_loop`]: the one loop every workbench screen runs in; [`view`]: the shape of a
+//!   view (draw, keys, commands, intents); [`keys`]: a view's one key table, which its
+//!   matcher, its status bar and its `?` are all made from.
+//! - [`dashboard`]: what the UI keeps of a run's stream and what its keys do (teach mode's
+//!   keys too: its state, [`Teach`], lives in [`crate::teach`], which draws nothing).
 //! - [`reference`]: a finished protocol's bands beside the live run (`--compare`).
 //! - [`row_window`]: which rows a table too long for its panel shows.
 //! - [`dashboard_view`], [`teach_view`]: drawing each screen, a file per panel, as pure
@@ -17,20 +21,28 @@
 //!   the dashboard's view draws teach mode on the live graph with `teach_view`, never the
 //!   reverse.
 //! - [`workbench`]: `sapnet` (a protocol trained and watched in views, one run followed
-//!   in the dashboard) and `sapnet open DIR` (a results folder, live or not, in views).
+//!   in the Run view), `sapnet open DIR` (a results folder, live or not) and `sapnet open
+//!   SWEEP` (a sweep's cells), as views on screens.
 //! - [`graph_layout`]: the graph's geometry, which the state (moving the cursor) and the
 //!   views share. The state modules import no view.
+//!
+//! Stand-alone teach mode ([`run_teach`]) still has a loop of its own: teach's state and
+//! view are being restructured elsewhere, and join [`event_loop`] as a [`event_loop::Screen`]
+//! once they are.
 
 pub mod dashboard;
 pub mod dashboard_view;
+pub mod event_loop;
 pub mod follow;
 pub mod graph_layout;
 pub mod graph_view;
+pub mod keys;
 pub mod reference;
 pub mod row_window;
 pub mod screen;
 pub mod teach_view;
 pub mod theme;
+pub mod view;
 pub mod workbench;
 
 use std::time::Duration;

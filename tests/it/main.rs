@@ -24,6 +24,7 @@ mod headless_cli;
 mod hostile_folders;
 mod import_cli;
 mod judgment_signals;
+mod key_tables;
 mod layers;
 mod method_behaviour;
 mod other_agents;

@@ -14,10 +14,11 @@ use sapnet::experiment::{self, OpenedOutput, OutputOptions, RunOptions, Tap, Wat
 use sapnet::results::folder_state::FolderReader;
 use sapnet::trainer::{Event, MethodId};
 use sapnet::tui::dashboard::Dashboard;
+use sapnet::tui::event_loop::Flow;
 use sapnet::tui::theme::Theme;
-use sapnet::tui::workbench::opened::{self, Opened};
 use sapnet::tui::workbench::recorded;
-use sapnet::tui::workbench::state::Workbench;
+use sapnet::tui::workbench::screens::opened::Opened;
+use sapnet::tui::workbench::screens::workbench::Tab;
 
 /// The embedded CartPole config on the shipped library, cut to 60 episodes of one run of
 /// SAP-Net, UCB1, GPI and a DQN: a protocol of seconds with a library, past SAP-Net's
@@ -134,9 +135,7 @@ fn key(code: KeyCode) -> KeyEvent {
 
 fn drawn(opened: &Opened) -> String {
     let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
-    terminal
-        .draw(|f| opened::draw(f, opened, Theme::plain()))
-        .unwrap();
+    terminal.draw(|f| opened.draw(f, Theme::plain())).unwrap();
     let buffer = terminal.backend().buffer();
     (0..buffer.area.height)
         .map(|y| {
@@ -159,13 +158,10 @@ fn enter_in_the_runs_view_shows_a_finished_runs_dashboard() {
     trained_live(&config, &out);
     let open = |dir: &Path| {
         let folder = FolderReader::new(dir).read().unwrap();
-        Opened::new(Workbench::new(folder, None))
+        Opened::new(folder, None)
     };
     let mut opened = open(&out);
-    assert_eq!(
-        opened.on_key(key(KeyCode::Enter)),
-        sapnet::tui::workbench::state::Action::None
-    );
+    assert_eq!(opened.on_key(key(KeyCode::Enter)), Flow::Continue);
     let screen = drawn(&opened);
     assert!(screen.contains("▶ sapnet run 0"), "{screen}");
     assert!(
@@ -174,7 +170,7 @@ fn enter_in_the_runs_view_shows_a_finished_runs_dashboard() {
     );
     assert!(screen.contains("ep 60/60"), "{screen}");
     opened.on_key(key(KeyCode::Char('r')));
-    assert!(opened.run.is_none());
+    assert_eq!(opened.workbench.tab, Tab::Runs);
     assert!(drawn(&opened).contains("Runs"));
     // A damaged file: said, naming it, and the views stay.
     let activations = out.join("runs/sapnet-run0/activations.csv");
@@ -184,8 +180,8 @@ fn enter_in_the_runs_view_shows_a_finished_runs_dashboard() {
     )
     .unwrap();
     opened.on_key(key(KeyCode::Enter));
-    assert!(opened.run.is_none());
-    let notice = opened.notice.clone().unwrap_or_default();
+    assert_eq!(opened.workbench.tab, Tab::Runs);
+    let notice = opened.workbench.notice.clone().unwrap_or_default();
     assert!(notice.contains("activations.csv"), "{notice}");
     assert!(drawn(&opened).contains("activations.csv"));
 
@@ -224,9 +220,9 @@ fn enter_in_the_runs_view_shows_a_finished_runs_dashboard() {
         "{screen}"
     );
     // What the record keeps is shown: the steps each source acted.
-    let record = &opened.workbench.folder.runs[0];
+    let record = &opened.folder().state.runs[0];
     assert_eq!(record.method.label(), "sapnet");
-    let (_, dashboard) = opened.run.as_ref().unwrap();
+    let dashboard = &opened.workbench.run.followed_run().unwrap().dashboard;
     let library = dashboard.library.as_ref().unwrap();
     let live = trained_steps(&out);
     assert_eq!(library.selections, live);

@@ -11,7 +11,9 @@ use sapnet::teach::Teach;
 use sapnet::trainer::Event;
 use sapnet::tui::dashboard::Dashboard;
 use sapnet::tui::theme::Theme;
+use sapnet::tui::workbench::screens::session::{overlays, Phase, Session};
 use sapnet::tui::{dashboard_view as view, teach_view};
+use std::path::Path;
 
 const SIZES: [(u16, u16); 2] = [(120, 40), (80, 24)];
 
@@ -221,14 +223,34 @@ fn status_line(terminal: &Terminal<TestBackend>) -> String {
         .collect()
 }
 
+/// `dashboard` in the Run view of a protocol training, as `sapnet` shows it: `?` is the
+/// Run view's (its keys are the dashboard's table, its screen's tabs and controls).
+fn in_the_run_view(dashboard: Dashboard) -> Session {
+    let followed = Some(("sapnet".to_string(), 0));
+    let mut session = Session::new(Path::new("out"), "CartPole-v1", followed, Phase::Running);
+    session
+        .workbench
+        .run
+        .show_recorded(("sapnet".into(), 0), dashboard);
+    session
+}
+
+fn draw_session(session: &Session, (w, h): (u16, u16)) -> Terminal<TestBackend> {
+    let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
+    terminal
+        .draw(|f| overlays::draw(f, session, Theme::plain()))
+        .unwrap();
+    terminal
+}
+
 #[test]
 fn dashboard_help_overlay() {
-    let mut d = dashboard();
-    d.on_key(key('?'));
+    let mut session = in_the_run_view(dashboard());
+    session.on_key(key('?'));
     for size in SIZES {
         insta::assert_snapshot!(
             format!("help_{}x{}", size.0, size.1),
-            draw_dashboard(&d, size).backend()
+            draw_session(&session, size).backend()
         );
     }
 }
@@ -361,9 +383,9 @@ fn a_library_over_several_tasks_is_grouped_and_labelled_by_task() {
 }
 
 #[test]
-fn v_shows_each_score_less_the_highest() {
+fn d_shows_each_score_less_the_highest() {
     let mut d = dashboard();
-    d.on_key(key('v'));
+    d.on_key(key('d'));
     let terminal = draw_dashboard(&d, (120, 40));
     let text = format!("{}", terminal.backend());
     assert!(text.contains("A−max"), "{text}");
@@ -374,7 +396,7 @@ fn v_shows_each_score_less_the_highest() {
         .expect("source-6's row");
     assert!(row.contains(" 0.000 "), "{row}");
     insta::assert_snapshot!("dashboard_relative_120x40", terminal.backend());
-    d.on_key(key('v'));
+    d.on_key(key('d'));
     assert!(!format!("{}", draw_dashboard(&d, (120, 40)).backend()).contains("A−max"));
 }
 
@@ -667,11 +689,11 @@ fn a_lesson_whose_names_end_alike_is_labelled_by_index() {
 /// left out for source-0…; a line too long for the box wraps instead of being cut.
 #[test]
 fn live_teach_help_tells_the_keys_as_they_are() {
-    let mut d = dashboard();
-    d.on_key(key(' '));
-    d.on_key(key('t'));
-    d.on_key(key('?'));
-    let terminal = draw_dashboard(&d, (80, 24));
+    let mut session = in_the_run_view(dashboard());
+    session.on_key(key(' '));
+    session.on_key(key('t'));
+    session.on_key(key('?'));
+    let terminal = draw_session(&session, (80, 24));
     let lines = screen_lines(&terminal);
     let text = lines.join("\n");
     assert!(
@@ -767,7 +789,7 @@ fn a_key_that_does_nothing_or_leaves_training_paused_says_so() {
         }
         let line = status_line(&draw_dashboard(&d, size));
         assert!(line.contains("already at the slowest speed"), "{line}");
-        d.on_key(key('v'));
+        d.on_key(key('d'));
         let line = status_line(&draw_dashboard(&d, size));
         assert!(!line.contains("already"), "the next key clears it: {line}");
         d.on_key(key('t'));
@@ -779,6 +801,6 @@ fn a_key_that_does_nothing_or_leaves_training_paused_says_so() {
             "{line}"
         );
         d.on_key(key(' '));
-        d.on_key(key('v'));
+        d.on_key(key('d'));
     }
 }

@@ -245,26 +245,45 @@ fn in_teach_mode_a_click_picks_a_node_or_a_row() {
     );
 }
 
+/// `?` is the Run view's screen's (the dashboard draws in the workbench's frame): any key
+/// closes it and does nothing else, Esc included; `q` and Ctrl-C still quit.
 #[test]
 fn help_opens_on_question_mark_and_any_key_closes_it_but_q_quits_always() {
-    let mut d = scripted(1);
-    d.on_key(key('?'));
-    assert!(d.help);
+    use sapnet::results::Status;
+    use sapnet::tui::workbench::screens::session::{Phase, Request, Session};
+    use sapnet::tui::workbench::screens::workbench::Tab;
+    // The dashboard in the Run view of a protocol that ended (q then quits at once).
+    let session = || {
+        let ended = Phase::Ended(Status::Complete);
+        let mut s = Session::new(std::path::Path::new("out"), "CartPole-v1", None, ended);
+        s.workbench
+            .run
+            .show_recorded(("sapnet".into(), 0), scripted(1));
+        s.workbench.tab = Tab::Run;
+        s
+    };
+    let mode = |s: &Session| s.workbench.run.followed_run().unwrap().dashboard.mode;
+    let mut s = session();
+    s.on_key(key('?'));
+    assert!(s.workbench.help);
     assert_eq!(
-        d.on_key(key(' ')),
-        Action::None,
+        s.on_key(key(' ')),
+        Request::None,
         "closing the help is all it does"
     );
-    assert!(!d.help);
-    assert_eq!(d.mode, Mode::Running);
-    d.on_key(key('?'));
-    assert_eq!(d.on_key(key('q')), Action::Quit);
+    assert!(!s.workbench.help);
+    assert_eq!(mode(&s), Mode::Running);
+    s.on_key(key('?'));
+    assert_eq!(s.on_key(key('q')), Request::Quit);
     let ctrl_c = KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL);
-    assert_eq!(scripted(1).on_key(ctrl_c), Action::Quit);
-    assert_eq!(
-        scripted(1).on_key(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE)),
-        Action::Quit
-    );
+    assert_eq!(session().on_key(ctrl_c), Request::Quit);
+    let esc = KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE);
+    assert_eq!(session().on_key(esc), Request::Quit);
+    // Esc on the overlay closes it and never quits.
+    let mut s = session();
+    s.on_key(key('?'));
+    assert_eq!(s.on_key(esc), Request::None);
+    assert!(!s.workbench.help);
 }
 
 #[test]

@@ -17,8 +17,7 @@ use ratatui::Terminal;
 use sapnet::folder_lock::{FolderLock, Holder};
 use sapnet::results::folder_state::{FolderReader, RunStatus};
 use sapnet::tui::theme::Theme;
-use sapnet::tui::workbench::state::Workbench;
-use sapnet::tui::workbench::view;
+use sapnet::tui::workbench::screens::opened::Opened;
 
 use crate::common::cli::{configs, sapnet, stderr};
 use crate::common::library::quick_protocol;
@@ -53,20 +52,20 @@ fn protocol_into(config: &Path, out: &Path) {
 }
 
 /// The workbench on `out` as the binary opens it, its views pressed by `keys`.
-fn workbench(out: &Path, keys: &str) -> Workbench {
+fn workbench(out: &Path, keys: &str) -> Opened {
     let folder = FolderReader::new(out).read().unwrap();
     let report = (!folder.finished_key().is_empty()).then(|| folder.report());
-    let mut workbench = Workbench::new(folder, report);
+    let mut workbench = Opened::new(folder, report);
     for c in keys.chars() {
         workbench.on_key(key(c));
     }
     workbench
 }
 
-fn screen(workbench: &Workbench, (w, h): (u16, u16)) -> Terminal<TestBackend> {
+fn screen(workbench: &Opened, (w, h): (u16, u16)) -> Terminal<TestBackend> {
     let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
     terminal
-        .draw(|f| view::draw(f, workbench, Theme::plain()))
+        .draw(|f| workbench.draw(f, Theme::plain()))
         .unwrap();
     terminal
 }
@@ -305,9 +304,9 @@ fn the_views_at_both_sizes() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("out");
     finished_folder(&out);
-    let steady = |mut w: Workbench| {
+    let steady = |mut w: Opened| {
         // The folder's path is the test's temporary one.
-        w.folder.dir = PathBuf::from("out/two_baselines");
+        w.folder_mut().state.dir = PathBuf::from("out/two_baselines");
         w
     };
     for size in SIZES {
@@ -351,15 +350,15 @@ fn the_views_at_both_sizes() {
         ] {
             let mut workbench = steady(workbench(&live, keys));
             assert_eq!(
-                workbench.folder.writer.as_ref().map(|w| w.pid),
+                workbench.folder().state.writer.as_ref().map(|w| w.pid),
                 Some(std::process::id())
             );
             // Who holds the lock, and the running run's pace, are this test's own.
-            workbench.folder.writer = Some(Holder {
+            workbench.folder_mut().state.writer = Some(Holder {
                 pid: 1234,
                 says: "running as PID 1234 on host since 10:02:07 UTC (the protocol)".into(),
             });
-            for run in &mut workbench.folder.runs {
+            for run in &mut workbench.folder_mut().state.runs {
                 if run.status == RunStatus::Running {
                     run.wall_s = Some(6.0);
                 }
@@ -450,7 +449,10 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
     let mut workbench = workbench(&out, "v");
     let labels = ["dqn[16]", "dqn[8]"];
     for (index, label) in labels.iter().enumerate() {
-        let points = workbench.curves.curve(&workbench.folder, index);
+        let points = workbench
+            .workbench
+            .curves
+            .curve(&workbench.folder().state, index);
         for (statistic, of) in [
             (
                 "iqm",
@@ -475,7 +477,7 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
             assert_eq!(drawn, rows, "{label} {statistic}");
         }
     }
-    let legend_value = |workbench: &Workbench, label: &str| -> String {
+    let legend_value = |workbench: &Opened, label: &str| -> String {
         let drawn = text(&screen(workbench, (120, 40)));
         let line = drawn
             .lines()
@@ -507,7 +509,7 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
     // shown is episode 26's.
     workbench.on_key(key('m'));
     workbench.on_key(key('+'));
-    let (from, to) = workbench.curves.range(&workbench.folder);
+    let (from, to) = workbench.workbench.curves.range(&workbench.folder().state);
     assert_eq!((from, to), (6.0, 26.0));
     let drawn = text(&screen(&workbench, (120, 40)));
     assert!(drawn.contains("ep 6–26 of 30"), "{drawn}");
@@ -519,7 +521,7 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
     }
     // Space hides the picked method (the first): its legend box empties.
     workbench.on_key(key(' '));
-    assert!(workbench.curves.hidden.contains(&0));
+    assert!(workbench.workbench.curves.hidden.contains(&0));
     let drawn = text(&screen(&workbench, (120, 40)));
     assert!(drawn.contains("□ ● dqn[16]"), "{drawn}");
     assert!(drawn.contains("■ ▲ dqn[8]"), "{drawn}");
@@ -534,7 +536,8 @@ fn the_curves_are_drawn_in_each_methods_colour_or_marker() {
     finished_folder(&out);
     let workbench = workbench(&out, "v");
     let kinds: Vec<_> = workbench
-        .folder
+        .folder()
+        .state
         .config
         .protocol
         .methods
@@ -545,7 +548,7 @@ fn the_curves_are_drawn_in_each_methods_colour_or_marker() {
     assert_ne!(colours[0], colours[1], "two DQN sizes read apart");
     let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
     terminal
-        .draw(|f| view::draw(f, &workbench, Theme { color: true }))
+        .draw(|f| workbench.draw(f, Theme { color: true }))
         .unwrap();
     let buffer = terminal.backend().buffer();
     for (r, g, b) in colours {
@@ -742,14 +745,13 @@ fn drawn_at(terminal: &Terminal<TestBackend>, needle: &str) -> (u16, u16) {
 #[test]
 fn a_click_picks_a_view_a_run_a_method_and_a_legend_entry() {
     use crossterm::event::{MouseButton, MouseEvent, MouseEventKind};
-    use sapnet::tui::workbench::mouse::on_mouse;
-    use sapnet::tui::workbench::state::View;
+    use sapnet::tui::workbench::screens::workbench::Tab;
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("out");
     finished_folder(&out);
     let mut workbench = workbench(&out, "");
     let size = ratatui::layout::Rect::new(0, 0, 120, 40);
-    let click = |workbench: &mut Workbench, (column, row): (u16, u16)| {
+    let click = |workbench: &mut Opened, (column, row): (u16, u16)| {
         let event = MouseEvent {
             kind: MouseEventKind::Down(MouseButton::Left),
             column,
@@ -757,30 +759,30 @@ fn a_click_picks_a_view_a_run_a_method_and_a_legend_entry() {
             modifiers: KeyModifiers::NONE,
         };
         assert!(
-            on_mouse(workbench, event, size),
+            workbench.on_mouse(event, size),
             "a click at {column}, {row}"
         );
     };
     // Runs: the first run of dqn[8] is the fourth (index 3).
     let at = drawn_at(&screen(&workbench, (120, 40)), "dqn[8]  0");
     click(&mut workbench, at);
-    assert_eq!(workbench.run_cursor, 3);
+    assert_eq!(workbench.workbench.runs.cursor, 3);
     let at = drawn_at(&screen(&workbench, (120, 40)), "v curves");
     click(&mut workbench, at);
-    assert_eq!(workbench.view, View::Curves);
+    assert_eq!(workbench.workbench.tab, Tab::Curves);
     let at = drawn_at(&screen(&workbench, (120, 40)), "■ ▲ dqn[8]");
     click(&mut workbench, at);
-    assert_eq!(workbench.curves.cursor, 1);
-    assert!(workbench.curves.hidden.contains(&1));
+    assert_eq!(workbench.workbench.curves.cursor, 1);
+    assert!(workbench.workbench.curves.hidden.contains(&1));
     assert!(text(&screen(&workbench, (120, 40))).contains("□ ▲ dqn[8]"));
     click(&mut workbench, at);
-    assert!(workbench.curves.hidden.is_empty());
+    assert!(workbench.workbench.curves.hidden.is_empty());
     let at = drawn_at(&screen(&workbench, (120, 40)), "c comparison");
     click(&mut workbench, at);
-    assert_eq!(workbench.view, View::Comparison);
+    assert_eq!(workbench.workbench.tab, Tab::Comparison);
     let at = drawn_at(&screen(&workbench, (120, 40)), "│dqn[8] ");
     click(&mut workbench, (at.0 + 1, at.1));
-    assert_eq!(workbench.method_cursor, 1);
+    assert_eq!(workbench.workbench.comparison.cursor, 1);
 }
 
 /// Item 4: a folder shipped with its top-level files only (no `runs/`, as `docs/`'s) opens
@@ -854,7 +856,9 @@ fn open_reads_a_shipped_folder_from_its_top_level_files_and_writes_nothing() {
 /// folder unchanged by the reading.
 #[test]
 fn the_sweep_view_shows_the_cells_and_the_merges_comparisons() {
-    use sapnet::tui::workbench::sweep::{comparisons, CellStatus, SweepBench, SweepState};
+    use sapnet::tui::workbench::screens::sweep::SweepScreen;
+    use sapnet::tui::workbench::sweep_folder::{comparisons, CellStatus, SweepState};
+    use sapnet::tui::workbench::views::sweep::SweepView;
     let tmp = tempfile::tempdir().unwrap();
     let base = std::fs::read_to_string(configs("tiny_transfer.ron")).unwrap();
     std::fs::write(tmp.path().join("base.ron"), base).unwrap();
@@ -955,7 +959,8 @@ fn the_sweep_view_shows_the_cells_and_the_merges_comparisons() {
     assert_eq!(compared, rows.len(), "every merged row is a value's method");
 
     // The view, its paths and the failed cell's error (a temporary path) made steady.
-    let mut bench = SweepBench::new(sweep, values);
+    let mut screen = SweepScreen::new(SweepView::new(sweep, values));
+    let bench = &mut screen.view;
     bench.sweep.dir = PathBuf::from("sweep");
     bench.sweep.cells[0].status = CellStatus::Failed(
         "cell 0000: the source library is missing (sapnet sweep prepare)".into(),
@@ -963,11 +968,9 @@ fn the_sweep_view_shows_the_cells_and_the_merges_comparisons() {
     for size in SIZES {
         let (w, h) = size;
         let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
-        terminal
-            .draw(|f| sapnet::tui::workbench::sweep_view::draw(f, &bench, Theme::plain()))
-            .unwrap();
+        terminal.draw(|f| screen.draw(f, Theme::plain())).unwrap();
         let drawn = text(&terminal);
-        let first = &bench.values[0];
+        let first = &screen.view.values[0];
         let sapnet_row = &first.report.comparison[0];
         let shown = sapnet::report::comparison::interval(&sapnet_row.training.unwrap().iqm, 1);
         assert!(drawn.contains(&shown), "{shown} in\n{drawn}");
@@ -1063,14 +1066,10 @@ fn the_curves_legend_scrolls_to_the_picked_method() {
         modifiers: KeyModifiers::NONE,
     };
     let screen_area = ratatui::layout::Rect::new(0, 0, size.0, size.1);
-    assert!(sapnet::tui::workbench::mouse::on_mouse(
-        &mut workbench,
-        event,
-        screen_area
-    ));
+    assert!(workbench.on_mouse(event, screen_area));
     assert!(
-        workbench.curves.hidden.contains(&23),
+        workbench.workbench.curves.hidden.contains(&23),
         "{:?}",
-        workbench.curves.hidden
+        workbench.workbench.curves.hidden
     );
 }

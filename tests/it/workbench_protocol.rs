@@ -12,9 +12,9 @@ use ratatui::Terminal;
 use sapnet::folder_lock::Holder;
 use sapnet::results::folder_state::FolderReader;
 use sapnet::tui::theme::Theme;
-use sapnet::tui::workbench::picker::Picker;
-use sapnet::tui::workbench::session::{Overlay, Phase, Request, Screen, Session};
-use sapnet::tui::workbench::session_view;
+use sapnet::tui::workbench::screens::session::picker::Picker;
+use sapnet::tui::workbench::screens::session::{overlays, Overlay, Phase, Request, Session};
+use sapnet::tui::workbench::screens::workbench::Tab;
 
 use crate::common::cli::{configs, sapnet, stderr};
 use crate::common::tmux;
@@ -128,7 +128,7 @@ fn key(code: KeyCode) -> KeyEvent {
 fn draw(session: &Session, (w, h): (u16, u16)) -> Terminal<TestBackend> {
     let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
     terminal
-        .draw(|f| session_view::draw(f, session, Theme::plain()))
+        .draw(|f| overlays::draw(f, session, Theme::plain()))
         .unwrap();
     terminal
 }
@@ -179,13 +179,12 @@ fn the_protocol_screens_at_both_sizes() {
 
     // `r`, then `q`: the question, over the Runs view.
     assert_eq!(session.on_key(key(KeyCode::Char('r'))), Request::None);
-    assert_eq!(session.screen, Screen::Views);
+    assert_eq!(session.workbench.tab, Tab::Runs);
     assert_eq!(session.on_key(key(KeyCode::Char('q'))), Request::None);
     assert!(matches!(
         session.overlay,
         Some(Overlay::Stop { then_quit: true })
     ));
-    session.sync_host_keys();
     for size in SIZES {
         let (w, h) = size;
         let terminal = draw(&session, size);
@@ -224,7 +223,6 @@ fn the_protocol_screens_at_both_sizes() {
     assert_eq!(picker.entries.len(), 2);
     assert_eq!(picker.left_out, 1);
     picker.dir = PathBuf::from("assets");
-    session.sync_host_keys();
     for size in SIZES {
         let (w, h) = size;
         let terminal = draw(&session, size);

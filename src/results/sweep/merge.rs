@@ -18,6 +18,7 @@
 //! Cells not done are named and left out.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use anyhow::{Context, Result};
 
@@ -342,7 +343,7 @@ fn folder_name(axis: &str, value: &str) -> String {
 
 /// What makes two pooled runs one: the method's label, the run's seed, its training
 /// returns and its test returns.
-type SameRun<'a> = (String, u64, Option<&'a TrainingEpisodes>, &'a Vec<f64>);
+type SameRun<'a> = (String, u64, Option<&'a Arc<TrainingEpisodes>>, &'a Vec<f64>);
 
 /// The runs of several cells as one protocol: the methods of all (matched by label, in the
 /// order first met), the runs numbered on from cell to cell.
@@ -415,7 +416,8 @@ fn plot_data(pooled: &Results, subject: Option<String>) -> PlotData {
                 .collect();
             let runs: Vec<TrainingEpisodes> = mine
                 .iter()
-                .filter_map(|r| pooled.episodes.get(&(id.clone(), r.record.run)).cloned())
+                .filter_map(|r| pooled.episodes.get(&(id.clone(), r.record.run)))
+                .map(|e| TrainingEpisodes::clone(e))
                 .collect();
             (!runs.is_empty()).then(|| Curve {
                 label: id.label().to_string(),

@@ -1,6 +1,8 @@
-//! What the keys and the mouse do to the dashboard, and to teach mode inside it.
+//! What the keys and the mouse do to the dashboard (the Run view's state), and to teach
+//! mode inside it. Its keys are one table, [`KEYS`]: the Run view matches it, the
+//! dashboard's status bar and the Run view's `?` are made from it.
 
-use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use crossterm::event::{KeyCode, KeyEvent};
 
 use crate::teach::knobs::Knob;
 use crate::teach::session::PromptKind;
@@ -9,6 +11,7 @@ use crate::trainer::Command;
 
 use super::{Dashboard, Focus, Mode, SPEEDS};
 use crate::tui::graph_layout;
+use crate::tui::keys::{self, ch, code, Binding};
 
 /// What the UI loop must do after a key.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -16,11 +19,10 @@ pub enum Action {
     None,
     /// Send this to the followed run (or the only run).
     Send(Command),
-    /// Pause or resume every run.
+    /// Pause or resume the run (in a protocol's session, the followed one only).
     SendAll(Command),
-    /// Stop following this method's run and follow the next method's same run instead.
+    /// Follow the next run that trains now instead.
     FollowNext,
-    Quit,
 }
 
 /// What a left click landed on, as the view that drew the screen tells it.
@@ -34,36 +36,123 @@ pub enum Clicked {
     Teach(usize),
 }
 
+/// What the dashboard's keys do.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DashboardCommand {
+    PauseResume,
+    Step,
+    Faster,
+    Slower,
+    Focus,
+    Up,
+    Down,
+    Left,
+    Right,
+    Zoom,
+    FollowNext,
+    Relative,
+    Teach,
+}
+
+use DashboardCommand as D;
+
+/// The dashboard's keys, the Run view's own (the tabs, `?` and quitting are its screen's).
+pub const KEYS: &[Binding<DashboardCommand>] = &[
+    Binding {
+        keys: &[(ch(' '), D::PauseResume)],
+        help: (
+            "space",
+            "pause / resume the followed run (the others train on)",
+        ),
+        bar: Some(("space", "pause")),
+    },
+    Binding {
+        keys: &[(ch('n'), D::Step)],
+        help: ("n", "one training step while paused"),
+        bar: Some(("n", "step")),
+    },
+    Binding {
+        keys: &[
+            (ch('+'), D::Faster),
+            (ch('='), D::Faster),
+            (ch('-'), D::Slower),
+        ],
+        help: (
+            "+ / -",
+            "faster / slower (delays training, never the screen)",
+        ),
+        bar: None,
+    },
+    Binding {
+        keys: &[(code(KeyCode::Tab), D::Focus)],
+        help: ("tab", "focus the graph or the table"),
+        bar: None,
+    },
+    Binding {
+        keys: &[
+            (code(KeyCode::Up), D::Up),
+            (ch('k'), D::Up),
+            (code(KeyCode::Down), D::Down),
+            (ch('j'), D::Down),
+            (code(KeyCode::Left), D::Left),
+            (ch('h'), D::Left),
+            (code(KeyCode::Right), D::Right),
+            (ch('l'), D::Right),
+        ],
+        help: (
+            "↑↓←→ hjkl",
+            "pick a policy (graph: the nearest node that way)",
+        ),
+        bar: None,
+    },
+    Binding {
+        keys: &[(ch('z'), D::Zoom)],
+        help: ("z", "enlarge the focused panel, or back"),
+        bar: None,
+    },
+    Binding {
+        keys: &[(ch('m'), D::FollowNext)],
+        help: ("m", "the next run training (the one left runs full speed)"),
+        bar: Some(("m", "next run")),
+    },
+    Binding {
+        keys: &[(ch('d'), D::Relative)],
+        help: ("d", "scores as A − max(A), readable when A saturates"),
+        bar: None,
+    },
+    Binding {
+        keys: &[(ch('t'), D::Teach)],
+        help: ("t", "teach mode on the live graph (pauses; t or Esc: back)"),
+        bar: Some(("t", "teach")),
+    },
+];
+
 impl Dashboard {
     /// The number of policies the arrows move over.
     fn policy_count(&self) -> usize {
         self.library.as_ref().map_or(0, |v| v.policies.len())
     }
 
-    /// What `key` does. Keys in teach mode go to [`Teach`]; `t` or Esc leaves it.
+    /// What `key` does to the dashboard alone: teach mode's keys while it is on, else
+    /// [`KEYS`]; `Action::None` for a key of neither (the screen's: `?`, `q`, the tabs).
+    /// The Run view matches the same table and offers the rest to its screen.
     pub fn on_key(&mut self, key: KeyEvent) -> Action {
-        let ctrl_c =
-            key.code == KeyCode::Char('c') && key.modifiers.contains(KeyModifiers::CONTROL);
-        let typing = self.teach.as_ref().is_some_and(|t| t.prompt().is_some());
-        if ctrl_c || (key.code == KeyCode::Char('q') && !typing) {
-            return Action::Quit;
-        }
         self.notice = None;
-        if self.help {
-            // Any key closes the help overlay.
-            self.help = false;
-            return Action::None;
+        if let Some(action) = self.teach_key(&key) {
+            return action;
         }
-        if self.mode == Mode::Teach {
-            return self.on_teach_key(key);
-        }
-        match key.code {
-            KeyCode::Esc => Action::Quit,
-            KeyCode::Char('?') => {
-                self.help = true;
-                Action::None
-            }
-            KeyCode::Char(' ') => match self.mode {
+        keys::command(KEYS, &key).map_or(Action::None, |command| self.apply(command))
+    }
+
+    /// The bar's words for `command` now: space pauses or resumes.
+    pub fn bar_words(&self, command: DashboardCommand) -> Option<&'static str> {
+        (command == D::PauseResume && self.mode == Mode::Paused).then_some("resume")
+    }
+
+    /// What a command of [`KEYS`] does.
+    pub fn apply(&mut self, command: DashboardCommand) -> Action {
+        match command {
+            D::PauseResume => match self.mode {
                 Mode::Running => {
                     self.mode = Mode::Paused;
                     Action::SendAll(Command::Pause)
@@ -73,40 +162,41 @@ impl Dashboard {
                     Action::SendAll(Command::Resume)
                 }
             },
-            KeyCode::Char('n') if self.mode == Mode::Paused => Action::Send(Command::Step),
-            KeyCode::Char('m') => Action::FollowNext,
-            KeyCode::Char('+') | KeyCode::Char('=') if self.speed == 0 => {
-                self.notice = Some("already at full speed");
-                Action::None
+            D::Step if self.mode == Mode::Paused => Action::Send(Command::Step),
+            D::Step => self.said("n steps while paused: space pauses first"),
+            D::Faster if self.speed == 0 => self.said("already at full speed"),
+            D::Slower if self.speed == SPEEDS.len() - 1 => {
+                self.said("already at the slowest speed")
             }
-            KeyCode::Char('-') if self.speed == SPEEDS.len() - 1 => {
-                self.notice = Some("already at the slowest speed");
-                Action::None
-            }
-            KeyCode::Char('+') | KeyCode::Char('=') => self.set_speed(self.speed - 1),
-            KeyCode::Char('-') => self.set_speed(self.speed + 1),
-            KeyCode::Tab => {
+            D::Faster => self.set_speed(self.speed - 1),
+            D::Slower => self.set_speed(self.speed + 1),
+            D::Focus => {
                 self.focus = match self.focus {
                     Focus::Table => Focus::Graph,
                     Focus::Graph => Focus::Table,
                 };
                 Action::None
             }
-            KeyCode::Up | KeyCode::Char('k') => self.move_toward(-1, (0.0, 1.0)),
-            KeyCode::Down | KeyCode::Char('j') => self.move_toward(1, (0.0, -1.0)),
-            KeyCode::Left | KeyCode::Char('h') => self.move_toward(-1, (-1.0, 0.0)),
-            KeyCode::Right | KeyCode::Char('l') => self.move_toward(1, (1.0, 0.0)),
-            KeyCode::Char('t') => self.enter_teach(),
-            KeyCode::Char('v') => {
+            D::Up => self.move_toward(-1, (0.0, 1.0)),
+            D::Down => self.move_toward(1, (0.0, -1.0)),
+            D::Left => self.move_toward(-1, (-1.0, 0.0)),
+            D::Right => self.move_toward(1, (1.0, 0.0)),
+            D::Teach => self.enter_teach(),
+            D::FollowNext => Action::FollowNext,
+            D::Relative => {
                 self.relative = !self.relative;
                 Action::None
             }
-            KeyCode::Char('z') => {
+            D::Zoom => {
                 self.zoom = !self.zoom;
                 Action::None
             }
-            _ => Action::None,
         }
+    }
+
+    fn said(&mut self, notice: &'static str) -> Action {
+        self.notice = Some(notice);
+        Action::None
     }
 
     fn set_speed(&mut self, speed: usize) -> Action {
@@ -134,9 +224,6 @@ impl Dashboard {
     /// A left click, found by the view under the mouse ([`super::click`]): picks the
     /// policy clicked, if any, and focuses its panel.
     pub fn on_click(&mut self, clicked: Clicked) {
-        if self.help {
-            return;
-        }
         match clicked {
             Clicked::Teach(i) => {
                 if let Some(teach) = &mut self.teach {
@@ -164,7 +251,7 @@ impl Dashboard {
     /// `t`: pauses training and steps spreading by hand on a copy of the live net.
     fn enter_teach(&mut self) -> Action {
         let Some(view) = &self.library else {
-            return Action::None;
+            return self.said("teach mode needs a library's graph: this run reuses none");
         };
         let names = view.policies.iter().map(|p| p.name.clone()).collect();
         let mut teach = Teach::new(names, view.net.clone())
@@ -181,25 +268,35 @@ impl Dashboard {
         }
     }
 
-    fn on_teach_key(&mut self, key: KeyEvent) -> Action {
+    /// Teach mode takes every key but `?`, `q` and Ctrl-C (its screen's: the help, which
+    /// then lists teach mode's keys, and quitting), and while a line is typed every key but
+    /// Ctrl-C: what it did, or `None` outside teach mode and for those keys.
+    pub fn teach_key(&mut self, key: &KeyEvent) -> Option<Action> {
+        if self.mode != Mode::Teach {
+            return None;
+        }
         let Some(teach) = &mut self.teach else {
             self.mode = Mode::Paused;
-            return Action::None;
+            return Some(Action::None);
         };
-        if !apply_teach_key(teach, key) {
-            match key.code {
-                KeyCode::Char('t') | KeyCode::Esc => {
-                    // Back to the paused dashboard: the copy's activations are discarded,
-                    // training resumes from its own on space.
-                    self.teach = None;
-                    self.mode = Mode::Paused;
-                    self.notice = Some("training is still paused: space resumes it");
-                }
-                KeyCode::Char('?') => self.help = true,
-                _ => {}
-            }
+        if keys::ctrl('c').matches(key) {
+            return None;
         }
-        Action::None
+        if teach.prompt().is_some() {
+            apply_teach_key(teach, *key);
+            return Some(Action::None);
+        }
+        if [ch('q'), ch('?')].iter().any(|k| k.matches(key)) {
+            return None;
+        }
+        if !apply_teach_key(teach, *key) && matches!(key.code, KeyCode::Char('t') | KeyCode::Esc) {
+            // Back to the paused dashboard: the copy's activations are discarded, training
+            // resumes from its own on space.
+            self.teach = None;
+            self.mode = Mode::Paused;
+            self.notice = Some("training is still paused: space resumes it");
+        }
+        Some(Action::None)
     }
 }
 

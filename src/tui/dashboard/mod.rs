@@ -13,7 +13,7 @@ mod run_views;
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
-pub use keys::{apply_teach_key, Action, Clicked};
+pub use keys::{apply_teach_key, Action, Clicked, DashboardCommand, KEYS};
 pub use live_curve::{LiveCurve, CURVE_POINTS};
 pub use run_views::{LibraryView, PolicyRow, RunView, HISTORY};
 
@@ -56,8 +56,7 @@ pub struct Dashboard {
     pub task: String,
     pub mode: Mode,
     pub focus: Focus,
-    pub help: bool,
-    /// The table shows A − max(A) instead of A (`v`): readable once A saturates.
+    /// The table shows A − max(A) instead of A (`d`): readable once A saturates.
     pub relative: bool,
     /// The focused panel fills the screen (`z`).
     pub zoom: bool,
@@ -107,7 +106,6 @@ impl Dashboard {
             task: task.into(),
             mode: Mode::Running,
             focus: Focus::Table,
-            help: false,
             relative: false,
             zoom: false,
             cursor: 0,

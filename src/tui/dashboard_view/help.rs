@@ -1,26 +1,11 @@
-//! The dashboard's keys, and what the table's symbols mean, for its `?` overlay (drawn by
-//! [`crate::tui::screen::draw_help`]).
+//! What the Run view's `?` says after its keys (which are its table's,
+//! [`crate::tui::dashboard::KEYS`]): the mouse, what the table's symbols mean, and what
+//! each method's score column and P(π) are.
 
-/// Each key (or symbol) beside what it does (or means); an empty pair is a blank line.
-pub(super) const KEYS: &[(&str, &str)] = &[
-    ("space", "pause / resume training"),
-    ("n", "one training step while paused"),
-    (
-        "+ / -",
-        "faster / slower (delays training, never the screen)",
-    ),
-    ("tab / click", "focus the graph or the table"),
-    (
-        "↑↓←→ hjkl",
-        "pick a policy (graph: the nearest node that way)",
-    ),
-    ("click", "pick the policy of a node or a row"),
-    ("z", "enlarge the focused panel, or back"),
-    ("m", "follow the next reusing method's run"),
-    ("v", "scores as A − max(A), readable when A saturates"),
-    ("t", "teach mode on the live graph (pauses training)"),
-    ("?", "this help (any key closes it)"),
-    ("q / Esc / Ctrl-C", "quit"),
+/// The mouse and the symbols, each beside what it does or means; an empty pair is a
+/// blank line.
+const SYMBOLS: &[(&str, &str)] = &[
+    ("click", "pick a node's or a row's policy, focus its panel"),
     ("", ""),
     ("○ ◐ ●", "a node's A: < ¼, < ¾, ≥ ¾ of the highest A"),
     ("cat", "category: number of hidden layers (the prototype)"),
@@ -77,20 +62,20 @@ const COLUMNS: &[(&str, &str, &str)] = &[
     ("w̄", "a2t", "w̄: mean attention weight; P: its weight now"),
 ];
 
-/// The overlay's lines: the keys and symbols, then what the score and P(π) columns mean
-/// for the followed method (`score_name`) and, when `room` lines allow, for every other.
-pub(super) fn keys(score_name: Option<&str>, room: usize) -> Vec<(&'static str, &'static str)> {
-    let mut lines = KEYS.to_vec();
+/// The lines after the keys: the mouse and the symbols, then what the score and P(π)
+/// columns mean for the followed method (`score_name`) first, then for every other (the
+/// overlay shows as many as its box holds).
+pub fn legend(score_name: Option<&str>) -> Vec<(&'static str, &'static str)> {
+    let mut lines = SYMBOLS.to_vec();
     let followed = COLUMNS
         .iter()
         .filter(|(name, ..)| Some(*name) == score_name);
     let others = COLUMNS
         .iter()
         .filter(|(name, ..)| Some(*name) != score_name);
-    let all = lines.len() + COLUMNS.len() <= room;
     lines.extend(
         followed
-            .chain(others.filter(|_| all))
+            .chain(others)
             .map(|&(_, method, what)| (method, what)),
     );
     lines
@@ -101,13 +86,10 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_followed_methods_columns_first_and_the_others_where_they_fit() {
-        let short = keys(Some("wins"), KEYS.len() + 3);
-        assert_eq!(short.len(), KEYS.len() + 1);
-        assert_eq!(short.last().unwrap().0, "gpi");
-        let tall = keys(Some("wins"), 40);
-        assert_eq!(tall.len(), KEYS.len() + COLUMNS.len());
-        assert_eq!(tall[KEYS.len()].0, "gpi", "the followed method first");
-        assert_eq!(keys(None, KEYS.len()).len(), KEYS.len());
+    fn the_followed_methods_columns_come_first() {
+        let lines = legend(Some("wins"));
+        assert_eq!(lines.len(), SYMBOLS.len() + COLUMNS.len());
+        assert_eq!(lines[SYMBOLS.len()].0, "gpi", "the followed method first");
+        assert_eq!(legend(None)[SYMBOLS.len()].0, "sapnet");
     }
 }

@@ -1,7 +1,8 @@
 //! Drawing the dashboard: pure functions of its state, so the snapshot tests draw exactly
 //! what a user sees. This file lays the screen out, hands each panel to its file, and
 //! tells what a click lands on in the same rectangles; teach mode on the live graph is
-//! drawn by [`teach_view`].
+//! drawn by [`teach_view`]. The `?` overlay is its screen's (the Run view's keys with
+//! [`legend`] after them).
 
 mod figures;
 mod graph_panel;
@@ -19,13 +20,14 @@ use ratatui::Frame;
 
 use crate::tui::dashboard::{Clicked, Dashboard, Focus, Mode};
 use crate::tui::graph_layout;
-use crate::tui::screen::{draw_help, too_small};
+use crate::tui::screen::too_small;
 use crate::tui::teach_view;
 use crate::tui::theme::Theme;
+pub use help::legend;
 use policy_table::policy_rows;
 use step_line::step_line;
 
-/// Draws the whole dashboard (or teach mode on the live graph, or the help overlay).
+/// Draws the whole dashboard (or teach mode on the live graph).
 pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
     let area = frame.area();
     if too_small(frame, area) {
@@ -37,16 +39,6 @@ pub fn draw_dashboard(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
         _ => draw_training(frame, dashboard, theme),
     }
     status_bar::draw(frame, status, dashboard, theme);
-    if dashboard.help {
-        if let (Some(teach), Mode::Teach) = (&dashboard.teach, dashboard.mode) {
-            draw_help(frame, area, &teach_view::teach_help(teach, true), theme);
-        } else {
-            let score_name = dashboard.library.as_ref().map(|v| v.score_name);
-            // The overlay's borders and margins take four lines.
-            let room = usize::from(area.height).saturating_sub(4);
-            draw_help(frame, area, &help::keys(score_name, room), theme);
-        }
-    }
 }
 
 /// Where the dashboard's panels are on a screen of `area`: drawing and mouse clicks use

@@ -10,20 +10,85 @@ use ratatui::Frame;
 use super::figures::thousands;
 use crate::config::Budget;
 use crate::results::folder_state::short_count;
-use crate::tui::dashboard::{Dashboard, Mode, SPEEDS};
+use crate::tui::dashboard::{Dashboard, DashboardCommand, Mode, RunView, KEYS, SPEEDS};
+use crate::tui::keys::{self, HELP_BAR, QUIT_BAR};
 use crate::tui::theme::Theme;
+
+/// Teach mode's keys in their short form (teach_view/status_bar.rs has the long one):
+/// teach's own, not yet a table of teach's.
+const TEACH_KEYS: &str = "a s r R u c 1–5± E x M n D C v w X";
+const TEACH_BACK: &str = "Esc/t back";
+
+/// The keys on the right of the line, as the Run view's table says them: the mode's own
+/// (space, n, t), then `?` and `q` as every screen says them; teach mode's are its own.
+fn hints(dashboard: &Dashboard, width: u16, failed: bool, finished: bool) -> String {
+    use DashboardCommand as D;
+    let said = |key: &str, words: &str| format!("{key} {words}");
+    let own = |command: D| {
+        let (key, words) = keys::binding(KEYS, command)
+            .and_then(|b| b.bar)
+            .expect("the bar's keys are in the table");
+        said(key, dashboard.bar_words(command).unwrap_or(words))
+    };
+    let help = said(HELP_BAR.0, HELP_BAR.1);
+    let quit = said(QUIT_BAR.0, QUIT_BAR.1);
+    let teaching = dashboard.mode == Mode::Teach;
+    let hints: Vec<String> = if failed {
+        vec![quit]
+    } else if let Some(notice) = dashboard.notice {
+        vec![notice.to_string()]
+    } else if width < 100 && teaching {
+        // `q` here would quit the training too: the way back is what teach mode offers.
+        vec![TEACH_BACK.into(), help]
+    } else if width < 100 {
+        vec![help, quit]
+    } else if teaching {
+        vec![TEACH_KEYS.into(), TEACH_BACK.into(), help]
+    } else if finished {
+        // Nothing left to pause or step; the graph can still be taught on.
+        vec![own(D::Teach), help, quit]
+    } else if dashboard.mode == Mode::Paused {
+        vec![own(D::PauseResume), own(D::Step), own(D::Teach), help]
+    } else {
+        vec![own(D::PauseResume), own(D::Teach), help, quit]
+    };
+    hints.join(" · ")
+}
+
+/// Where `run` is: its episode (the one being played) of those planned, or under a step
+/// budget its steps too.
+fn episode(dashboard: &Dashboard, r: &RunView) -> String {
+    // Run 0 goes without saying; another (`--follow-run`) is named, from 0 as in the
+    // results' files.
+    let which = match r.run {
+        0 => String::new(),
+        run => format!(" run {run}"),
+    };
+    // The episode being played, as the step line counts it: the next one once its
+    // first step came (the run counts the episodes that ended).
+    let playing = dashboard.last_step.as_ref().map_or(0, |s| s.episode);
+    let episode = r.episode.max(playing);
+    match r.budget {
+        Budget::Episodes(n) => format!("{}{which} ep {episode}/{n}", r.method),
+        Budget::Steps(n) => {
+            let stepped = dashboard.last_step.as_ref().map_or(0, |s| s.step);
+            let steps = short_count(r.steps.max(stepped));
+            format!(
+                "{}{which} ep {episode} · {steps}/{} steps",
+                r.method,
+                short_count(n)
+            )
+        }
+    }
+}
 
 /// The bottom line: mode and figures on the left, the keys of the mode on the right
 /// (the figures give way first on a narrow terminal).
 pub(super) fn draw(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: Theme) {
-    let (mode, hints) = match dashboard.mode {
-        Mode::Running => ("RUNNING", "space pause · t teach · ? keys · q quit"),
-        Mode::Paused => ("PAUSED", "space resume · n step · t teach · ? keys"),
-        // Stand-alone teach mode's keys, in its short form (teach_view/status_bar.rs).
-        Mode::Teach => (
-            "TEACH",
-            "a s r R u c 1–5± E x M n D C v w X · Esc/t back · ? keys",
-        ),
+    let mode = match dashboard.mode {
+        Mode::Running => "RUNNING",
+        Mode::Paused => "PAUSED",
+        Mode::Teach => "TEACH",
     };
     let run = dashboard.main_run();
     let finished = run.is_some_and(|r| r.ended.is_some());
@@ -39,45 +104,9 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: 
         .filter(|r| r.failed.is_some())
         .map(|r| r.method.label())
         .collect();
-    let hints = if failure.is_some() {
-        "q quit"
-    } else if let Some(notice) = dashboard.notice {
-        notice
-    } else if area.width < 100 && dashboard.mode == Mode::Teach {
-        // `q` here would quit the training too: the way back is what teach mode offers.
-        "Esc/t back · ? keys"
-    } else if area.width < 100 {
-        "? keys · q quit"
-    } else if finished && dashboard.mode != Mode::Teach {
-        // Nothing left to pause or step; the graph can still be taught on.
-        "t teach · ? keys · q quit"
-    } else {
-        hints
-    };
-    let episode = run.map_or("-".to_string(), |r| {
-        // Run 0 goes without saying; another (`--follow-run`) is named, from 0 as in the
-        // results' files.
-        let which = match r.run {
-            0 => String::new(),
-            run => format!(" run {run}"),
-        };
-        // The episode being played, as the step line counts it: the next one once its
-        // first step came (the run counts the episodes that ended).
-        let playing = dashboard.last_step.as_ref().map_or(0, |s| s.episode);
-        let episode = r.episode.max(playing);
-        match r.budget {
-            Budget::Episodes(n) => format!("{}{which} ep {episode}/{n}", r.method),
-            Budget::Steps(n) => {
-                let stepped = dashboard.last_step.as_ref().map_or(0, |s| s.step);
-                let steps = short_count(r.steps.max(stepped));
-                format!(
-                    "{}{which} ep {episode} · {steps}/{} steps",
-                    r.method,
-                    short_count(n)
-                )
-            }
-        }
-    });
+    let hints = hints(dashboard, area.width, failure.is_some(), finished);
+    let hints = hints.as_str();
+    let episode = run.map_or("-".to_string(), |r| episode(dashboard, r));
     // Paused, training makes no steps: the last rate measured would be stale.
     let speed = match (dashboard.mode, dashboard.steps_per_second) {
         (Mode::Teach, _) => Some("paused".to_string()),

@@ -1,6 +1,6 @@
 //! The dashboard of a run that ended before the screen opened, made from its files
 //! ([`crate::results::recorded_run`]): Enter on it in the Runs view shows it, in
-//! `sapnet open` ([`super::opened`]) as in a protocol's session ([`super::session`]).
+//! `sapnet open` as in a protocol's session ([`super::screens`]).
 
 use anyhow::Result;
 

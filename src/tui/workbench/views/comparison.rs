@@ -5,21 +5,201 @@
 //! that `comparison.csv` and `improvement.csv` are written from, printed as the stdout
 //! table prints them, and the view says over how many finished runs of how many.
 
+use crossterm::event::{KeyCode, MouseButton, MouseEvent, MouseEventKind};
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::Style;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Paragraph, Wrap};
 use ratatui::Frame;
 
-use super::cells::{fit, inner, method_styles};
-use super::state::{Aggregate, Score, Workbench};
+use super::Intent;
 use crate::report::comparison::interval;
 use crate::report::improvement::p_value;
 use crate::report::{Aggregates, MethodComparison, Report};
 use crate::stats::separation::{Verdict, BOOTSTRAP_SEEDS};
 use crate::stats::Estimate;
+use crate::tui::keys::{ch, code, Binding};
 use crate::tui::row_window::RowWindow;
 use crate::tui::theme::Theme;
+use crate::tui::view::{Outcome, View};
+use crate::tui::workbench::cells::{fit, inner, method_styles};
+use crate::tui::workbench::folder::Folder;
+
+/// Which aggregate over runs the Comparison view shows, as `comparison.csv` names them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Aggregate {
+    Iqm,
+    Mean,
+    Median,
+    OptimalityGap,
+}
+
+impl Aggregate {
+    const ORDER: [Aggregate; 4] = [
+        Aggregate::Iqm,
+        Aggregate::Mean,
+        Aggregate::Median,
+        Aggregate::OptimalityGap,
+    ];
+
+    /// As the table's header says it (`IQM`, as the stdout table does).
+    pub fn name(self) -> &'static str {
+        match self {
+            Aggregate::Iqm => "IQM",
+            Aggregate::Mean => "mean",
+            Aggregate::Median => "median",
+            Aggregate::OptimalityGap => "optimality gap",
+        }
+    }
+
+    fn next(self) -> Self {
+        let i = Self::ORDER.iter().position(|&a| a == self).unwrap_or(0);
+        Self::ORDER[(i + 1) % Self::ORDER.len()]
+    }
+}
+
+/// A score of the comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Score {
+    /// The training return: the headline, which pairs are ranked by.
+    Return,
+    /// The greedy test score of what a run hands over.
+    Test,
+}
+
+impl Score {
+    /// As `improvement.csv`'s `score` column says it.
+    pub fn column(self) -> &'static str {
+        match self {
+            Score::Return => "return",
+            Score::Test => "test",
+        }
+    }
+}
+
+/// What the Comparison view's keys do.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ComparisonCommand {
+    /// The cursor by this many methods.
+    Move(isize),
+    NextAggregate,
+    OtherScore,
+}
+
+/// The Comparison view's keys.
+const KEYS: &[Binding<ComparisonCommand>] = &[
+    Binding {
+        keys: &[
+            (code(KeyCode::Up), ComparisonCommand::Move(-1)),
+            (ch('k'), ComparisonCommand::Move(-1)),
+            (code(KeyCode::Down), ComparisonCommand::Move(1)),
+            (ch('j'), ComparisonCommand::Move(1)),
+            (code(KeyCode::PageUp), ComparisonCommand::Move(-10)),
+            (code(KeyCode::PageDown), ComparisonCommand::Move(10)),
+        ],
+        help: (
+            "↑ ↓ j k, PgUp PgDn",
+            "pick a method: its P(X > Y) over every other below",
+        ),
+        bar: Some(("↑↓", "method")),
+    },
+    Binding {
+        keys: &[(ch('a'), ComparisonCommand::NextAggregate)],
+        help: (
+            "a",
+            "the next aggregate (IQM, mean, median, optimality gap)",
+        ),
+        bar: Some(("a", "aggregate")),
+    },
+    Binding {
+        keys: &[(ch('s'), ComparisonCommand::OtherScore)],
+        help: (
+            "s",
+            "the pairs of the other score (training return or test score); below 100 \
+             columns, the table's too",
+        ),
+        bar: Some(("s", "score")),
+    },
+];
+
+/// The methods side by side: aggregates with intervals, whiskers, pairs.
+#[derive(Debug)]
+pub struct ComparisonView {
+    pub aggregate: Aggregate,
+    /// The score whose pairs the view lists (and the only one it shows on a terminal too
+    /// narrow for both).
+    pub score: Score,
+    /// The picked method.
+    pub cursor: usize,
+}
+
+impl Default for ComparisonView {
+    fn default() -> Self {
+        Self {
+            aggregate: Aggregate::Iqm,
+            score: Score::Return,
+            cursor: 0,
+        }
+    }
+}
+
+impl ComparisonView {
+    /// Keeps the cursor on a method of a folder read again.
+    pub fn refreshed(&mut self, folder: &Folder) {
+        self.cursor = self.cursor.min(folder.methods().saturating_sub(1));
+    }
+}
+
+impl View for ComparisonView {
+    type Model = Folder;
+    type Command = ComparisonCommand;
+    type Intent = Intent;
+
+    fn keys(&self) -> &'static [Binding<ComparisonCommand>] {
+        KEYS
+    }
+
+    fn apply(&mut self, folder: &Folder, command: ComparisonCommand) -> Outcome<Intent> {
+        match command {
+            ComparisonCommand::Move(by) => {
+                let last = folder.methods().saturating_sub(1) as isize;
+                self.cursor = (self.cursor as isize + by).clamp(0, last) as usize;
+            }
+            ComparisonCommand::NextAggregate => self.aggregate = self.aggregate.next(),
+            ComparisonCommand::OtherScore => {
+                self.score = match self.score {
+                    Score::Return => Score::Test,
+                    Score::Test => Score::Return,
+                };
+            }
+        }
+        Outcome::Done
+    }
+
+    fn draw(&self, folder: &Folder, frame: &mut Frame, area: Rect, theme: Theme) {
+        draw(frame, area, self, folder, theme);
+    }
+
+    fn legend(&self, _: &Folder) -> Vec<(&'static str, &'static str)> {
+        vec![(
+            "click",
+            "a method's row picks it; a view's name below shows it",
+        )]
+    }
+
+    fn on_mouse(&mut self, folder: &Folder, mouse: MouseEvent, area: Rect) -> Outcome<Intent> {
+        if mouse.kind != MouseEventKind::Down(MouseButton::Left) {
+            return Outcome::Ignored;
+        }
+        match method_at(area, self, folder, mouse.column, mouse.row) {
+            Some(method) => {
+                self.cursor = method;
+                Outcome::Done
+            }
+            None => Outcome::Ignored,
+        }
+    }
+}
 
 /// Below this width the table shows one score (`s` switches), with room for its whisker.
 const BOTH_SCORES_WIDTH: u16 = 100;
@@ -27,14 +207,14 @@ const BOTH_SCORES_WIDTH: u16 = 100;
 /// The fewest lines the pairs' panel keeps (its borders and three pairs).
 const PAIRS_LINES: u16 = 5;
 
-pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) {
-    let Some(report) = &workbench.report else {
+fn draw(frame: &mut Frame, area: Rect, view: &ComparisonView, model: &Folder, theme: Theme) {
+    let Some(report) = &model.report else {
         frame.render_widget(
             Paragraph::new(vec![
-                Line::from(coverage(workbench)),
+                Line::from(coverage(model)),
                 Line::from(""),
                 Line::styled(
-                    if workbench.computing {
+                    if model.computing {
                         "Making the comparison of the finished runs (the bootstrap takes a \
                          moment)…"
                     } else {
@@ -49,15 +229,15 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
         );
         return;
     };
-    let [said, table, pairs] = areas(area, workbench);
-    frame.render_widget(Paragraph::new(coverage(workbench)), said);
-    draw_table(frame, table, workbench, report, theme);
-    draw_pairs(frame, pairs, workbench, report, theme);
+    let [said, table, pairs] = areas(area, model);
+    frame.render_widget(Paragraph::new(coverage(model)), said);
+    draw_table(frame, table, (view, model), report, theme);
+    draw_pairs(frame, pairs, view, model, report, theme);
 }
 
 /// The line saying over how many runs, the table, the pairs.
-fn areas(area: Rect, workbench: &Workbench) -> [Rect; 3] {
-    let methods = workbench.methods() as u16;
+fn areas(area: Rect, model: &Folder) -> [Rect; 3] {
+    let methods = model.methods() as u16;
     let table_height = (methods + 5).min(area.height.saturating_sub(1 + PAIRS_LINES));
     Layout::vertical([
         Constraint::Length(1),
@@ -69,29 +249,35 @@ fn areas(area: Rect, workbench: &Workbench) -> [Rect; 3] {
 
 /// The methods the table's inside `inside` shows, below its header line and above its
 /// axis line.
-fn window(inside: Rect, workbench: &Workbench) -> RowWindow {
+fn window(inside: Rect, view: &ComparisonView, model: &Folder) -> RowWindow {
     let room = usize::from(inside.height).saturating_sub(2);
-    RowWindow::new(workbench.methods(), room, [workbench.method_cursor])
+    RowWindow::new(model.methods(), room, [view.cursor])
 }
 
 /// The method whose row of the table is at (`column`, `row`) of the screen, the view
 /// drawn in `area`: what a click picks.
-pub fn method_at(area: Rect, workbench: &Workbench, column: u16, row: u16) -> Option<usize> {
-    workbench.report.as_ref()?;
-    let [_, table, _] = areas(area, workbench);
+fn method_at(
+    area: Rect,
+    view: &ComparisonView,
+    model: &Folder,
+    column: u16,
+    row: u16,
+) -> Option<usize> {
+    model.report.as_ref()?;
+    let [_, table, _] = areas(area, model);
     let inside = inner(table);
     let first = inside.y + 1;
     if !(inside.x..inside.x + inside.width).contains(&column) || row < first {
         return None;
     }
-    window(inside, workbench).row_at(usize::from(row - first))
+    window(inside, view, model).row_at(usize::from(row - first))
 }
 
 /// Over how many runs: every planned one, or (partial) the finished ones so far.
-fn coverage(workbench: &Workbench) -> String {
-    let folder = &workbench.folder;
+fn coverage(model: &Folder) -> String {
+    let folder = &model.state;
     let (finished, planned) = (folder.finished_runs(), folder.runs.len());
-    if workbench.report.is_none() {
+    if model.report.is_none() {
         format!(" {finished} of {planned} runs finished")
     } else if finished == planned {
         format!(" over all {planned} runs (as comparison.csv and improvement.csv)")
@@ -145,33 +331,41 @@ fn score_name(report: &Report, score: Score) -> String {
     }
 }
 
-fn draw_table(frame: &mut Frame, area: Rect, workbench: &Workbench, report: &Report, theme: Theme) {
-    let aggregate = workbench.aggregate;
-    let title = Line::from(vec![
-        Span::styled(format!(" {} ", aggregate.name()), theme.title()),
-        Span::raw("of each method's finished runs, 95% stratified bootstrap intervals "),
-    ]);
-    frame.render_widget(Block::bordered().title(title), area);
-    let inside = inner(area);
-    if inside.height < 3 {
-        return;
+/// The whiskers' axis: its ends under each score's whiskers; under the methods, whether
+/// the table hides some.
+fn axis_line(
+    columns: &[ScoreColumn],
+    (method_width, runs_width, whisker_width): (usize, usize, usize),
+    more: bool,
+    digits: usize,
+) -> Vec<Span<'static>> {
+    let mut axis_line = vec![Span::raw(format!(
+        "{} {}",
+        fit(if more { "▲▼ more (↑↓)" } else { "" }, method_width),
+        fit("", runs_width)
+    ))];
+    for column in columns {
+        let (low, high) = column.axis;
+        axis_line.push(Span::raw(format!(" {} ", fit("", column.width))));
+        let (low, high) = (format!("{low:.digits$}"), format!("{high:.digits$}"));
+        let gap = whisker_width.saturating_sub(low.chars().count() + high.chars().count());
+        axis_line.push(Span::raw(fit(
+            &format!("{low}{}{high} ", " ".repeat(gap)),
+            whisker_width + 1,
+        )));
     }
-    let folder = &workbench.folder;
-    let labels: Vec<String> = folder
-        .config
-        .protocol
-        .methods
-        .iter()
-        .map(|m| m.label())
-        .collect();
-    let rows: Vec<Option<&MethodComparison>> = labels
-        .iter()
-        .map(|l| report.comparison.iter().find(|c| &c.method == l))
-        .collect();
-    let scores = shown_scores(area.width, workbench.score);
+    axis_line
+}
+
+/// Each score's column: the intervals as text, and the whiskers' shared axis.
+fn score_columns(
+    rows: &[Option<&MethodComparison>],
+    scores: &[Score],
+    aggregate: Aggregate,
+    report: &Report,
+) -> Vec<ScoreColumn> {
     let digits = digits(report, aggregate);
-    // Each score's column: the intervals as text, and the whiskers' shared axis.
-    let columns: Vec<ScoreColumn> = scores
+    scores
         .iter()
         .map(|&score| {
             let estimates: Vec<Option<Estimate>> = rows
@@ -201,7 +395,41 @@ fn draw_table(frame: &mut Frame, area: Rect, workbench: &Workbench, report: &Rep
                 axis,
             }
         })
+        .collect()
+}
+
+fn draw_table(
+    frame: &mut Frame,
+    area: Rect,
+    (view, model): (&ComparisonView, &Folder),
+    report: &Report,
+    theme: Theme,
+) {
+    let aggregate = view.aggregate;
+    let title = Line::from(vec![
+        Span::styled(format!(" {} ", aggregate.name()), theme.title()),
+        Span::raw("of each method's finished runs, 95% stratified bootstrap intervals "),
+    ]);
+    frame.render_widget(Block::bordered().title(title), area);
+    let inside = inner(area);
+    if inside.height < 3 {
+        return;
+    }
+    let folder = &model.state;
+    let labels: Vec<String> = folder
+        .config
+        .protocol
+        .methods
+        .iter()
+        .map(|m| m.label())
         .collect();
+    let rows: Vec<Option<&MethodComparison>> = labels
+        .iter()
+        .map(|l| report.comparison.iter().find(|c| &c.method == l))
+        .collect();
+    let scores = shown_scores(area.width, view.score);
+    let digits = digits(report, aggregate);
+    let columns = score_columns(&rows, &scores, aggregate, report);
     let method_width = labels
         .iter()
         .map(|l| l.chars().count())
@@ -233,10 +461,10 @@ fn draw_table(frame: &mut Frame, area: Rect, workbench: &Workbench, report: &Rep
         header.push(Span::raw(format!("{} ", fit("", whisker_width))));
     }
     let mut lines = vec![Line::from(header).style(theme.dim())];
-    let window = window(inside, workbench);
+    let window = window(inside, view, model);
     let styles = method_styles(folder, theme);
     for i in window.rows() {
-        let picked = i == workbench.method_cursor;
+        let picked = i == view.cursor;
         let style = |s: Style| if picked { s.patch(theme.cursor()) } else { s };
         let runs = format!(
             "{}/{}",
@@ -269,29 +497,13 @@ fn draw_table(frame: &mut Frame, area: Rect, workbench: &Workbench, report: &Rep
         }
         lines.push(Line::from(spans));
     }
-    // The whiskers' axis: its ends under each score's whiskers.
-    let mut axis_line = vec![Span::raw(format!(
-        "{} {}",
-        fit(
-            if window.shown < window.total {
-                "▲▼ more (↑↓)"
-            } else {
-                ""
-            },
-            method_width
-        ),
-        fit("", runs_width)
-    ))];
-    for column in &columns {
-        let (low, high) = column.axis;
-        axis_line.push(Span::raw(format!(" {} ", fit("", column.width))));
-        let (low, high) = (format!("{low:.digits$}"), format!("{high:.digits$}"));
-        let gap = whisker_width.saturating_sub(low.chars().count() + high.chars().count());
-        axis_line.push(Span::raw(fit(
-            &format!("{low}{}{high} ", " ".repeat(gap)),
-            whisker_width + 1,
-        )));
-    }
+    let more = window.shown < window.total;
+    let axis_line = axis_line(
+        &columns,
+        (method_width, runs_width, whisker_width),
+        more,
+        digits,
+    );
     lines.push(Line::from(axis_line).style(theme.dim()));
     frame.render_widget(Paragraph::new(lines), inside);
 }
@@ -352,18 +564,25 @@ pub fn whisker(e: &Estimate, (low, high): (f64, f64), width: usize) -> String {
         .collect()
 }
 
-fn draw_pairs(frame: &mut Frame, area: Rect, workbench: &Workbench, report: &Report, theme: Theme) {
-    let folder = &workbench.folder;
+fn draw_pairs(
+    frame: &mut Frame,
+    area: Rect,
+    view: &ComparisonView,
+    model: &Folder,
+    report: &Report,
+    theme: Theme,
+) {
+    let folder = &model.state;
     let Some(method) = folder
         .config
         .protocol
         .methods
-        .get(workbench.method_cursor)
+        .get(view.cursor)
         .map(|m| m.label())
     else {
         return;
     };
-    let score = workbench.score;
+    let score = view.score;
     let title = Line::from(vec![
         Span::styled(format!(" P({method} > Y) "), theme.title()),
         Span::raw(format!(

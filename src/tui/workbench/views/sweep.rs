@@ -4,54 +4,169 @@
 //! each method's IQM of the training return and of the test score with their 95%
 //! intervals, printed as the stdout table prints them; the status bar of its keys.
 
+use std::convert::Infallible;
+
+use crossterm::event::KeyCode;
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::Style;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Paragraph};
 use ratatui::Frame;
 
-use super::cells::{fit, inner};
-use super::sweep::{CellStatus, Focus, SweepBench};
 use crate::report::comparison::interval;
+use crate::tui::keys::{ch, code, Binding};
 use crate::tui::row_window::RowWindow;
-use crate::tui::screen;
 use crate::tui::theme::Theme;
+use crate::tui::view::{Outcome, View};
+use crate::tui::workbench::cells::{fit, inner};
+use crate::tui::workbench::sweep_folder::{CellStatus, SweepState, ValueComparison};
 
-pub fn draw(frame: &mut Frame, bench: &SweepBench, theme: Theme) {
-    let area = frame.area();
-    if screen::too_small(frame, area) {
-        return;
+/// Which of the Sweep view's lists the arrows move in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Focus {
+    Cells,
+    Values,
+}
+
+/// What the Sweep view's keys do.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SweepCommand {
+    /// The other list.
+    Focus,
+    /// The focused list's cursor by this many rows.
+    Move(isize),
+}
+
+/// The Sweep view's keys.
+const KEYS: &[Binding<SweepCommand>] = &[
+    Binding {
+        keys: &[
+            (code(KeyCode::Tab), SweepCommand::Focus),
+            (code(KeyCode::BackTab), SweepCommand::Focus),
+        ],
+        help: (
+            "Tab",
+            "move between the cells and the axis values (the comparison shown is the \
+             picked value's)",
+        ),
+        bar: Some(("Tab", "cells")),
+    },
+    Binding {
+        keys: &[
+            (code(KeyCode::Up), SweepCommand::Move(-1)),
+            (ch('k'), SweepCommand::Move(-1)),
+            (code(KeyCode::Down), SweepCommand::Move(1)),
+            (ch('j'), SweepCommand::Move(1)),
+            (code(KeyCode::PageUp), SweepCommand::Move(-10)),
+            (code(KeyCode::PageDown), SweepCommand::Move(10)),
+        ],
+        help: ("↑ ↓ j k, PgUp PgDn", "pick a cell or an axis value"),
+        bar: Some(("↑↓", "value")),
+    },
+];
+
+/// The Sweep view's state: the folder as last read, its comparisons, what is picked.
+pub struct SweepView {
+    pub sweep: SweepState,
+    pub values: Vec<ValueComparison>,
+    /// The comparisons of newly done cells are being made.
+    pub computing: bool,
+    pub focus: Focus,
+    pub cell_cursor: usize,
+    pub value_cursor: usize,
+    /// The last refresh's failure, shown until a read succeeds again.
+    pub read_error: Option<String>,
+}
+
+impl SweepView {
+    pub fn new(sweep: SweepState, values: Vec<ValueComparison>) -> Self {
+        Self {
+            sweep,
+            values,
+            computing: false,
+            focus: Focus::Values,
+            cell_cursor: 0,
+            value_cursor: 0,
+            read_error: None,
+        }
     }
-    let [header, body, status] = Layout::vertical([
-        Constraint::Length(1),
-        Constraint::Fill(1),
-        Constraint::Length(1),
-    ])
-    .areas(area);
-    frame.render_widget(Paragraph::new(header_line(bench, theme)), header);
-    // The cells take up to two fifths of the screen, their rows and borders.
-    let cells_height = (bench.sweep.cells.len() as u16 + 3).min(body.height * 2 / 5);
-    let [cells, values] =
-        Layout::vertical([Constraint::Length(cells_height), Constraint::Fill(1)]).areas(body);
-    draw_cells(frame, cells, bench, theme);
-    let list_width = bench
-        .values
-        .iter()
-        .map(|v| v.axis.chars().count() + v.value.chars().count() + 8)
-        .max()
-        .unwrap_or(24)
-        .clamp(24, usize::from(values.width / 3).max(24)) as u16;
-    let [list, comparison] =
-        Layout::horizontal([Constraint::Length(list_width), Constraint::Fill(1)]).areas(values);
-    draw_values(frame, list, bench, theme);
-    draw_comparison(frame, comparison, bench, theme);
-    frame.render_widget(Paragraph::new(status_line(bench, theme)), status);
-    if bench.help {
-        screen::draw_help(frame, area, &bench.keys(), theme);
+
+    pub fn refreshed(&mut self, sweep: SweepState, values: Option<Vec<ValueComparison>>) {
+        self.sweep = sweep;
+        if let Some(values) = values {
+            self.values = values;
+            self.computing = false;
+        }
+        self.read_error = None;
+        self.cell_cursor = self
+            .cell_cursor
+            .min(self.sweep.cells.len().saturating_sub(1));
+        self.value_cursor = self.value_cursor.min(self.values.len().saturating_sub(1));
     }
 }
 
-fn header_line(bench: &SweepBench, theme: Theme) -> Line<'static> {
+impl View for SweepView {
+    /// The view owns the sweep as read: it is the screen's only view.
+    type Model = ();
+    type Command = SweepCommand;
+    type Intent = Infallible;
+
+    fn keys(&self) -> &'static [Binding<SweepCommand>] {
+        KEYS
+    }
+
+    fn apply(&mut self, _: &(), command: SweepCommand) -> Outcome<Infallible> {
+        match command {
+            SweepCommand::Focus => {
+                self.focus = match self.focus {
+                    Focus::Cells => Focus::Values,
+                    Focus::Values => Focus::Cells,
+                };
+            }
+            SweepCommand::Move(by) => {
+                let (cursor, rows) = match self.focus {
+                    Focus::Cells => (&mut self.cell_cursor, self.sweep.cells.len()),
+                    Focus::Values => (&mut self.value_cursor, self.values.len()),
+                };
+                let last = rows.saturating_sub(1) as isize;
+                *cursor = (*cursor as isize + by).clamp(0, last) as usize;
+            }
+        }
+        Outcome::Done
+    }
+
+    fn draw(&self, _: &(), frame: &mut Frame, body: Rect, theme: Theme) {
+        // The cells take up to two fifths of the screen, their rows and borders.
+        let cells_height = (self.sweep.cells.len() as u16 + 3).min(body.height * 2 / 5);
+        let [cells, values] =
+            Layout::vertical([Constraint::Length(cells_height), Constraint::Fill(1)]).areas(body);
+        draw_cells(frame, cells, self, theme);
+        let list_width = self
+            .values
+            .iter()
+            .map(|v| v.axis.chars().count() + v.value.chars().count() + 8)
+            .max()
+            .unwrap_or(24)
+            .clamp(24, usize::from(values.width / 3).max(24)) as u16;
+        let [list, comparison] =
+            Layout::horizontal([Constraint::Length(list_width), Constraint::Fill(1)]).areas(values);
+        draw_values(frame, list, self, theme);
+        draw_comparison(frame, comparison, self, theme);
+    }
+
+    /// Tab names the list it moves to, ↑↓ what they pick.
+    fn words(&self, _: &(), command: SweepCommand) -> Option<&'static str> {
+        Some(match (command, self.focus) {
+            (SweepCommand::Focus, Focus::Cells) => "axis values",
+            (SweepCommand::Focus, Focus::Values) => "cells",
+            (SweepCommand::Move(_), Focus::Cells) => "cell",
+            (SweepCommand::Move(_), Focus::Values) => "value",
+        })
+    }
+}
+
+/// What sweep this is and how far it is, for the screen's top line.
+pub fn header_line(bench: &SweepView, theme: Theme) -> Line<'static> {
     let sweep = &bench.sweep;
     let counts: Vec<String> = ["done", "running", "queued", "stopped", "failed", "not run"]
         .iter()
@@ -103,7 +218,7 @@ fn detail(status: &CellStatus, progress: Option<(usize, usize)>) -> String {
     }
 }
 
-fn draw_cells(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) {
+fn draw_cells(frame: &mut Frame, area: Rect, bench: &SweepView, theme: Theme) {
     let focused = bench.focus == Focus::Cells;
     let title = Line::from(vec![Span::styled(
         " Cells ",
@@ -163,7 +278,7 @@ fn draw_cells(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) {
     frame.render_widget(Paragraph::new(lines), inside);
 }
 
-fn draw_values(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) {
+fn draw_values(frame: &mut Frame, area: Rect, bench: &SweepView, theme: Theme) {
     let focused = bench.focus == Focus::Values;
     let title = Span::styled(
         " Values (done cells) ",
@@ -204,7 +319,7 @@ fn draw_values(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) 
 }
 
 /// The picked value's comparison: each method's runs and IQMs with their intervals.
-fn draw_comparison(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: Theme) {
+fn draw_comparison(frame: &mut Frame, area: Rect, bench: &SweepView, theme: Theme) {
     let Some(value) = bench.values.get(bench.value_cursor) else {
         let said = if bench.computing {
             "Making the comparison of the finished cells…"
@@ -299,35 +414,4 @@ fn draw_comparison(frame: &mut Frame, area: Rect, bench: &SweepBench, theme: The
         ));
     }
     frame.render_widget(Paragraph::new(lines), inside);
-}
-
-fn status_line(bench: &SweepBench, theme: Theme) -> Line<'static> {
-    let mut spans = vec![Span::raw(" ")];
-    for (key, what) in [
-        (
-            "Tab",
-            if bench.focus == Focus::Cells {
-                "axis values"
-            } else {
-                "cells"
-            },
-        ),
-        (
-            "↑↓",
-            if bench.focus == Focus::Cells {
-                "cell"
-            } else {
-                "value"
-            },
-        ),
-    ] {
-        spans.push(Span::styled(key.to_string(), theme.title()));
-        spans.push(Span::raw(format!(" {what}  ")));
-    }
-    spans.push(Span::styled("│ ", theme.dim()));
-    spans.push(Span::styled("?", theme.title()));
-    spans.push(Span::raw(" keys  "));
-    spans.push(Span::styled("q", theme.title()));
-    spans.push(Span::raw(" quit"));
-    Line::from(spans)
 }

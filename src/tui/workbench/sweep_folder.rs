@@ -1,18 +1,17 @@
-//! `sapnet open SWEEP_DIR`: a sweep folder (`sapnet sweep plan`) in the Sweep view — its
-//! cells (queued, running, done, failed) and, per axis value, the comparison of its
-//! finished cells, made by the code `sweep merge` writes `merged/comparison.csv` with
+//! A sweep folder (`sapnet sweep plan`) as the Sweep view reads it — its cells (queued,
+//! running, done, failed) and, per axis value, the comparison of its finished cells, made
+//! by the code `sweep merge` writes `merged/comparison.csv` with
 //! ([`crate::results::sweep::merge::groups`], [`crate::results::sweep::merge::value_report`]).
 //!
 //! Read only, as any folder from elsewhere: the manifest, each cell's state as `sweep
 //! status` reads it, a running cell's process from its protocol's lock (never taken) and
 //! its progress from its partial results, each done cell's records as `sweep merge` reads
-//! them. A thread reads the folder again every [`super::REFRESH`] and makes the
-//! comparisons again when the set of done cells changed.
+//! them. The sweep screen's thread reads it again every [`super::folder::REFRESH`] and
+//! makes the comparisons again when the set of done cells changed.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 
 use crate::folder_lock::{self, Holder};
 use crate::report::Report;
@@ -183,102 +182,4 @@ pub fn comparisons(dir: &Path, done: &[usize]) -> Result<Vec<ValueComparison>> {
             }
         })
         .collect())
-}
-
-/// Which of the Sweep view's lists the arrows move in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Focus {
-    Cells,
-    Values,
-}
-
-/// The Sweep view's state: the folder as last read, its comparisons, what is picked.
-pub struct SweepBench {
-    pub sweep: SweepState,
-    pub values: Vec<ValueComparison>,
-    /// The comparisons of newly done cells are being made.
-    pub computing: bool,
-    pub focus: Focus,
-    pub cell_cursor: usize,
-    pub value_cursor: usize,
-    pub help: bool,
-    /// The last refresh's failure, shown until a read succeeds again.
-    pub read_error: Option<String>,
-}
-
-impl SweepBench {
-    pub fn new(sweep: SweepState, values: Vec<ValueComparison>) -> Self {
-        Self {
-            sweep,
-            values,
-            computing: false,
-            focus: Focus::Values,
-            cell_cursor: 0,
-            value_cursor: 0,
-            help: false,
-            read_error: None,
-        }
-    }
-
-    pub fn on_key(&mut self, key: KeyEvent) -> bool {
-        let ctrl_c =
-            key.code == KeyCode::Char('c') && key.modifiers.contains(KeyModifiers::CONTROL);
-        if ctrl_c || matches!(key.code, KeyCode::Char('q') | KeyCode::Esc) {
-            return false;
-        }
-        if self.help {
-            self.help = false;
-            return true;
-        }
-        let (cursor, rows) = match self.focus {
-            Focus::Cells => (&mut self.cell_cursor, self.sweep.cells.len()),
-            Focus::Values => (&mut self.value_cursor, self.values.len()),
-        };
-        let last = rows.saturating_sub(1);
-        match key.code {
-            KeyCode::Char('?') => self.help = true,
-            KeyCode::Tab | KeyCode::BackTab => {
-                self.focus = match self.focus {
-                    Focus::Cells => Focus::Values,
-                    Focus::Values => Focus::Cells,
-                };
-            }
-            KeyCode::Up | KeyCode::Char('k') => *cursor = cursor.saturating_sub(1),
-            KeyCode::Down | KeyCode::Char('j') => *cursor = (*cursor + 1).min(last),
-            KeyCode::PageUp => *cursor = cursor.saturating_sub(10),
-            KeyCode::PageDown => *cursor = (*cursor + 10).min(last),
-            _ => {}
-        }
-        true
-    }
-
-    pub(super) fn refreshed(&mut self, sweep: SweepState, values: Option<Vec<ValueComparison>>) {
-        self.sweep = sweep;
-        if let Some(values) = values {
-            self.values = values;
-            self.computing = false;
-        }
-        self.read_error = None;
-        self.cell_cursor = self
-            .cell_cursor
-            .min(self.sweep.cells.len().saturating_sub(1));
-        self.value_cursor = self.value_cursor.min(self.values.len().saturating_sub(1));
-    }
-
-    /// Every key, for `?`.
-    pub fn keys(&self) -> Vec<(&'static str, &'static str)> {
-        vec![
-            (
-                "Tab",
-                "move between the cells and the axis values (the comparison shown is the \
-                 picked value's)",
-            ),
-            ("↑ ↓ j k, PgUp PgDn", "pick a cell or an axis value"),
-            ("?", "every key"),
-            (
-                "q, Esc, Ctrl-C",
-                "quit (the folder is only read: nothing in it changes)",
-            ),
-        ]
-    }
 }

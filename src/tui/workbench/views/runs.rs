@@ -3,24 +3,118 @@
 //! one scale for all (so lines compare at a glance), the latest MA10, the time
 //! left at its pace, and the source it handed over or used most.
 
+use crossterm::event::{KeyCode, MouseButton, MouseEvent, MouseEventKind};
 use ratatui::layout::Rect;
 use ratatui::style::Style;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Paragraph};
 use ratatui::Frame;
 
-use super::cells::{fit, inner, method_styles};
-use super::state::Workbench;
+use super::Intent;
 use crate::report::moving_average;
-use crate::results::folder_state::{RunProgress, RunStatus};
+use crate::results::folder_state::{FolderState, RunProgress, RunStatus};
+use crate::tui::keys::{ch, code, Binding};
 use crate::tui::row_window::RowWindow;
 use crate::tui::theme::Theme;
+use crate::tui::view::{Outcome, View};
+use crate::tui::workbench::cells::{fit, inner, method_styles};
+use crate::tui::workbench::folder::Folder;
 
 /// The sparkline's levels, lowest first.
 const LEVELS: [char; 8] = ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'];
 
-pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) {
-    let folder = &workbench.folder;
+/// What the Runs view's keys do.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunsCommand {
+    /// The cursor by this many runs.
+    Move(isize),
+    Show,
+}
+
+/// The Runs view's keys.
+const KEYS: &[Binding<RunsCommand>] = &[
+    Binding {
+        keys: &[
+            (code(KeyCode::Up), RunsCommand::Move(-1)),
+            (ch('k'), RunsCommand::Move(-1)),
+            (code(KeyCode::Down), RunsCommand::Move(1)),
+            (ch('j'), RunsCommand::Move(1)),
+            (code(KeyCode::PageUp), RunsCommand::Move(-10)),
+            (code(KeyCode::PageDown), RunsCommand::Move(10)),
+        ],
+        help: ("↑ ↓ j k, PgUp PgDn", "pick a run"),
+        bar: Some(("↑↓", "run")),
+    },
+    Binding {
+        keys: &[(code(KeyCode::Enter), RunsCommand::Show)],
+        help: (
+            "Enter",
+            "the picked run's dashboard in the Run view: followed live if it trains in this \
+             session, else made from its files once it finished",
+        ),
+        bar: Some(("⏎", "dashboard")),
+    },
+];
+
+/// Every planned run of the protocol, one a line; the picked one is what Enter shows.
+#[derive(Debug, Default)]
+pub struct RunsView {
+    pub cursor: usize,
+}
+
+impl RunsView {
+    /// Keeps the cursor on a run of a folder read again.
+    pub fn refreshed(&mut self, folder: &Folder) {
+        self.cursor = self.cursor.min(folder.state.runs.len().saturating_sub(1));
+    }
+}
+
+impl View for RunsView {
+    type Model = Folder;
+    type Command = RunsCommand;
+    type Intent = Intent;
+
+    fn keys(&self) -> &'static [Binding<RunsCommand>] {
+        KEYS
+    }
+
+    fn apply(&mut self, folder: &Folder, command: RunsCommand) -> Outcome<Intent> {
+        match command {
+            RunsCommand::Move(by) => {
+                let last = folder.state.runs.len().saturating_sub(1) as isize;
+                self.cursor = (self.cursor as isize + by).clamp(0, last) as usize;
+                Outcome::Done
+            }
+            RunsCommand::Show => Outcome::Intent(Intent::ShowRun(self.cursor)),
+        }
+    }
+
+    fn draw(&self, folder: &Folder, frame: &mut Frame, area: Rect, theme: Theme) {
+        draw(frame, area, &folder.state, self.cursor, theme);
+    }
+
+    fn legend(&self, _: &Folder) -> Vec<(&'static str, &'static str)> {
+        vec![(
+            "click",
+            "a run's line picks it; a view's name below shows it",
+        )]
+    }
+
+    fn on_mouse(&mut self, folder: &Folder, mouse: MouseEvent, area: Rect) -> Outcome<Intent> {
+        if mouse.kind != MouseEventKind::Down(MouseButton::Left) {
+            return Outcome::Ignored;
+        }
+        match run_at(area, &folder.state, self.cursor, mouse.column, mouse.row) {
+            Some(run) => {
+                self.cursor = run;
+                Outcome::Done
+            }
+            None => Outcome::Ignored,
+        }
+    }
+}
+
+fn draw(frame: &mut Frame, area: Rect, folder: &FolderState, cursor: usize, theme: Theme) {
     let title = Line::from(vec![
         Span::styled(" Runs ", theme.title()),
         Span::raw(format!("{} ", counts(&folder.runs))),
@@ -44,34 +138,12 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &a| {
             (lo.min(a), hi.max(a))
         });
-    let method_width = folder
-        .runs
-        .iter()
-        .map(|r| r.method.label().chars().count())
-        .max()
-        .unwrap_or(6)
-        .clamp(6, 22);
-    let source_width = folder
-        .runs
-        .iter()
-        .filter_map(|r| r.source.as_ref().map(|s| s.chars().count()))
-        .max()
-        .unwrap_or(1)
-        .clamp(6, 12);
-    let episodes_width = folder
-        .runs
-        .iter()
-        .map(|r| {
-            let mut full = r.clone();
-            full.training.lengths.clear();
-            full.progress_text().len().max(r.progress_text().len())
-        })
-        .max()
-        .unwrap_or(8)
-        .max(8);
-    // method, run, status, episodes, [sparkline], MA10, ETA, source, with a space between.
-    let fixed = method_width + 4 + 8 + episodes_width + 8 + 7 + source_width + 7;
-    let spark_width = usize::from(inside.width).saturating_sub(fixed).max(4);
+    let Widths {
+        method: method_width,
+        source: source_width,
+        episodes: episodes_width,
+        spark: spark_width,
+    } = widths(folder, inside.width);
     let header = format!(
         "{} {} {} {} {} {} {} {}",
         fit("method", method_width),
@@ -91,7 +163,7 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
         fit("source", source_width),
     );
     let mut lines = vec![Line::styled(header, theme.dim())];
-    let rows = run_window(inside, workbench);
+    let rows = run_window(inside, folder, cursor);
     let styles = method_styles(folder, theme);
     for i in rows.rows() {
         let run = &folder.runs[i];
@@ -106,7 +178,7 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
             .last()
             .map_or_else(|| "-".to_string(), |a| format!("{a:.1}"));
         let eta = run.eta_s().map_or_else(|| "-".to_string(), duration);
-        let picked = i == workbench.run_cursor;
+        let picked = i == cursor;
         let row_style = |style: Style| {
             if picked {
                 style.patch(theme.cursor())
@@ -151,26 +223,67 @@ pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) 
     frame.render_widget(Paragraph::new(lines), inside);
 }
 
+/// The columns' widths: each as wide as its longest cell, the sparkline what is left.
+struct Widths {
+    method: usize,
+    source: usize,
+    episodes: usize,
+    spark: usize,
+}
+
+fn widths(folder: &FolderState, inside_width: u16) -> Widths {
+    let method = folder
+        .runs
+        .iter()
+        .map(|r| r.method.label().chars().count())
+        .max()
+        .unwrap_or(6)
+        .clamp(6, 22);
+    let source = folder
+        .runs
+        .iter()
+        .filter_map(|r| r.source.as_ref().map(|s| s.chars().count()))
+        .max()
+        .unwrap_or(1)
+        .clamp(6, 12);
+    let episodes = folder
+        .runs
+        .iter()
+        .map(|r| r.full_text().len().max(r.progress_text().len()))
+        .max()
+        .unwrap_or(8)
+        .max(8);
+    // method, run, status, episodes, [sparkline], MA10, ETA, source, with a space between.
+    let fixed = method + 4 + 8 + episodes + 8 + 7 + source + 7;
+    let spark = usize::from(inside_width).saturating_sub(fixed).max(4);
+    Widths {
+        method,
+        source,
+        episodes,
+        spark,
+    }
+}
+
 /// The runs shown in the panel's inside `inside`, below its header line; a line under them
 /// says what they hide, when they do not all fit.
-fn run_window(inside: Rect, workbench: &Workbench) -> RowWindow {
-    let runs = workbench.folder.runs.len();
+fn run_window(inside: Rect, folder: &FolderState, cursor: usize) -> RowWindow {
+    let runs = folder.runs.len();
     let mut room = usize::from(inside.height).saturating_sub(1);
     if runs > room {
         room = room.saturating_sub(1);
     }
-    RowWindow::new(runs, room, [workbench.run_cursor])
+    RowWindow::new(runs, room, [cursor])
 }
 
 /// The run whose line is at (`column`, `row`) of the screen, the view drawn in `area`: what
 /// a click picks.
-pub fn run_at(area: Rect, workbench: &Workbench, column: u16, row: u16) -> Option<usize> {
+fn run_at(area: Rect, folder: &FolderState, cursor: usize, column: u16, row: u16) -> Option<usize> {
     let inside = inner(area);
     let first = inside.y + 1;
     if !(inside.x..inside.x + inside.width).contains(&column) || row < first {
         return None;
     }
-    run_window(inside, workbench).row_at(usize::from(row - first))
+    run_window(inside, folder, cursor).row_at(usize::from(row - first))
 }
 
 /// `done 3 · running 2 · queued 6` (only the statuses some run has).

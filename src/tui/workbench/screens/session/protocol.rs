@@ -8,12 +8,12 @@ use std::thread::JoinHandle;
 
 use anyhow::{Context, Result};
 
-use super::session::RunKey;
 use crate::config::Config;
 use crate::env::PythonSettings;
 use crate::experiment::{self, OpenedOutput, OutputOptions, RunOptions, Tap, Watched};
 use crate::results::Summary;
 use crate::trainer::Command;
+use crate::tui::workbench::views::run::RunKey;
 
 /// A protocol training on its thread.
 pub struct ProtocolRun {

@@ -1,8 +1,8 @@
-//! The Curves view: every method's learning curve across its runs — the IQM or mean over
+//! Drawing the Curves view: every method's learning curve across its runs — the IQM or mean over
 //! runs of each run's moving average (MA10), with its 95% bootstrap band — in the plots'
 //! colour of each method (without colour: a marker of its own along its line), beside a
 //! legend that switches methods on and off and gives each one's value where the view
-//! ends. The points are `sample_efficiency.csv`'s ([`super::curves`]). `Enter` shows the
+//! ends. The points are `sample_efficiency.csv`'s ([`super`]). `Enter` shows the
 //! picked method's runs one by one, each over its method's band.
 
 use ratatui::layout::{Constraint, Layout, Rect};
@@ -12,9 +12,7 @@ use ratatui::widgets::canvas::{Canvas, Context, Line as Segment, Points};
 use ratatui::widgets::{Block, Paragraph};
 use ratatui::Frame;
 
-use super::cells::{fit, inner};
-use super::curves::{planned, runs_of, Curves};
-use super::state::Workbench;
+use super::{planned, runs_of, CurvesView as Curves};
 use crate::config::Budget;
 use crate::report::moving_average;
 use crate::report::plots::palette::method_colours;
@@ -24,6 +22,7 @@ use crate::results::folder_state::FolderState;
 use crate::stats::Estimate;
 use crate::tui::row_window::RowWindow;
 use crate::tui::theme::Theme;
+use crate::tui::workbench::cells::{fit, inner, method_kinds};
 
 /// Without colour, each method's line carries its own marker (the legend's too).
 pub const MARKERS: [&str; 10] = ["●", "▲", "■", "◆", "✚", "○", "△", "□", "◇", "×"];
@@ -39,10 +38,14 @@ struct Shown {
     points: Vec<EfficiencyPoint>,
 }
 
-pub fn draw(frame: &mut Frame, area: Rect, workbench: &Workbench, theme: Theme) {
-    let folder = &workbench.folder;
-    let curves = &workbench.curves;
-    let colours = method_colours(&super::cells::method_kinds(folder));
+pub(super) fn draw(
+    frame: &mut Frame,
+    area: Rect,
+    curves: &Curves,
+    folder: &FolderState,
+    theme: Theme,
+) {
+    let colours = method_colours(&method_kinds(folder));
     let methods: Vec<Shown> = folder
         .config
         .protocol
@@ -163,18 +166,24 @@ fn areas(inside: Rect, label_width: usize, runs: bool) -> [Rect; 2] {
 
 /// The method whose legend line is at (`column`, `row`) of the screen, the view drawn in
 /// `area` with every method (not one method's runs): what a click shows or hides.
-pub fn legend_method_at(area: Rect, workbench: &Workbench, column: u16, row: u16) -> Option<usize> {
-    if workbench.curves.run.is_some() {
+pub(super) fn legend_method_at(
+    area: Rect,
+    curves: &Curves,
+    folder: &FolderState,
+    column: u16,
+    row: u16,
+) -> Option<usize> {
+    if curves.run.is_some() {
         return None;
     }
     let inside = inner(area);
-    let [_, legend] = areas(inside, label_width(&workbench.folder), false);
+    let [_, legend] = areas(inside, label_width(folder), false);
     let first = legend.y + 1;
     if !(legend.x..legend.x + legend.width).contains(&column) || row < first {
         return None;
     }
-    legend_window(legend, workbench.methods(), workbench.curves.cursor)
-        .row_at(usize::from(row - first))
+    let methods = folder.config.protocol.methods.len();
+    legend_window(legend, methods, curves.cursor).row_at(usize::from(row - first))
 }
 
 /// The methods' lines the legend in `area` shows: as many as fit between its heading and
@@ -271,26 +280,7 @@ fn draw_chart(
     } else {
         (low - 1.0, high + 1.0)
     };
-    let [left, plot] =
-        Layout::horizontal([Constraint::Length(Y_LABELS), Constraint::Fill(1)]).areas(area);
-    let [plot, x_labels] =
-        Layout::vertical([Constraint::Fill(1), Constraint::Length(1)]).areas(plot);
-    // The y axis: its top, middle and bottom values.
-    let mut y_lines = vec![Line::from(""); usize::from(plot.height)];
-    let last = y_lines.len().saturating_sub(1);
-    for (row, value) in [(0, high), (last / 2, (low + high) / 2.0), (last, low)] {
-        y_lines[row] = Line::styled(format!("{value:>6.0} "), theme.dim());
-    }
-    frame.render_widget(Paragraph::new(y_lines), left);
-    let (first, end) = (format!("{from:.0}"), format!("episode {to:.0}"));
-    let gap = usize::from(x_labels.width).saturating_sub(first.len() + end.len());
-    frame.render_widget(
-        Paragraph::new(Line::styled(
-            format!("{first}{}{end}", " ".repeat(gap)),
-            theme.dim(),
-        )),
-        x_labels,
-    );
+    let plot = draw_axes(frame, area, range, (low, high), theme);
     let picked = curves.cursor;
     let colour = |m: &Shown| if theme.color { m.colour } else { Color::Reset };
     // Without colour a marker every few columns along each line tells the lines apart.
@@ -367,6 +357,37 @@ fn draw_chart(
             }
         });
     frame.render_widget(canvas, plot);
+}
+
+/// The axes' labels around the plot in `area` (the y axis: its top, middle and bottom
+/// values; the x axis: its ends), and the plot's area inside them.
+fn draw_axes(
+    frame: &mut Frame,
+    area: Rect,
+    (from, to): (f64, f64),
+    (low, high): (f64, f64),
+    theme: Theme,
+) -> Rect {
+    let [left, plot] =
+        Layout::horizontal([Constraint::Length(Y_LABELS), Constraint::Fill(1)]).areas(area);
+    let [plot, x_labels] =
+        Layout::vertical([Constraint::Fill(1), Constraint::Length(1)]).areas(plot);
+    let mut y_lines = vec![Line::from(""); usize::from(plot.height)];
+    let last = y_lines.len().saturating_sub(1);
+    for (row, value) in [(0, high), (last / 2, (low + high) / 2.0), (last, low)] {
+        y_lines[row] = Line::styled(format!("{value:>6.0} "), theme.dim());
+    }
+    frame.render_widget(Paragraph::new(y_lines), left);
+    let (first, end) = (format!("{from:.0}"), format!("episode {to:.0}"));
+    let gap = usize::from(x_labels.width).saturating_sub(first.len() + end.len());
+    frame.render_widget(
+        Paragraph::new(Line::styled(
+            format!("{first}{}{end}", " ".repeat(gap)),
+            theme.dim(),
+        )),
+        x_labels,
+    );
+    plot
 }
 
 /// The value of a curve where the view ends: its last point inside the episodes shown.
