@@ -9,7 +9,8 @@ set -euo pipefail
 src=$1 dest=$2
 mkdir -p "$dest"
 for f in comparison.csv improvement.csv scores.csv tests.csv summary.json \
-    intervals.png profiles.png improvement.png learning_curve.png tests.png selections.png activations.png; do
+    sample_efficiency.csv intervals.png profiles.png improvement.png learning_curve.png \
+    sample_efficiency.png tests.png selections.png activations.png; do
     if [ -f "$src/$f" ]; then cp "$src/$f" "$dest/$f"; fi
 done
 # A CSV reader, not cut: labels such as dqn[100,100] are quoted and hold commas.

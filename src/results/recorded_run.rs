@@ -20,7 +20,7 @@ use serde::Deserialize;
 use super::folder_state::FolderState;
 use super::plot_data;
 use super::records::{run_name, RUNS};
-use crate::reuse::{self, Library};
+use crate::reuse::{self, Library, ScoreColumn};
 use crate::safe_io;
 use crate::sapnet::SapNet;
 use crate::trainer::{
@@ -77,7 +77,7 @@ pub fn read(
         None => Vec::new(),
     };
     let activations = !rows.is_empty();
-    let score_name = library.as_ref().map_or("", |l| l.score_name);
+    let score = library.as_ref().map_or(ScoreColumn::NONE, |l| l.score);
     // What the record keeps of the selector, when no activations were on file: the
     // scores the run started from.
     let started = match (&library, activations) {
@@ -107,7 +107,7 @@ pub fn read(
                 method: method.clone(),
                 step,
                 episode: episode.episode,
-                score_name,
+                score,
                 activations: row.scores.clone(),
                 probabilities: row.probabilities.clone(),
                 selections: selections.clone(),
@@ -133,7 +133,7 @@ pub fn read(
             method: method.clone(),
             step: record.steps,
             episode: record.episodes,
-            score_name,
+            score,
             activations: scores,
             probabilities,
             selections: record.source_steps.clone(),
@@ -221,7 +221,7 @@ fn library_start(folder: &FolderState, method: &MethodId) -> Result<LibraryStart
             })
             .collect(),
         net,
-        score_name: selector.view().score_name,
+        score: selector.view().score,
     })
 }
 

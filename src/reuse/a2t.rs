@@ -26,7 +26,10 @@ use serde::{Deserialize, Serialize};
 
 use super::definition::{MethodKind, ReuseMethod, Tested};
 use super::gpi::{check_learner, learner_label};
-use super::{Actor, Combined, Learning, Library, ReuseError, Selector, SelectorView, StateValues};
+use super::{
+    Actor, Combined, Learning, Library, ReuseError, ScoreColumn, Selector, SelectorView,
+    StateValues,
+};
 use crate::sapnet::SapNetParams;
 
 /// Where A2T's weights over the sources and the base come from.
@@ -179,6 +182,13 @@ pub fn choose(weights: &[f32], base: &[f32], sources: &[Vec<f32>]) -> Combined {
     Combined { action, followed }
 }
 
+/// A2T's score: each source's mean attention weight.
+pub const SCORE: ScoreColumn = ScoreColumn {
+    name: "w̄",
+    meaning: "w̄: mean attention weight; P: its weight now",
+    counted: false,
+};
+
 impl Selector for A2t {
     fn learning(&self) -> Learning {
         Learning::Learner
@@ -214,7 +224,7 @@ impl Selector for A2t {
     fn view(&self) -> SelectorView {
         let steps = self.steps.max(1) as f64;
         SelectorView::unjudged(
-            "w̄",
+            SCORE,
             self.sums.iter().map(|s| s / steps).collect(),
             self.latest.clone(),
         )

@@ -4,7 +4,7 @@
 use rand::rngs::StdRng;
 
 use super::definition::{MethodKind, ReuseMethod, Tested};
-use super::{Actor, Learning, Library, ReuseError, Selector, SelectorView};
+use super::{Actor, Learning, Library, ReuseError, ScoreColumn, Selector, SelectorView};
 use crate::sapnet::SapNetParams;
 
 /// Always the source with the highest recorded score (the lowest index on a tie).
@@ -39,6 +39,13 @@ impl BestSource {
     }
 }
 
+/// The oracle's score: each source's recorded score.
+pub const SCORE: ScoreColumn = ScoreColumn {
+    name: "score",
+    meaning: "score: its recorded score; P: 1 on the best",
+    counted: false,
+};
+
 impl Selector for BestSource {
     fn learning(&self) -> Learning {
         Learning::ActingSource
@@ -53,7 +60,7 @@ impl Selector for BestSource {
         let n = self.scores.len();
         let mut probabilities = vec![0.0; n];
         probabilities[self.best] = 1.0;
-        SelectorView::unjudged("score", self.scores.clone(), probabilities)
+        SelectorView::unjudged(SCORE, self.scores.clone(), probabilities)
     }
 
     fn top_probability(&self) -> Option<f64> {

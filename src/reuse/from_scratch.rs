@@ -3,7 +3,7 @@
 use rand::rngs::StdRng;
 
 use super::definition::{MethodKind, ReuseMethod, Tested};
-use super::{Actor, Learning, Library, ReuseError, Selector, SelectorView};
+use super::{Actor, Learning, Library, ReuseError, ScoreColumn, Selector, SelectorView};
 use crate::sapnet::SapNetParams;
 
 /// The learner acts and learns at every step.
@@ -20,7 +20,7 @@ impl Selector for Scratch {
     }
 
     fn view(&self) -> SelectorView {
-        SelectorView::unjudged("", Vec::new(), Vec::new())
+        SelectorView::unjudged(ScoreColumn::NONE, Vec::new(), Vec::new())
     }
 
     fn chosen(&self) -> Option<usize> {

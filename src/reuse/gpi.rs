@@ -47,7 +47,8 @@ use rand::rngs::StdRng;
 
 use super::definition::{check_label, MethodKind, ReuseMethod, Tested};
 use super::{
-    Actor, Combined, Evaluate, Learning, Library, ReuseError, Selector, SelectorView, StateValues,
+    Actor, Combined, Evaluate, Learning, Library, ReuseError, ScoreColumn, Selector, SelectorView,
+    StateValues,
 };
 use crate::sapnet::SapNetParams;
 
@@ -252,6 +253,13 @@ pub fn choose(learner: &[f32], sources: &[Vec<f32>]) -> Combined {
     best
 }
 
+/// GPI's score: the steps each source's value won the maximum.
+pub const SCORE: ScoreColumn = ScoreColumn {
+    name: "wins",
+    meaning: "wins: steps its Q won the max; P: their share",
+    counted: true,
+};
+
 impl Selector for Gpi {
     fn learning(&self) -> Learning {
         Learning::Learner
@@ -288,7 +296,7 @@ impl Selector for Gpi {
     /// Scores: the steps each source's Q-value won the maximum; probabilities: their share
     /// of all steps (the learner and exploring steps hold the rest).
     fn view(&self) -> SelectorView {
-        self.wins.view("wins")
+        self.wins.view(SCORE)
     }
 
     fn chosen(&self) -> Option<usize> {
@@ -320,7 +328,7 @@ impl FollowedCounts {
     }
 
     /// The counts as the scores, their share of all steps as the probabilities.
-    pub fn view(&self, score_name: &'static str) -> SelectorView {
+    pub fn view(&self, score: ScoreColumn) -> SelectorView {
         let total = (self.sources.iter().sum::<u64>() + self.learner) as f64;
         let probabilities = self
             .sources
@@ -328,7 +336,7 @@ impl FollowedCounts {
             .map(|&c| if total > 0.0 { c as f64 / total } else { 0.0 })
             .collect();
         let scores = self.sources.iter().map(|&c| c as f64).collect();
-        SelectorView::unjudged(score_name, scores, probabilities)
+        SelectorView::unjudged(score, scores, probabilities)
     }
 }
 

@@ -195,11 +195,30 @@ pub struct Activation {
     pub calls: Vec<TraceStep>,
 }
 
+/// What a selector's scores are, as its own file says: the column's header, what the
+/// column and P(π) mean (the Run view's `?` line), and whether the scores count steps
+/// (shown as whole numbers).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ScoreColumn {
+    /// The column's header: `A` (SAP-Net's activation), `mean`, `W`…
+    pub name: &'static str,
+    pub meaning: &'static str,
+    pub counted: bool,
+}
+
+impl ScoreColumn {
+    /// A method with no sources to score (DQN from scratch).
+    pub const NONE: Self = Self {
+        name: "",
+        meaning: "",
+        counted: false,
+    };
+}
+
 /// What a selector shows of itself: one score and one probability per source.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SelectorView {
-    /// What the scores are, as a column header: `A` (SAP-Net's activation), `UCB`, `W`.
-    pub score_name: &'static str,
+    pub score: ScoreColumn,
     pub scores: Vec<f64>,
     /// The probability that each source is picked at the next choice.
     pub probabilities: Vec<f64>,
@@ -215,10 +234,10 @@ pub struct SelectorView {
 impl SelectorView {
     /// The view of a selector that judges nothing and excludes no source: no judgments,
     /// one zero per source.
-    pub fn unjudged(score_name: &'static str, scores: Vec<f64>, probabilities: Vec<f64>) -> Self {
+    pub fn unjudged(score: ScoreColumn, scores: Vec<f64>, probabilities: Vec<f64>) -> Self {
         let n = scores.len();
         Self {
-            score_name,
+            score,
             scores,
             probabilities,
             positive: vec![0; n],

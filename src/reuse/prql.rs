@@ -21,7 +21,9 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 use super::definition::{check_label, MethodKind, ReuseMethod, Tested};
-use super::{Actor, EpisodeEnd, Learning, Library, ReuseError, Selector, SelectorView};
+use super::{
+    Actor, EpisodeEnd, Learning, Library, ReuseError, ScoreColumn, Selector, SelectorView,
+};
 use crate::ron_file::Got;
 use crate::sapnet::SapNetParams;
 
@@ -225,6 +227,13 @@ impl Prql {
     }
 }
 
+/// PRQ-learning's score: each source's mean scaled discounted return.
+pub const SCORE: ScoreColumn = ScoreColumn {
+    name: "W",
+    meaning: "W: mean scaled discounted return; P: softmax(τ·W)",
+    counted: false,
+};
+
 impl Selector for Prql {
     fn learning(&self) -> Learning {
         Learning::Learner
@@ -273,7 +282,7 @@ impl Selector for Prql {
     /// Scores: W of each source, in [0, 1] (the learner's is not a source's).
     fn view(&self) -> SelectorView {
         SelectorView::unjudged(
-            "W",
+            SCORE,
             self.w[1..].to_vec(),
             self.probabilities()[1..].to_vec(),
         )

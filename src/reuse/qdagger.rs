@@ -38,7 +38,7 @@ use serde::{Deserialize, Serialize};
 use super::definition::{check_label, MethodKind, ReuseMethod, Tested};
 use super::{
     argmax_f32, Actor, Combined, Distillation, EpisodeEnd, LearnerRound, Learning, Library,
-    ReuseError, Selector, SelectorView, StateValues,
+    ReuseError, ScoreColumn, Selector, SelectorView, StateValues,
 };
 use crate::ron_file::Got;
 use crate::sapnet::SapNetParams;
@@ -255,6 +255,13 @@ impl QDagger {
     }
 }
 
+/// QDagger's score: the distillation weight λ_t, on its teacher's row.
+pub const SCORE: ScoreColumn = ScoreColumn {
+    name: "λ",
+    meaning: "λ: λ_t on the teacher's row; P: the teacher's share",
+    counted: false,
+};
+
 impl Selector for QDagger {
     fn learning(&self) -> Learning {
         Learning::Learner
@@ -370,7 +377,7 @@ impl Selector for QDagger {
         if self.steps > 0 {
             probabilities[self.teacher] = self.teacher_steps_acted as f64 / self.steps as f64;
         }
-        SelectorView::unjudged("λ", scores, probabilities)
+        SelectorView::unjudged(SCORE, scores, probabilities)
     }
 
     fn chosen(&self) -> Option<usize> {

@@ -38,7 +38,8 @@ use serde::{Deserialize, Serialize};
 use super::definition::{MethodKind, ReuseMethod, Tested};
 use super::gpi::{check_learner, learner_label, FollowedCounts};
 use super::{
-    argmax_f32, Actor, Combined, Learning, Library, ReuseError, Selector, SelectorView, StateValues,
+    argmax_f32, Actor, Combined, Learning, Library, ReuseError, ScoreColumn, Selector,
+    SelectorView, StateValues,
 };
 use crate::sapnet::SapNetParams;
 
@@ -213,6 +214,13 @@ pub fn choose(learner: &[f32], own: usize, sources: &[Vec<f32>]) -> Combined {
     best
 }
 
+/// The Q-switch's score: the steps that took each source's proposal.
+pub const SCORE: ScoreColumn = ScoreColumn {
+    name: "followed",
+    meaning: "followed: steps that took its action; P: their share",
+    counted: true,
+};
+
 impl Selector for QSwitch {
     fn learning(&self) -> Learning {
         Learning::Learner
@@ -248,7 +256,7 @@ impl Selector for QSwitch {
     /// Scores: the steps each source's action was followed; probabilities: their share of
     /// all steps (the learner's own actions hold the rest).
     fn view(&self) -> SelectorView {
-        self.followed.view("followed")
+        self.followed.view(SCORE)
     }
 
     fn chosen(&self) -> Option<usize> {

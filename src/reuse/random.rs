@@ -7,7 +7,9 @@ use rand::rngs::StdRng;
 use rand::Rng;
 
 use super::definition::{MethodKind, ReuseMethod, Tested};
-use super::{Actor, EpisodeEnd, Learning, Library, ReuseError, Selector, SelectorView};
+use super::{
+    Actor, EpisodeEnd, Learning, Library, ReuseError, ScoreColumn, Selector, SelectorView,
+};
 use crate::sapnet::SapNetParams;
 
 /// A uniform draw over the sources.
@@ -44,6 +46,13 @@ impl Random {
     }
 }
 
+/// Random's score: the steps each source acted.
+pub const SCORE: ScoreColumn = ScoreColumn {
+    name: "acted",
+    meaning: "acted: steps it acted; P: 1/N (per episode: 1 drawn)",
+    counted: true,
+};
+
 impl Selector for Random {
     fn learning(&self) -> Learning {
         Learning::ActingSource
@@ -74,7 +83,7 @@ impl Selector for Random {
             probabilities[i] = 1.0;
         }
         SelectorView::unjudged(
-            "acted",
+            SCORE,
             self.acted.iter().map(|&n| n as f64).collect(),
             probabilities,
         )

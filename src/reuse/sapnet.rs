@@ -12,7 +12,7 @@ use super::exclusion::{Exclusion, Exclusions};
 use super::parameter_schedule::Schedule;
 use super::{
     Activation, Actor, Deposit, EpisodeEnd, Feedback, Learning, Library, Needs, ReuseError,
-    Selector, SelectorView,
+    ScoreColumn, Selector, SelectorView,
 };
 use crate::sapnet::{self, PolicyDescription, SapNet, SapNetError, SapNetParams, TraceStep};
 
@@ -328,6 +328,13 @@ impl SapNetSelector {
     }
 }
 
+/// SAP-Net's score: each source's activation A (eq. 5).
+pub const SCORE: ScoreColumn = ScoreColumn {
+    name: "A",
+    meaning: "A: activation (eq. 5); P: the softmax of A (eq. 6)",
+    counted: false,
+};
+
 impl Selector for SapNetSelector {
     fn learning(&self) -> Learning {
         Learning::ActingSource
@@ -451,7 +458,7 @@ impl Selector for SapNetSelector {
 
     fn view(&self) -> SelectorView {
         SelectorView {
-            score_name: "A",
+            score: SCORE,
             scores: self.net.activations().to_vec(),
             probabilities: self.probabilities(),
             positive: self.positive.clone(),

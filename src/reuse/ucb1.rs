@@ -6,7 +6,9 @@
 use rand::rngs::StdRng;
 
 use super::definition::{MethodKind, ReuseMethod, Tested};
-use super::{Actor, EpisodeEnd, Learning, Library, ReuseError, Selector, SelectorView};
+use super::{
+    Actor, EpisodeEnd, Learning, Library, ReuseError, ScoreColumn, Selector, SelectorView,
+};
 use crate::sapnet::SapNetParams;
 
 #[derive(Debug)]
@@ -52,6 +54,13 @@ impl Ucb1 {
     }
 }
 
+/// UCB1's score: the mean scaled return of each source's pulls.
+pub const SCORE: ScoreColumn = ScoreColumn {
+    name: "mean",
+    meaning: "mean: scaled return of its pulls; P: 1 on the next",
+    counted: false,
+};
+
 impl Selector for Ucb1 {
     fn learning(&self) -> Learning {
         Learning::ActingSource
@@ -83,7 +92,7 @@ impl Selector for Ucb1 {
             .current
             .unwrap_or_else(|| super::argmax(&self.indices()));
         probabilities[next] = 1.0;
-        SelectorView::unjudged("mean", self.means.clone(), probabilities)
+        SelectorView::unjudged(SCORE, self.means.clone(), probabilities)
     }
 
     /// The source played most (the best mean on a tie).

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 
 use super::manifest::{self, LibraryTraining};
-use super::{library_dir, plan, policy_files, InterTaskMapping, SourceTask, Spaces};
+use super::{library_dir, plan, policy_files, InterTaskMapping, SourcePlan, SourceTask, Spaces};
 use crate::config::Config;
 use crate::policy_store;
 use crate::sapnet::PolicyDescription;
@@ -70,8 +70,40 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
     if dir.is_dir() {
         super::import::recover(&dir)?;
     }
-    let Some(found) = manifest::read(&dir)? else {
-        let on_disk = policy_files(&dir)?;
+    let found = read_manifest(&dir, library)?;
+    let wanted = LibraryTraining::of(config);
+    check_against_config(config, &dir, &found, &wanted)?;
+    let (observation_size, action_count) = crate::env::spaces(&config.env)?;
+    let target = Spaces {
+        observation_size,
+        action_count,
+    };
+    let fits = task_spaces(&dir, &wanted, target)?;
+    let mut sources = Vec::with_capacity(found.policies.len() + found.imported.len());
+    for (entry, planned) in found.policies.iter().zip(&plan(config)) {
+        let task = &wanted.tasks[planned.task];
+        sources.push(planned_source(
+            &dir,
+            entry,
+            planned,
+            task,
+            fits[planned.task],
+            target,
+        )?);
+    }
+    // An imported policy's category is the task it was imported for, named as the config
+    // names that task.
+    for entry in &found.imported {
+        sources.push(imported_source(&dir, entry, &wanted, target)?);
+    }
+    Ok(sources)
+}
+
+/// The library's manifest; without one, what to do: train the library, or check the
+/// policies an older sapnet left against the config.
+fn read_manifest(dir: &Path, library: &Path) -> Result<manifest::Manifest> {
+    let Some(found) = manifest::read(dir)? else {
+        let on_disk = policy_files(dir)?;
         if on_disk.is_empty() {
             bail!(
                 "the source library {} holds no policies; train it with `sapnet sources \
@@ -89,8 +121,19 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
             library.display()
         );
     };
-    let manifest_path = manifest::path(&dir);
-    let wanted = LibraryTraining::of(config);
+    Ok(found)
+}
+
+/// The library is the config's: its tasks and their mappings, finished, of
+/// `sources.count`, and nothing on disk that its manifest does not list (settings that
+/// differ only warn: the library is reused as it is).
+fn check_against_config(
+    config: &Config,
+    dir: &Path,
+    found: &manifest::Manifest,
+    wanted: &LibraryTraining,
+) -> Result<()> {
+    let manifest_path = manifest::path(dir);
     let trained = |tasks: &[SourceTask]| -> Vec<SourceTask> {
         tasks.iter().map(SourceTask::trained).collect()
     };
@@ -161,7 +204,7 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
             dir.display()
         );
     }
-    if let Some(stray) = policy_files(&dir)?.into_iter().find(|name| {
+    if let Some(stray) = policy_files(dir)?.into_iter().find(|name| {
         !found
             .policies
             .iter()
@@ -175,40 +218,11 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
             manifest_path.display()
         );
     }
+    Ok(())
+}
 
-    let (observation_size, action_count) = crate::env::spaces(&config.env)?;
-    let target = Spaces {
-        observation_size,
-        action_count,
-    };
-    let plans = plan(config);
-    let load =
-        |entry: &manifest::ManifestEntry, spaces: Spaces| -> Result<policy_store::StoredPolicy> {
-            let stored = policy_store::load_for_task(
-                &dir,
-                &entry.name,
-                spaces.observation_size,
-                spaces.action_count,
-            )?;
-            let metadata_path = policy_store::paths(&dir, &entry.name).1;
-            let metadata_sha256 = policy_store::sha256_hex(
-                &std::fs::read(&metadata_path)
-                    .with_context(|| format!("reading {}", metadata_path.display()))?,
-            );
-            if stored.metadata.weights_sha256 != entry.weights_sha256
-                || metadata_sha256 != entry.metadata_sha256
-            {
-                bail!(
-                    "policy {} is not the one {} records (its files changed after the library was \
-                 written); retrain the library with `sapnet sources --retrain`",
-                    metadata_path.display(),
-                    manifest_path.display()
-                );
-            }
-            Ok(stored)
-        };
-    let mut sources = Vec::with_capacity(found.policies.len() + found.imported.len());
-    // Each task's spaces and the mapping that takes them to the target's, checked once.
+/// Each source task's spaces, checked once against the target's through its mapping.
+fn task_spaces(dir: &Path, wanted: &LibraryTraining, target: Spaces) -> Result<Vec<Spaces>> {
     let mut fits = Vec::with_capacity(wanted.tasks.len());
     for (i, task) in wanted.tasks.iter().enumerate() {
         let spaces = match &task.mapping {
@@ -230,58 +244,102 @@ pub fn load_library(config: &Config, library: &Path) -> Result<Vec<SourcePolicy>
         .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
         fits.push(spaces);
     }
-    for (entry, planned) in found.policies.iter().zip(&plans) {
-        let task = &wanted.tasks[planned.task];
-        let mut stored = load(entry, fits[planned.task])?;
-        let metadata_path = policy_store::paths(&dir, &entry.name).1;
-        if entry.name != planned.name || stored.metadata.source_task != task.env.as_recorded() {
-            bail!(
-                "policy {} was trained on {}, but the config puts {} on {}; retrain the library \
-                 with `sapnet sources --retrain` or use another --library",
-                metadata_path.display(),
-                stored.metadata.source_task.label(),
-                planned.name,
-                task.label
-            );
-        }
-        if let Some(mapping) = &task.mapping {
-            stored.net = mapping
-                .translate(&stored.net, target)
-                .with_context(|| format!("mapping {} to the target", metadata_path.display()))?;
-        }
-        sources.push(SourcePolicy::new(
-            entry.name.clone(),
-            stored.net,
-            PolicyDescription {
-                hidden: stored.metadata.architecture.hidden.clone(),
-                activation: stored.metadata.activation.clone(),
-                source_task: task.label.clone(),
-            },
-            stored.metadata.final_score,
-        )?);
+    Ok(fits)
+}
+
+/// A policy's files, loaded for `spaces` and checked against the hashes the manifest
+/// records.
+fn load_checked(
+    dir: &Path,
+    entry: &manifest::ManifestEntry,
+    spaces: Spaces,
+) -> Result<policy_store::StoredPolicy> {
+    let stored = policy_store::load_for_task(
+        dir,
+        &entry.name,
+        spaces.observation_size,
+        spaces.action_count,
+    )?;
+    let metadata_path = policy_store::paths(dir, &entry.name).1;
+    let metadata_sha256 = policy_store::sha256_hex(
+        &std::fs::read(&metadata_path)
+            .with_context(|| format!("reading {}", metadata_path.display()))?,
+    );
+    if stored.metadata.weights_sha256 != entry.weights_sha256
+        || metadata_sha256 != entry.metadata_sha256
+    {
+        bail!(
+            "policy {} is not the one {} records (its files changed after the library was \
+             written); retrain the library with `sapnet sources --retrain`",
+            metadata_path.display(),
+            manifest::path(dir).display()
+        );
     }
-    // An imported policy's category is the task it was imported for, named as the config
-    // names that task.
-    for entry in &found.imported {
-        let stored = load(entry, target)?;
-        let recorded = &stored.metadata.source_task;
-        let label = wanted
-            .tasks
-            .iter()
-            .find(|t| &t.env.as_recorded() == recorded)
-            .map_or_else(|| recorded.label(), |t| t.label.clone());
-        sources.push(SourcePolicy::new(
-            entry.name.clone(),
-            stored.net,
-            PolicyDescription {
-                hidden: stored.metadata.architecture.hidden.clone(),
-                activation: stored.metadata.activation.clone(),
-                source_task: label,
-            },
-            stored.metadata.final_score,
-        )?);
+    Ok(stored)
+}
+
+/// A planned source: trained on its task as the config says, mapped to the target.
+fn planned_source(
+    dir: &Path,
+    entry: &manifest::ManifestEntry,
+    planned: &SourcePlan,
+    task: &SourceTask,
+    spaces: Spaces,
+    target: Spaces,
+) -> Result<SourcePolicy> {
+    let mut stored = load_checked(dir, entry, spaces)?;
+    let metadata_path = policy_store::paths(dir, &entry.name).1;
+    if entry.name != planned.name || stored.metadata.source_task != task.env.as_recorded() {
+        bail!(
+            "policy {} was trained on {}, but the config puts {} on {}; retrain the library \
+             with `sapnet sources --retrain` or use another --library",
+            metadata_path.display(),
+            stored.metadata.source_task.label(),
+            planned.name,
+            task.label
+        );
     }
-    Ok(sources)
+    if let Some(mapping) = &task.mapping {
+        stored.net = mapping
+            .translate(&stored.net, target)
+            .with_context(|| format!("mapping {} to the target", metadata_path.display()))?;
+    }
+    Ok(SourcePolicy::new(
+        entry.name.clone(),
+        stored.net,
+        PolicyDescription {
+            hidden: stored.metadata.architecture.hidden.clone(),
+            activation: stored.metadata.activation.clone(),
+            source_task: task.label.clone(),
+        },
+        stored.metadata.final_score,
+    )?)
+}
+
+/// An imported source, its category the config's name of the task it was imported for.
+fn imported_source(
+    dir: &Path,
+    entry: &manifest::ManifestEntry,
+    wanted: &LibraryTraining,
+    target: Spaces,
+) -> Result<SourcePolicy> {
+    let stored = load_checked(dir, entry, target)?;
+    let recorded = &stored.metadata.source_task;
+    let label = wanted
+        .tasks
+        .iter()
+        .find(|t| &t.env.as_recorded() == recorded)
+        .map_or_else(|| recorded.label(), |t| t.label.clone());
+    Ok(SourcePolicy::new(
+        entry.name.clone(),
+        stored.net,
+        PolicyDescription {
+            hidden: stored.metadata.architecture.hidden.clone(),
+            activation: stored.metadata.activation.clone(),
+            source_task: label,
+        },
+        stored.metadata.final_score,
+    )?)
 }
 
 /// Whether the library of `config` under `library` is missing or its training unfinished

@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize, Serializer};
 
 use crate::dqn::UpdateReport;
 pub use crate::reuse::Deposit;
-use crate::reuse::{Method, MethodKind};
+use crate::reuse::{Method, MethodKind, ScoreColumn};
 use crate::sapnet::{PolicyDescription, SapNet, TraceStep};
 
 /// Which learner a run trains: its place in `protocol.methods`, its kind and its label in
@@ -254,7 +254,7 @@ pub struct LibraryStart {
     pub policies: Vec<SourceSummary>,
     pub net: SapNet,
     /// What the selector's scores are: `A` for SAP-Net's activations, else its own.
-    pub score_name: &'static str,
+    pub score: ScoreColumn,
 }
 
 /// One environment step.
@@ -291,7 +291,7 @@ pub struct ActivationSnapshot {
     pub step: u64,
     pub episode: u32,
     /// What the scores are: `A` for SAP-Net's activations 𝔸, or the selector's own.
-    pub score_name: &'static str,
+    pub score: ScoreColumn,
     /// The selector's score of each source (SAP-Net: 𝔸).
     pub activations: Vec<f64>,
     /// The probability of picking each source next (SAP-Net: P(π_i), eq. 6).

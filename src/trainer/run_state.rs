@@ -494,7 +494,7 @@ impl<'a> Run<'a> {
             name: spec.sources[chosen].name.clone(),
             hidden: spec.sources[chosen].description.hidden.clone(),
             score: view.scores[chosen],
-            score_name: view.score_name.into(),
+            score_name: view.score.name.into(),
         });
         let net = self.networks.take_net(chosen)?;
         if !record.stopped {
@@ -547,7 +547,7 @@ impl<'a> Run<'a> {
             method: self.spec.method.clone(),
             step: self.steps,
             episode,
-            score_name: view.score_name,
+            score: view.score,
             activations: view.scores,
             probabilities: view.probabilities,
             selections: self.tally.run.clone(),
@@ -593,7 +593,7 @@ fn library_start(spec: &RunSpec, selector: &dyn Selector) -> Option<Box<LibraryS
             })
             .collect(),
         net,
-        score_name: selector.view().score_name,
+        score: selector.view().score,
     }))
 }
 

@@ -26,9 +26,7 @@
 //! - [`graph_layout`]: the graph's geometry, which the state (moving the cursor) and the
 //!   views share. The state modules import no view.
 //!
-//! Stand-alone teach mode ([`run_teach`]) still has a loop of its own: teach's state and
-//! view are being restructured elsewhere, and join [`event_loop`] as a [`event_loop::Screen`]
-//! once they are.
+//! - [`teach_screen`]: stand-alone teach mode ([`run_teach`]), a screen of the same loop.
 
 pub mod dashboard;
 pub mod dashboard_view;
@@ -40,6 +38,7 @@ pub mod keys;
 pub mod reference;
 pub mod row_window;
 pub mod screen;
+pub mod teach_screen;
 pub mod teach_view;
 pub mod theme;
 pub mod view;
@@ -48,11 +47,10 @@ pub mod workbench;
 use std::time::Duration;
 
 use anyhow::{Context, Result};
-use crossterm::event::{self as term, KeyEventKind, MouseButton, MouseEventKind};
 
-use crate::teach::session::CALLS_PER_FRAME;
 use crate::teach::Teach;
-use dashboard::{apply_teach_key, Dashboard};
+use dashboard::Dashboard;
+use teach_screen::TeachScreen;
 use theme::Theme;
 
 /// The time between frames: about 30 per second.
@@ -100,71 +98,8 @@ pub fn click(dashboard: &mut Dashboard, area: ratatui::layout::Rect, column: u16
 }
 
 /// Runs stand-alone teach mode until the user quits.
-pub fn run_teach(mut teach: Teach) -> Result<()> {
-    let theme = Theme::from_env();
-    let (mut terminal, _guard) = open_terminal()?;
-    let mut help = false;
-    loop {
-        if crate::signals::received().is_some() {
-            return Ok(());
-        }
-        // A long `r` runs in slices between frames: keys are read between them.
-        teach.advance(CALLS_PER_FRAME);
-        terminal
-            .draw(|frame| teach_view::draw(frame, &teach, help, theme))
-            .context("drawing teach mode")?;
-        let wait = if teach.is_running() {
-            Duration::ZERO
-        } else {
-            FRAME
-        };
-        if !term::poll(wait).context("reading the keyboard")? {
-            continue;
-        }
-        let key = match term::read().context("reading the keyboard")? {
-            term::Event::Key(key) => key,
-            term::Event::Mouse(mouse) => {
-                if !help && mouse.kind == MouseEventKind::Down(MouseButton::Left) {
-                    let size = terminal.size().context("reading the terminal's size")?;
-                    if let Some(i) =
-                        teach_view::clicked(&teach, size.into(), mouse.column, mouse.row)
-                    {
-                        teach.pick(i);
-                    }
-                }
-                continue;
-            }
-            _ => continue,
-        };
-        if key.kind != KeyEventKind::Press {
-            continue;
-        }
-        // A line being typed (`w`, `E`) takes q and Esc too.
-        if teach.prompt().is_some() && !is_ctrl_c(key) {
-            apply_teach_key(&mut teach, key);
-            continue;
-        }
-        if is_quit(key) {
-            return Ok(());
-        }
-        if help {
-            help = false;
-        } else if key.code == term::KeyCode::Char('?') {
-            help = true;
-        } else if key.code == term::KeyCode::Esc {
-            return Ok(());
-        } else {
-            apply_teach_key(&mut teach, key);
-        }
-    }
-}
-
-fn is_quit(key: term::KeyEvent) -> bool {
-    key.code == term::KeyCode::Char('q') || is_ctrl_c(key)
-}
-
-fn is_ctrl_c(key: term::KeyEvent) -> bool {
-    key.code == term::KeyCode::Char('c') && key.modifiers.contains(term::KeyModifiers::CONTROL)
+pub fn run_teach(teach: Teach) -> Result<()> {
+    event_loop::show(&mut TeachScreen::new(teach, Theme::from_env()))
 }
 
 #[cfg(test)]

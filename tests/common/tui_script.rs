@@ -56,7 +56,7 @@ pub fn sapnet_start() -> Event {
                 })
                 .collect(),
             net,
-            score_name: "A",
+            score: sapnet::reuse::sapnet::SCORE,
         })),
     }
 }
@@ -124,7 +124,7 @@ pub fn episodes(episodes: u32) -> Vec<Event> {
             run: 0,
             method: method("sapnet"),
             step,
-            score_name: "A",
+            score: sapnet::reuse::sapnet::SCORE,
             episode,
             activations: activations.clone(),
             probabilities: terms.iter().map(|t| t / total).collect(),
@@ -185,7 +185,7 @@ pub fn probabilities_at(method: MethodId, step: u64, probabilities: Vec<f64>) ->
         method,
         step,
         episode: 1,
-        score_name: "A",
+        score: sapnet::reuse::sapnet::SCORE,
         activations: vec![0.0; n],
         probabilities,
         selections: vec![0; n],

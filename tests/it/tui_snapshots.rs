@@ -308,7 +308,7 @@ fn another_selector_is_drawn_under_its_own_scores() {
     } = &mut start
     {
         *method = sapnet::trainer::MethodId::new(7, &sapnet::reuse::Method::Ucb1);
-        sapnet.as_mut().unwrap().score_name = "mean";
+        sapnet.as_mut().unwrap().score = sapnet::reuse::ucb1::SCORE;
     }
     let mut d = Dashboard::new("CartPole-v1");
     d.on_event(start);

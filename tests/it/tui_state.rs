@@ -312,11 +312,11 @@ fn m_follows_the_next_method_and_late_events_of_the_old_one_are_left_out() {
     } = &mut start
     {
         *method = sapnet::trainer::MethodId::new(7, &sapnet::reuse::Method::Ucb1);
-        sapnet.as_mut().unwrap().score_name = "mean";
+        sapnet.as_mut().unwrap().score = sapnet::reuse::ucb1::SCORE;
     }
     d.on_event(start);
     let view = d.library.as_ref().unwrap();
-    assert_eq!((view.method.as_str(), view.score_name), ("ucb1", "mean"));
+    assert_eq!((view.method.as_str(), view.score.name), ("ucb1", "mean"));
     assert_eq!(d.runs[0].method.label(), "ucb1");
     // A paused dashboard starts the new run paused, at its speed.
     d.on_key(key(' '));
@@ -375,7 +375,7 @@ fn a_method_that_picks_by_rule_never_shows_a_lock_in() {
     } = &mut start
     {
         *method = ucb1.clone();
-        sapnet.as_mut().unwrap().score_name = "mean";
+        sapnet.as_mut().unwrap().score = sapnet::reuse::ucb1::SCORE;
     }
     let mut d = Dashboard::new("CartPole-v1");
     d.on_event(start);

@@ -182,7 +182,7 @@ impl Dashboard {
                     let n = start.net.len();
                     self.library = Some(LibraryView {
                         method: run.method.label().to_string(),
-                        score_name: start.score_name,
+                        score: start.score,
                         policies: start
                             .policies
                             .into_iter()

@@ -4,6 +4,7 @@
 use std::collections::VecDeque;
 
 use crate::config::Budget;
+use crate::reuse::ScoreColumn;
 use crate::sapnet::{PolicyDescription, Prototype, SapNet};
 use crate::teach::labels::short_task;
 use crate::trainer::{MethodId, RunRecord};
@@ -31,7 +32,7 @@ pub struct LibraryView {
     /// The method whose selector this is (`sapnet`, `ucb1`…).
     pub method: String,
     /// What the scores are: `A` for SAP-Net's activations, else the selector's own.
-    pub score_name: &'static str,
+    pub score: ScoreColumn,
     pub policies: Vec<PolicyRow>,
     /// The graph and parameters, with the activations of the latest snapshot.
     pub net: SapNet,

@@ -1,6 +1,8 @@
 //! How the dashboard writes its figures where columns are narrow: counts, large step
 //! numbers, activations, and a row of scores as a sparkline.
 
+use crate::reuse::ScoreColumn;
+
 /// `1234567` → `1,234,567`.
 pub(super) fn thousands(n: u64) -> String {
     let digits = n.to_string();
@@ -39,14 +41,11 @@ pub(super) fn count(n: u64) -> String {
     }
 }
 
-/// The score columns that count steps (random's `acted`, GPI's `wins`, the Q-switch's
-/// `followed`): whole numbers, shown without decimals.
-const COUNTED: [&str; 3] = ["acted", "wins", "followed"];
-
-/// A score in the table's nine characters: a count as a whole number (`47262`; `−1200`
-/// less the highest, with `v`), anything else as [`format_activation`].
-pub(super) fn format_score(score_name: &str, a: f64) -> String {
-    if COUNTED.contains(&score_name) {
+/// A score in the table's nine characters: a count (random's `acted`, GPI's `wins`…) as a
+/// whole number (`47262`; `−1200` less the highest, with `d`), anything else as
+/// [`format_activation`].
+pub(super) fn format_score(score: ScoreColumn, a: f64) -> String {
+    if score.counted {
         format!("{a:.0}").replace('-', "−")
     } else {
         format_activation(a)
@@ -66,16 +65,17 @@ pub(super) fn format_activation(a: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::{count, format_score, sparkline};
+    use crate::reuse::{a2t, gpi, qswitch, random, sapnet};
 
     #[test]
     fn counted_scores_have_no_decimals_and_the_others_three() {
-        assert_eq!(format_score("wins", 47262.0), "47262");
-        assert_eq!(format_score("followed", 143_250.0), "143250");
-        assert_eq!(format_score("acted", 0.0), "0");
-        // `v`: a count less the highest.
-        assert_eq!(format_score("wins", -1200.0), "−1200");
-        assert_eq!(format_score("A", 12.34567), "12.346");
-        assert_eq!(format_score("w̄", 0.25), "0.250");
+        assert_eq!(format_score(gpi::SCORE, 47262.0), "47262");
+        assert_eq!(format_score(qswitch::SCORE, 143_250.0), "143250");
+        assert_eq!(format_score(random::SCORE, 0.0), "0");
+        // `d`: a count less the highest.
+        assert_eq!(format_score(gpi::SCORE, -1200.0), "−1200");
+        assert_eq!(format_score(sapnet::SCORE, 12.34567), "12.346");
+        assert_eq!(format_score(a2t::SCORE, 0.25), "0.250");
     }
 
     #[test]

@@ -12,10 +12,10 @@ use crate::tui::theme::Theme;
 /// "SAP-Net graph", or for another method the scores it keeps; the categories left out of
 /// the candidates counted.
 pub(super) fn title(view: &LibraryView) -> String {
-    let mut title = if view.score_name == "A" {
+    let mut title = if view.score == crate::reuse::sapnet::SCORE {
         "SAP-Net graph".to_string()
     } else {
-        format!("library graph · {} ({})", view.method, view.score_name)
+        format!("library graph · {} ({})", view.method, view.score.name)
     };
     let out = view.excluded.iter().filter(|&&e| e).count();
     if out > 0 {

@@ -111,9 +111,9 @@ pub(super) fn draw(
         .copied()
         .fold(f64::NEG_INFINITY, f64::max);
     let score_header = if relative {
-        format!("{}−max", view.score_name)
+        format!("{}−max", view.score.name)
     } else {
-        view.score_name.to_string()
+        view.score.name.to_string()
     };
     let top = graph_view::highest(view.net.activations().iter().copied());
     // Columns give way from the right of the wish list as the panel narrows: the graph
@@ -160,7 +160,7 @@ pub(super) fn draw(
                 }));
             }
             cells.push(Cell::from(format_score(
-                view.score_name,
+                view.score,
                 if relative { a - highest } else { a },
             )));
             cells.push(Cell::from(probability_bar(probability, bar_width)));

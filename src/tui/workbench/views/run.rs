@@ -307,11 +307,11 @@ impl View for RunView {
     }
 
     fn legend(&self, _: &()) -> Vec<(&'static str, &'static str)> {
-        let score_name = self
+        let score = self
             .followed_run()
             .and_then(|r| r.dashboard.library.as_ref())
-            .map(|l| l.score_name);
-        dashboard_view::legend(score_name)
+            .map(|l| l.score);
+        dashboard_view::legend(score)
     }
 
     fn on_mouse(&mut self, _: &(), mouse: MouseEvent, area: Rect) -> Outcome<Infallible> {
