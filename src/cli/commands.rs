@@ -87,8 +87,9 @@ pub struct CompareArgs {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// The lowest and highest return of the task, which normalise the scores (the
-    /// optimality gap, the profiles). Default: a results folder's task, else the lowest
-    /// and highest return read (with a warning: adding a run would move every score).
+    /// optimality gap, the profiles). Default: when every run comes from results folders
+    /// of one task, that task's range; else the lowest and highest return read (with a
+    /// warning: adding a run would move every score).
     #[arg(long, num_args = 2, value_names = ["LO", "HI"], allow_negative_numbers = true)]
     pub range: Option<Vec<f64>>,
     /// The final score is the mean return of each run's last K episodes.
@@ -106,7 +107,8 @@ pub struct CompareArgs {
     /// Put the runs side by side by episode even when their files give steps.
     #[arg(long)]
     pub by_episode: bool,
-    /// The task's name in titles. Default: a results folder's task, else `runs`.
+    /// The task's name in titles. Default: the task of the results folders when every run
+    /// comes from folders of one task, else `runs`.
     #[arg(long, value_name = "NAME")]
     pub task: Option<String>,
     /// A CSV's episodic-return column. Default: the first of charts/episodic_return,

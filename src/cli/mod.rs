@@ -130,7 +130,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub tensorboard: bool,
 
-    /// Runs trained at the same time (`sweep run --all`: cells). Default: one per core.
+    /// Runs trained at the same time. Default: one per core.
     #[arg(long, value_name = "N", global = true, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=4096))]
     pub jobs: Option<usize>,
 
@@ -269,6 +269,19 @@ pub const SUBCOMMANDS: &[SubcommandFlags] = &[
     },
 ];
 
+/// A global flag's help where a subcommand reads it otherwise than the run does: the
+/// subcommand, the flag's id, its help there.
+const OWN_HELP: &[(&str, &str, &str)] = &[
+    ("env", "python", CONFIG_PYTHON),
+    ("sources", "python", CONFIG_PYTHON),
+    ("sources import", "python", CONFIG_PYTHON),
+    ("sweep run", "jobs", "Cells run at the same time with --all. Default: one per core"),
+    ("sweep run", "python", "The Python that runs the cells' Gymnasium tasks (without it: the active virtualenv's, else python3): a sweep folder never chooses it"),
+];
+
+/// `--python` for the commands that read a config and no folder.
+const CONFIG_PYTHON: &str = "The Python that runs a Gymnasium task, instead of the config's `python` (without either: the active virtualenv's, else python3)";
+
 impl SubcommandFlags {
     /// The entry of the subcommand named `name` (`sweep run`).
     pub fn of(name: &str) -> &'static Self {
@@ -302,7 +315,10 @@ pub fn command() -> clap::Command {
                 } else if let Some(help) = match id {
                     "config" => flags.config,
                     "library" => flags.library,
-                    _ => None,
+                    _ => OWN_HELP
+                        .iter()
+                        .find(|(name, flag, _)| *name == flags.name && *flag == id)
+                        .map(|(_, _, help)| *help),
                 } {
                     arg = arg.help(help);
                 }
@@ -444,8 +460,10 @@ pub enum Command {
     /// folder of an older version. Prints the comparison.
     Plot(PlotArgs),
     /// Open a results folder in the terminal UI, read only: finished, stopped, or live and
-    /// being written by another process (`sapnet --headless --out DIR` running). Views:
-    /// Runs (r) and Comparison (c); `?` lists the keys. Nothing in the folder changes.
+    /// being written by another process (`sapnet --headless --out DIR` running). Views, a
+    /// tab each: Runs (r or 1), Comparison (c, 2), Curves (v, 3) and a run's dashboard (f,
+    /// 4: Enter on a finished run in Runs); a sweep folder opens in the Sweep view. `?`
+    /// lists the keys. Nothing in the folder changes.
     Open(OpenArgs),
     /// One comparison of finished protocols on different tasks (e.g. the variants of
     /// CartPole and of MountainCar): each method's scores normalised by each task's range

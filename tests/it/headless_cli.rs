@@ -462,6 +462,39 @@ fn flags_a_subcommand_would_ignore_are_refused() {
     }
 }
 
+/// Help copied where it did not fit (issue 51): `env`'s --python spoke of resuming a results
+/// folder, `sweep run`'s --jobs of runs, the run's --jobs of cells; `open` named three views
+/// where it has four tabs.
+#[test]
+fn a_global_flags_help_fits_its_subcommand() {
+    let help = |args: &[&str]| String::from_utf8_lossy(&sapnet(args).stdout).into_owned();
+    for args in [&["env", "--help"][..], &["sources", "--help"]] {
+        let text = help(args);
+        assert!(text.contains("--python <PATH>"), "{args:?}: {text}");
+        assert!(!text.contains("resuming one"), "{args:?}: {text}");
+    }
+    let run = help(&["sweep", "run", "--help"]);
+    assert!(
+        run.contains("Cells run at the same time with --all"),
+        "{run}"
+    );
+    assert!(!run.contains("Runs trained"), "{run}");
+    let main = help(&["--help"]);
+    assert!(
+        main.contains("Runs trained at the same time. Default"),
+        "{main}"
+    );
+    let open = help(&["open", "--help"]);
+    for tab in [
+        "Runs (r or 1)",
+        "Comparison (c, 2)",
+        "Curves (v, 3)",
+        "dashboard (f, 4",
+    ] {
+        assert!(open.contains(tab), "{open}");
+    }
+}
+
 /// `sapnet teach --help` listed --seed, --jobs and --library, which teach then refused, and
 /// described --config as the CartPole config: each subcommand's help lists the global flags
 /// it reads, and only those, with its own words for --config.

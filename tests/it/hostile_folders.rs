@@ -1005,7 +1005,11 @@ fn a_signal_stops_a_long_round_of_updates_within_seconds() {
         .success());
     let signalled = Instant::now();
     let exit = wait_within(&mut child, Duration::from_secs(5), "SIGTERM in a round");
-    assert_eq!(exit.code(), Some(143), "the README's exit code for SIGTERM");
+    assert_eq!(
+        exit.code(),
+        Some(143),
+        "docs/dev/reliability.md's exit code for SIGTERM"
+    );
     eprintln!("stopped {:?} after SIGTERM", signalled.elapsed());
     assert_eq!(status(&out), "stopped");
 }
@@ -1037,7 +1041,7 @@ fn resume(out: &Path) -> Output {
         .unwrap()
 }
 
-/// The README's Reliability section: run records are read only from the results folder's
+/// docs/dev/reliability.md: run records are read only from the results folder's
 /// own directories — a `runs/` or a run's folder planted as a link is refused before a
 /// resume reads or trains anything — and only where their method and run put them; a
 /// non-UTF-8 `--out` is refused.
@@ -1174,7 +1178,7 @@ fn untextual_paths_and_number_mistakes_are_said_before_anything_runs() {
 
 // Issue 52: bounded everywhere. Each test is built from the issue's reproducer; memory is
 // checked only where a bound refuses before allocating (the peaks are measured by hand:
-// see the README's reliability page).
+// see docs/dev/reliability.md).
 
 /// A copy of `docs/cartpole/`'s data files (`summary.json`, `episodes.csv.xz`): a shipped
 /// folder, read by `plot` and `open` from its top-level files.

@@ -25,7 +25,7 @@ use std::path::Path;
 
 /// The layers of `src/`, top to bottom: a file may import files of its own layer and of the
 /// layers below it. Each entry is a module path (`sources::train` for one file of a
-/// folder); a file is in the layer of the longest entry that holds it. README's Layout
+/// folder); a file is in the layer of the longest entry that holds it. docs/dev/layout.md's
 /// table says what each module is; the order is the one its descriptions imply ("below both
 /// front ends", "pure maths") and the modules' imports after issue 35's items 1 and 3
 /// (which brought `ron_file`).

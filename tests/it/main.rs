@@ -15,6 +15,7 @@ mod common;
 
 mod compare_cli;
 mod config_files;
+mod docs_links;
 mod dqn_agent;
 mod dqn_learns;
 mod dqn_policy_store;
@@ -30,6 +31,7 @@ mod method_behaviour;
 mod other_agents;
 mod pinned_numbers;
 mod pool_cli;
+mod quick_start;
 mod received_folders;
 mod recorded_runs;
 mod resume_cli;

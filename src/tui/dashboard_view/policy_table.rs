@@ -118,7 +118,7 @@ pub(super) fn draw(
     let top = graph_view::highest(view.net.activations().iter().copied());
     // Columns give way from the right of the wish list as the panel narrows: the graph
     // already shows categories, the counts matter least. Zoomed (`z`), the scores over
-    // time come before them: at 80 columns the table keeps the sparkline (as README
+    // time come before them: at 80 columns the table keeps the sparkline (as docs/guide/running.md
     // says `z` does) and gives up the hidden layers and the +/− counts.
     let full = area.width >= FULL_TABLE_WIDTH
         && !(dashboard.zoom && area.width < FULL_TABLE_WIDTH + 1 + MIN_HISTORY_WIDTH);
