@@ -225,7 +225,7 @@ fn open_shows_a_live_folders_progress_and_changes_nothing() {
     assert_eq!(banded, done, "{bands:?}");
     let comparison = text(&screen(&workbench(&out, "c"), (120, 40)));
     assert!(
-        comparison.contains(&format!("partial: over the {done} finished runs of 6")),
+        comparison.contains(&format!("partial: over the {done} finished of 6 runs")),
         "{comparison}"
     );
     // The binary itself, as a user runs it.

@@ -208,7 +208,10 @@ fn title(
     let over = if finished == planned_runs {
         format!("all {planned_runs} runs")
     } else {
-        format!("partial: {finished} of {planned_runs} runs finished, running ones so far")
+        format!(
+            "partial: {}, running ones so far",
+            crate::tui::workbench::cells::runs_finished(finished, planned_runs)
+        )
     };
     let zoom = if curves.zoom.is_some() {
         let unit = match folder.config.protocol.budget {
