@@ -30,6 +30,7 @@
 //! view are being restructured elsewhere, and join [`event_loop`] as a [`event_loop::Screen`]
 //! once they are.
 
+pub mod background;
 pub mod dashboard;
 pub mod dashboard_view;
 pub mod event_loop;
