@@ -264,8 +264,16 @@ fn top_line(chrome: &Chrome, theme: Theme, width: usize) -> Line<'static> {
     if !chrome.tabs.is_empty() || !chrome.commands.is_empty() {
         spans.push(Span::styled("  │ ", theme.dim()));
     }
-    spans.extend(tab_spans(&chrome.tabs, theme, width));
     let mut used: usize = spans.iter().map(Span::width).sum();
+    // Each tab whole or not at all, then the keys likewise.
+    for tab in tab_spans(&chrome.tabs, theme, width).chunks(3) {
+        let wide: usize = tab.iter().map(Span::width).sum();
+        if used + wide > width {
+            break;
+        }
+        used += wide;
+        spans.extend(tab.iter().cloned());
+    }
     for &command in &chrome.commands {
         let command = command_spans(command, theme);
         let wide: usize = command.iter().map(Span::width).sum();

@@ -745,11 +745,16 @@ fn draw_pairs(
         .unwrap_or(4)
         .min(22);
     let judgements: Vec<String> = rows.iter().map(|r| r.judgement()).collect();
-    let judgement_width = judgements
-        .iter()
-        .map(|j| j.chars().count())
-        .max()
-        .unwrap_or(0);
+    // Aligned where the lines fit; on a narrow panel, not padded into a wrapped gap.
+    let judgement_width = if area.width >= BOTH_SCORES_WIDTH {
+        judgements
+            .iter()
+            .map(|j| j.chars().count())
+            .max()
+            .unwrap_or(0)
+    } else {
+        0
+    };
     let rule = Line::styled(
         format!(
             "separated: {BOOTSTRAP_SEEDS} seeds' intervals exclude ½, Holm p < 0.05 · s: other \
@@ -773,7 +778,10 @@ fn draw_pairs(
                     r.p.hi
                 )),
                 // The better method named first, whichever way the row reads.
-                Span::styled(fit(judgement, judgement_width), verdict_style),
+                Span::styled(
+                    fit(judgement, judgement_width.max(judgement.chars().count())),
+                    verdict_style,
+                ),
                 Span::raw(format!(
                     "  Holm p = {}, {}/{BOOTSTRAP_SEEDS} seeds",
                     p_value(r.holm_p),
