@@ -25,15 +25,20 @@ pub fn print_summary(summary: &results::Summary, dir: &Path) -> Result<()> {
             .iter()
             .map(|r| format!("{r:.0}"))
             .collect();
+        // A run stopped before its tests has none: said so, not as an empty list.
+        let tests = if tests.is_empty() {
+            "not tested".to_string()
+        } else {
+            format!("greedy tests [{}]", tests.join(", "))
+        };
         eprintln!(
-            "{} run {}: {} episodes, best MA{} {}, greedy tests [{}]",
+            "{} run {}: {} episodes, best MA{} {}, {tests}",
             run.record.method,
             run.record.run,
             run.record.episodes,
             config.protocol.moving_average,
             run.best_moving_average
-                .map_or("-".into(), |a| format!("{a:.1}")),
-            tests.join(", ")
+                .map_or("—".into(), |a| format!("{a:.1}")),
         );
         if let Some(chosen) = &run.record.chosen {
             eprintln!(

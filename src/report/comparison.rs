@@ -403,6 +403,16 @@ fn share_tasks(rows: &[MethodComparison]) -> Vec<String> {
         .unwrap_or_default()
 }
 
+/// An aggregate over `runs` runs as a view shows it: with its interval, or for one run
+/// its value alone (`195.3 (1 run)`): a bootstrap of one value is no interval.
+pub fn interval_of_runs(e: &Estimate, runs: usize, digits: usize) -> String {
+    if runs <= 1 {
+        format!("{:.digits$} (1 run)", e.point)
+    } else {
+        interval(e, digits)
+    }
+}
+
 /// An interval as the table shows it: `123.4 [100.2, 140.0]`, with `digits` decimals.
 pub fn interval(e: &Estimate, digits: usize) -> String {
     format!(

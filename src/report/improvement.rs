@@ -42,6 +42,31 @@ pub struct Improvement {
     pub per_task: Vec<Verdict>,
 }
 
+impl Improvement {
+    /// The pair's two methods, the better first: the one with `P(X > Y)` ≥ ½ (`method`
+    /// on a tie).
+    pub fn better_first(&self) -> (&str, &str) {
+        if self.p.point >= 0.5 {
+            (&self.method, &self.over)
+        } else {
+            (&self.over, &self.method)
+        }
+    }
+
+    /// The verdict with its direction in words, the better method first, whichever way
+    /// the row reads: `a2t over sapnet, separated` on `sapnet`'s row over `a2t` as on
+    /// `a2t`'s over `sapnet`. A pair not separated has no direction: `not separated`.
+    pub fn judgement(&self) -> String {
+        match self.verdict {
+            Verdict::NotSeparated => self.verdict.name().to_string(),
+            verdict => {
+                let (better, worse) = self.better_first();
+                format!("{better} over {worse}, {}", verdict.name())
+            }
+        }
+    }
+}
+
 /// What the rule found for one unordered pair `(i, j)`, `i < j`, of one score's methods.
 struct Judged {
     /// `P(X_i > X_j)` under each bootstrap seed, the row's own seed first.
@@ -423,6 +448,24 @@ mod tests {
         let at = header.iter().position(|h| h == "per_task").unwrap();
         let line = &records[rows.iter().position(|r| r == ab).unwrap()];
         assert_eq!(line[at], "cartpole=separated;acrobot=not separated");
+    }
+
+    #[test]
+    fn a_verdict_says_the_better_method_first_on_either_row() {
+        let methods = [
+            method("sapnet", vec![(0..20).map(f64::from).collect()]),
+            method("a2t", vec![(0..20).map(|i| 50.0 + f64::from(i)).collect()]),
+            method(
+                "a2t-too",
+                vec![(0..20).map(|i| 50.5 + f64::from(i)).collect()],
+            ),
+        ];
+        let rows = every_pair(&methods, &["cartpole".into()]);
+        let ab = row(&rows, "sapnet", "a2t");
+        assert_eq!(ab.judgement(), "a2t over sapnet, separated");
+        assert_eq!(row(&rows, "a2t", "sapnet").judgement(), ab.judgement());
+        assert_eq!(ab.better_first(), ("a2t", "sapnet"));
+        assert_eq!(row(&rows, "a2t", "a2t-too").judgement(), "not separated");
     }
 
     #[test]

@@ -8,6 +8,7 @@
 
 pub mod comparison;
 pub mod improvement;
+pub mod metric;
 pub mod plots;
 pub mod runs;
 pub mod sample_efficiency;

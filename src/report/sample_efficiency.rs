@@ -76,6 +76,19 @@ fn step_curve(
 /// The IQM and mean of `values` (one per run) at `at`, the `i`-th point, with their
 /// intervals; none without a value.
 fn point(label: &str, at: u64, i: usize, values: Vec<f64>) -> Option<EfficiencyPoint> {
+    let (runs, iqm, mean) = over_runs(label, i, values)?;
+    Some(EfficiencyPoint {
+        at,
+        runs,
+        iqm,
+        mean,
+    })
+}
+
+/// Over how many runs, and the IQM and mean of `values` (one per run) at the `i`-th point
+/// of `label`'s curve, with their 95% bootstrap intervals (the seeds named by `label`, the
+/// statistic and `i`); none without a value.
+pub fn over_runs(label: &str, i: usize, values: Vec<f64>) -> Option<(usize, Estimate, Estimate)> {
     let runs = values.len();
     let scores = Scores::one_task(values)?;
     let seed = |statistic: &str| {
@@ -89,12 +102,11 @@ fn point(label: &str, at: u64, i: usize, values: Vec<f64>) -> Option<EfficiencyP
             ],
         )
     };
-    Some(EfficiencyPoint {
-        at,
+    Some((
         runs,
-        iqm: bootstrap::interval_of(&scores, aggregate::iqm, RESAMPLES, seed("iqm")),
-        mean: bootstrap::interval_of(&scores, aggregate::mean, RESAMPLES, seed("mean")),
-    })
+        bootstrap::interval_of(&scores, aggregate::iqm, RESAMPLES, seed("iqm")),
+        bootstrap::interval_of(&scores, aggregate::mean, RESAMPLES, seed("mean")),
+    ))
 }
 
 /// The points of an episode budget.

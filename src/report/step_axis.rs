@@ -32,11 +32,22 @@ pub fn points(budget: u64, count: usize) -> Vec<u64> {
 /// episodes that ended by it, or of all that did while fewer have; `None` before its first
 /// episode ended.
 pub fn curve(run: &TrainingEpisodes, window: usize, points: &[u64]) -> Vec<Option<f64>> {
+    means_at(&run.returns, &run.ends(), window, points)
+}
+
+/// The same curve of any per-episode `values` whose episodes end at `ends` (ascending, on
+/// any axis: steps, episodes, seconds): at each of `points`, the mean of the last `window`
+/// values whose episodes ended by it, or of all that did while fewer have.
+pub fn means_at<X: PartialOrd + Copy>(
+    values: &[f64],
+    ends: &[X],
+    window: usize,
+    points: &[X],
+) -> Vec<Option<f64>> {
     let window = window.max(1);
-    let ends = run.ends();
-    // sums[i] = Σ returns[..i], for every window's mean in O(1).
+    // sums[i] = Σ values[..i], for every window's mean in O(1).
     let sums: Vec<f64> = std::iter::once(0.0)
-        .chain(run.returns.iter().scan(0.0, |sum, &r| {
+        .chain(values.iter().scan(0.0, |sum, &r| {
             *sum += r;
             Some(*sum)
         }))

@@ -12,6 +12,7 @@ pub mod pool;
 pub mod recorded_run;
 pub mod records;
 pub mod replot;
+pub mod run_metrics;
 pub mod shipped;
 pub mod summary;
 pub mod sweep;

@@ -5,7 +5,8 @@
 //! events and the pace, nothing else.
 //!
 //! The screen's threads (a protocol's runs, the folder's reader) never wait for it: each
-//! frame takes every message they sent, never parking on their channels.
+//! frame takes every message they sent, never parking on their channels. A view's work in
+//! the background ([`super::background`]) is drawn every frame while it runs.
 
 use std::time::{Duration, Instant};
 
@@ -61,9 +62,15 @@ pub trait Screen {
 /// Runs `screen` on `terminal` until it quits, or fails to draw or read the keyboard.
 pub fn run(terminal: &mut ratatui::DefaultTerminal, screen: &mut impl Screen) -> Result<()> {
     let mut dirty = true;
+    let mut ended = super::background::ended();
     loop {
         let (changed, flow) = screen.drain();
         dirty |= changed;
+        // A view's work in the background: drawn while it runs (its sign of work), and
+        // once more when a piece ends (its result).
+        let now_ended = super::background::ended();
+        dirty |= now_ended != ended || super::background::busy();
+        ended = now_ended;
         if flow == Flow::Quit {
             return Ok(());
         }

@@ -29,6 +29,7 @@
 //! - [`teach_screen`]: stand-alone teach mode ([`run_teach`]), a screen of the same loop;
 //!   [`teach_keys`]: teach mode's one key table, alone or on the dashboard.
 
+pub mod background;
 pub mod dashboard;
 pub mod dashboard_view;
 pub mod event_loop;

@@ -63,7 +63,10 @@ impl Walked for Opened {
         self.on_key(key) == Flow::Quit
     }
 
+    /// Drawn once the Curves view's curves are made (in the background).
     fn drawn(&self) -> Buffer {
+        draw(|f| self.draw(f, Theme::plain()));
+        self.workbench.curves.settle();
         draw(|f| self.draw(f, Theme::plain()))
     }
 }

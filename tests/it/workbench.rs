@@ -62,8 +62,14 @@ fn workbench(out: &Path, keys: &str) -> Opened {
     workbench
 }
 
+/// The screen drawn, with the curves the Curves view makes in the background once they
+/// are made (a user sees them a moment later).
 fn screen(workbench: &Opened, (w, h): (u16, u16)) -> Terminal<TestBackend> {
     let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
+    terminal
+        .draw(|f| workbench.draw(f, Theme::plain()))
+        .unwrap();
+    workbench.workbench.curves.settle();
     terminal
         .draw(|f| workbench.draw(f, Theme::plain()))
         .unwrap();
@@ -225,7 +231,7 @@ fn open_shows_a_live_folders_progress_and_changes_nothing() {
     assert_eq!(banded, done, "{bands:?}");
     let comparison = text(&screen(&workbench(&out, "c"), (120, 40)));
     assert!(
-        comparison.contains(&format!("partial: over the {done} finished runs of 6")),
+        comparison.contains(&format!("partial: over the {done} finished of 6 runs")),
         "{comparison}"
     );
     // The binary itself, as a user runs it.
@@ -447,6 +453,9 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
     let out = tmp.path().join("out");
     finished_folder(&out);
     let mut workbench = workbench(&out, "v");
+    // sample_efficiency.csv's axis, the budget's: episodes (the view's default is the
+    // step, every run having steps).
+    workbench.workbench.curves.axis = Some(sapnet::report::metric::XAxis::Episode);
     let labels = ["dqn[16]", "dqn[8]"];
     for (index, label) in labels.iter().enumerate() {
         let points = workbench
@@ -456,7 +465,7 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
         for (statistic, of) in [
             (
                 "iqm",
-                (|p: &sapnet::report::sample_efficiency::EfficiencyPoint| p.iqm) as fn(&_) -> _,
+                (|p: &sapnet::report::metric::CurvePoint| p.iqm) as fn(&_) -> _,
             ),
             ("mean", |p| p.mean),
         ] {
@@ -535,6 +544,11 @@ fn the_curves_are_drawn_in_each_methods_colour_or_marker() {
     let out = tmp.path().join("out");
     finished_folder(&out);
     let workbench = workbench(&out, "v");
+    // The curves made first (in the background, a moment after the view opens).
+    workbench
+        .workbench
+        .curves
+        .made_now(&workbench.folder().state);
     let kinds: Vec<_> = workbench
         .folder()
         .state

@@ -1,5 +1,6 @@
 //! The followed run's statistic loss E over its episodes (Algorithm 3), its latest value
-//! in the title.
+//! in the title; `—` and no line where it has none (a method that spreads no activation,
+//! files that did not keep it).
 
 use ratatui::layout::Rect;
 use ratatui::symbols::Marker;
@@ -10,8 +11,14 @@ use ratatui::Frame;
 use crate::tui::dashboard::RunView;
 use crate::tui::theme::Theme;
 
-pub(super) fn draw(frame: &mut Frame, area: Rect, run: Option<&RunView>, theme: Theme) {
+pub(super) fn draw(
+    frame: &mut Frame,
+    area: Rect,
+    (run, known): (Option<&RunView>, bool),
+    theme: Theme,
+) {
     let points: Vec<(f64, f64)> = run
+        .filter(|r| known && r.method.kind.spreads)
         .map(|r| {
             let first = r.episode as usize + 1 - r.statistic_loss.len().min(r.episode as usize + 1);
             r.statistic_loss
@@ -28,7 +35,7 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, run: Option<&RunView>, theme: 
     let y_max = points.iter().map(|p| p.1).fold(1e-9, f64::max);
     let title = match points.last() {
         Some(&(_, e)) => format!(" statistic loss E {e:.4} "),
-        None => " statistic loss E ".to_string(),
+        None => " statistic loss E — ".to_string(),
     };
     let data = [Dataset::default()
         .marker(Marker::Braille)

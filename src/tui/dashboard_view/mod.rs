@@ -168,7 +168,9 @@ fn draw_training(frame: &mut Frame, dashboard: &Dashboard, theme: Theme) {
     }
     if !rewards.is_empty() {
         reward_chart::draw(frame, rewards, &dashboard.runs, &dashboard.reference, theme);
-        loss_chart::draw(frame, loss, dashboard.main_run(), theme);
+        // Known unless read from files that did not keep it.
+        let known = dashboard.from_files.is_none_or(|f| f.learner);
+        loss_chart::draw(frame, loss, (dashboard.main_run(), known), theme);
     }
 }
 

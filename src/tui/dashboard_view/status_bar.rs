@@ -114,11 +114,16 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: 
         (_, Some(s)) => Some(format!("{s:.0} steps/s")),
         (_, None) => Some("- steps/s".to_string()),
     };
+    // A run that ended (or read from its files) is not paced: no speed to say.
     let throttle = match SPEEDS[dashboard.speed] {
-        d if d.is_zero() => "full speed".to_string(),
-        d => format!("{} ms/step", d.as_millis()),
+        _ if finished || dashboard.from_files.is_some() => None,
+        d if d.is_zero() => Some("full speed".to_string()),
+        d => Some(format!("{} ms/step", d.as_millis())),
     };
-    let epsilon = run.map_or(0.0, |r| r.epsilon);
+    // ε where it is known: not before a run, nor from files that did not keep it.
+    let epsilon = run
+        .filter(|_| dashboard.from_files.is_none_or(|f| f.learner))
+        .map(|r| format!("ε {:.2}", r.epsilon));
     let figures = match failure {
         Some((method, error)) => Line::from(vec![
             Span::styled(" FAILED ", theme.stopped().add_modifier(Modifier::REVERSED)),
@@ -152,11 +157,11 @@ pub(super) fn draw(frame: &mut Frame, area: Rect, dashboard: &Dashboard, theme: 
                 .saturating_sub(hints.chars().count() + 2)
                 .saturating_sub(spans.iter().map(|s| s.content.chars().count()).sum());
             let figures = [
-                Some(throttle),
+                throttle,
                 Some(episode),
                 Some(format!("step {}", thousands(dashboard.step))),
                 speed,
-                Some(format!("ε {epsilon:.2}")),
+                epsilon,
                 Some(dashboard.task.clone()),
             ];
             let mut text = String::new();

@@ -20,6 +20,20 @@ pub fn fit(text: &str, width: usize) -> String {
     }
 }
 
+/// `1 run`, `20 runs`: a count and its noun, singular for one.
+pub fn counted(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
+/// `3 of 20 runs finished`, `0 of 1 run finished`.
+pub fn runs_finished(finished: usize, planned: usize) -> String {
+    format!("{finished} of {} finished", counted(planned, "run"))
+}
+
 /// The kind of each method of the folder's protocol, in its order.
 pub fn method_kinds(folder: &FolderState) -> Vec<crate::reuse::MethodKind> {
     folder

@@ -147,7 +147,7 @@ fn read_on(
 /// of seconds for a large protocol) then takes what training leaves of the cores, never
 /// their time (on Linux a thread has a nice value of its own). Best effort: a refusal
 /// leaves the thread as it was.
-fn lowest_priority() {
+pub(crate) fn lowest_priority() {
     // SAFETY: gettid and setpriority on this thread, no memory involved.
     unsafe {
         let tid = libc::gettid();

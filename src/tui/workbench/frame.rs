@@ -62,7 +62,10 @@ pub fn draw(
         body(frame, body_area(area, true));
         let top = Rect::new(area.x, area.y, area.width, 1);
         frame.render_widget(Clear, top);
-        frame.render_widget(Paragraph::new(top_line(chrome, theme)), top);
+        frame.render_widget(
+            Paragraph::new(top_line(chrome, theme, usize::from(top.width))),
+            top,
+        );
     } else {
         let [header, inside, status] = Layout::vertical([
             Constraint::Length(1),
@@ -140,9 +143,8 @@ pub fn folder_line(model: &Folder, theme: Theme, width: usize) -> Line<'static> 
     let folder = &model.state;
     let state = protocol_state(folder);
     let progress = format!(
-        " · {} of {} runs finished",
-        folder.finished_runs(),
-        folder.runs.len()
+        " · {}",
+        super::cells::runs_finished(folder.finished_runs(), folder.runs.len())
     );
     let mut dir = folder.dir.display().to_string();
     let mut task = format!("· {} · ", folder.task());
@@ -182,14 +184,37 @@ pub fn folder_line(model: &Folder, theme: Theme, width: usize) -> Line<'static> 
     Line::from(spans)
 }
 
-/// The tabs, the one shown marked.
-fn tab_spans(tabs: &[Tab], theme: Theme) -> Vec<Span<'static>> {
+/// Below this width the bar names the shown tab only, the others by their keys, so
+/// that the view's keys keep room.
+const COMPACT_TABS_BELOW: usize = 100;
+
+/// Whether the tabs are drawn by their keys on a bar of `width`, and the text of `tab`.
+fn tab_text((key, name, shown): &Tab, width: usize) -> (String, String) {
+    if width < COMPACT_TABS_BELOW && !shown {
+        (key.clone(), String::new())
+    } else {
+        (key.clone(), format!(" {name}"))
+    }
+}
+
+/// The space after each tab on a bar of `width`.
+fn tab_gap(width: usize) -> &'static str {
+    if width < COMPACT_TABS_BELOW {
+        " "
+    } else {
+        "  "
+    }
+}
+
+/// The tabs, the one shown marked, on a bar of `width`.
+fn tab_spans(tabs: &[Tab], theme: Theme, width: usize) -> Vec<Span<'static>> {
     let mut spans = Vec::new();
-    for (key, name, shown) in tabs {
-        let style = if *shown { theme.cursor() } else { Style::new() };
-        spans.push(Span::styled(key.clone(), theme.title()));
-        spans.push(Span::styled(format!(" {name}"), style));
-        spans.push(Span::raw("  "));
+    for tab in tabs {
+        let style = if tab.2 { theme.cursor() } else { Style::new() };
+        let (key, name) = tab_text(tab, width);
+        spans.push(Span::styled(key, theme.title()));
+        spans.push(Span::styled(name, style));
+        spans.push(Span::raw(tab_gap(width)));
     }
     spans
 }
@@ -206,7 +231,7 @@ fn command_spans((key, what): (&'static str, &'static str), theme: Theme) -> [Sp
 fn status_line(chrome: &Chrome, theme: Theme, width: usize) -> Line<'static> {
     let mut spans = vec![Span::raw(" ")];
     if !chrome.tabs.is_empty() {
-        spans.extend(tab_spans(&chrome.tabs, theme));
+        spans.extend(tab_spans(&chrome.tabs, theme, width));
         spans.push(Span::styled("│ ", theme.dim()));
     }
     let end = [
@@ -231,30 +256,49 @@ fn status_line(chrome: &Chrome, theme: Theme, width: usize) -> Line<'static> {
     Line::from(spans)
 }
 
-/// The Run view's line: which run and where the protocol is, then the tabs and the keys
-/// offered (`?` and quitting are on the dashboard's own line).
-fn top_line(chrome: &Chrome, theme: Theme) -> Line<'static> {
+/// The Run view's line: which run and where the protocol is, then the tabs and as many
+/// of the keys offered as fit whole in `width` (`?` and quitting are on the dashboard's
+/// own line).
+fn top_line(chrome: &Chrome, theme: Theme, width: usize) -> Line<'static> {
     let mut spans = chrome.header.spans.clone();
     if !chrome.tabs.is_empty() || !chrome.commands.is_empty() {
         spans.push(Span::styled("  │ ", theme.dim()));
     }
-    spans.extend(tab_spans(&chrome.tabs, theme));
+    let mut used: usize = spans.iter().map(Span::width).sum();
+    // Each tab whole or not at all, then the keys likewise.
+    for tab in tab_spans(&chrome.tabs, theme, width).chunks(3) {
+        let wide: usize = tab.iter().map(Span::width).sum();
+        if used + wide > width {
+            break;
+        }
+        used += wide;
+        spans.extend(tab.iter().cloned());
+    }
     for &command in &chrome.commands {
-        spans.extend(command_spans(command, theme));
+        let command = command_spans(command, theme);
+        let wide: usize = command.iter().map(Span::width).sum();
+        if used + wide > width {
+            break;
+        }
+        used += wide;
+        spans.extend(command);
     }
     Line::from(spans)
 }
 
-/// The tab whose name in the status bar is at `column`: the bar starts with a space,
-/// then each tab's key, a space, its name and two spaces.
-pub fn tab_at(tabs: &[Tab], column: u16) -> Option<usize> {
+/// The tab whose name in the status bar of `width` is at `column`: the bar starts with
+/// a space, then each tab's key, a space and its name (below [`COMPACT_TABS_BELOW`], the
+/// shown tab's only), and the gap.
+pub fn tab_at(tabs: &[Tab], column: u16, width: u16) -> Option<usize> {
+    let width = usize::from(width);
     let mut start = 1u16;
-    for (i, (key, name, _)) in tabs.iter().enumerate() {
-        let end = start + (key.chars().count() + 1 + name.chars().count()) as u16;
+    for (i, tab) in tabs.iter().enumerate() {
+        let (key, name) = tab_text(tab, width);
+        let end = start + (key.chars().count() + name.chars().count()) as u16;
         if (start..end).contains(&column) {
             return Some(i);
         }
-        start = end + 2;
+        start = end + tab_gap(width).len() as u16;
     }
     None
 }
@@ -273,6 +317,7 @@ mod tests {
         ]
         .map(|(key, name, shown)| (key.to_string(), name, shown));
         // " r runs  c comparison  v curves  f run  │ …"
+        let tab_at = |tabs: &[Tab], column| tab_at(tabs, column, 120);
         assert_eq!(tab_at(&tabs, 0), None);
         assert_eq!(tab_at(&tabs, 1), Some(0));
         assert_eq!(tab_at(&tabs, 6), Some(0));
@@ -285,5 +330,14 @@ mod tests {
         assert_eq!(tab_at(&tabs, 33), Some(3));
         assert_eq!(tab_at(&tabs, 37), Some(3));
         assert_eq!(tab_at(&tabs, 38), None);
+        // At 80 columns: " r c comparison v f │ …"
+        let narrow = |column| super::tab_at(&tabs, column, 80);
+        assert_eq!(narrow(1), Some(0));
+        assert_eq!(narrow(2), None);
+        assert_eq!((narrow(3), narrow(14)), (Some(1), Some(1)));
+        assert_eq!(
+            (narrow(15), narrow(16), narrow(18)),
+            (None, Some(2), Some(3))
+        );
     }
 }

@@ -308,7 +308,7 @@ impl Workbench {
         let over_the_top = self.tab == Tab::Run;
         let click = mouse.kind == MouseEventKind::Down(MouseButton::Left);
         if click && !over_the_top && mouse.row + 1 == screen.height {
-            let Some(i) = frame::tab_at(&self.tabs(keys), mouse.column) else {
+            let Some(i) = frame::tab_at(&self.tabs(keys), mouse.column, screen.width) else {
                 return false;
             };
             self.tab = tab_keys(keys)[i].0;
@@ -436,9 +436,11 @@ impl Workbench {
         if let Some(folder) = &self.folder {
             let state_now = &folder.state;
             state.push_str(&format!(
-                " · {} of {} runs finished",
-                state_now.finished_runs(),
-                state_now.runs.len()
+                " · {}",
+                crate::tui::workbench::cells::runs_finished(
+                    state_now.finished_runs(),
+                    state_now.runs.len()
+                )
             ));
         }
         let from_files = self

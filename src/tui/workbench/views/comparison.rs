@@ -3,7 +3,9 @@
 //! its 95% interval as a number and as a whisker on a shared axis; below, P(X > Y) of the
 //! picked method over every other by the separation rule. The numbers are the report's
 //! that `comparison.csv` and `improvement.csv` are written from, printed as the stdout
-//! table prints them, and the view says over how many finished runs of how many.
+//! table prints them, and the view says over how many finished runs of how many. The
+//! table sorts by any of its columns (`o` the column, `O` the direction); a method of one
+//! run shows its value without an interval; each pair's verdict names the better method.
 
 use crossterm::event::{KeyCode, MouseButton, MouseEvent, MouseEventKind};
 use ratatui::layout::{Constraint, Layout, Rect};
@@ -13,7 +15,7 @@ use ratatui::widgets::{Block, Paragraph, Wrap};
 use ratatui::Frame;
 
 use super::Intent;
-use crate::report::comparison::interval;
+use crate::report::comparison::interval_of_runs;
 use crate::report::improvement::p_value;
 use crate::report::{Aggregates, MethodComparison, Report};
 use crate::stats::separation::{Verdict, BOOTSTRAP_SEEDS};
@@ -22,7 +24,7 @@ use crate::tui::keys::{ch, code, Binding};
 use crate::tui::row_window::RowWindow;
 use crate::tui::theme::Theme;
 use crate::tui::view::{Outcome, View};
-use crate::tui::workbench::cells::{fit, inner, method_styles};
+use crate::tui::workbench::cells::{counted, fit, inner, method_styles, runs_finished};
 use crate::tui::workbench::folder::Folder;
 
 /// Which aggregate over runs the Comparison view shows, as `comparison.csv` names them.
@@ -77,6 +79,37 @@ impl Score {
     }
 }
 
+/// A column of the table its methods are sorted by.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SortColumn {
+    /// The protocol's order of its methods.
+    Protocol,
+    Method,
+    Runs,
+    /// The aggregate shown of a score.
+    Score(Score),
+}
+
+impl SortColumn {
+    const ORDER: [SortColumn; 5] = [
+        SortColumn::Protocol,
+        SortColumn::Method,
+        SortColumn::Runs,
+        SortColumn::Score(Score::Return),
+        SortColumn::Score(Score::Test),
+    ];
+
+    fn next(self) -> Self {
+        let i = Self::ORDER.iter().position(|&c| c == self).unwrap_or(0);
+        Self::ORDER[(i + 1) % Self::ORDER.len()]
+    }
+
+    /// Names ascend and numbers descend when first picked: the best first.
+    fn descending_first(self) -> bool {
+        matches!(self, SortColumn::Runs | SortColumn::Score(_))
+    }
+}
+
 /// What the Comparison view's keys do.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ComparisonCommand {
@@ -84,25 +117,15 @@ pub enum ComparisonCommand {
     Move(isize),
     NextAggregate,
     OtherScore,
+    /// Sorts by the next column.
+    NextSort,
+    /// Sorts the other way.
+    FlipSort,
 }
 
-/// The Comparison view's keys.
+/// The Comparison view's keys: the status bar drops the last first on a narrow terminal,
+/// and the arrows need no saying.
 const KEYS: &[Binding<ComparisonCommand>] = &[
-    Binding {
-        keys: &[
-            (code(KeyCode::Up), ComparisonCommand::Move(-1)),
-            (ch('k'), ComparisonCommand::Move(-1)),
-            (code(KeyCode::Down), ComparisonCommand::Move(1)),
-            (ch('j'), ComparisonCommand::Move(1)),
-            (code(KeyCode::PageUp), ComparisonCommand::Move(-10)),
-            (code(KeyCode::PageDown), ComparisonCommand::Move(10)),
-        ],
-        help: (
-            "↑ ↓ j k, PgUp PgDn",
-            "pick a method: its P(X > Y) over every other below",
-        ),
-        bar: Some(("↑↓", "method")),
-    },
     Binding {
         keys: &[(ch('a'), ComparisonCommand::NextAggregate)],
         help: (
@@ -120,6 +143,35 @@ const KEYS: &[Binding<ComparisonCommand>] = &[
         ),
         bar: Some(("s", "score")),
     },
+    Binding {
+        keys: &[(ch('o'), ComparisonCommand::NextSort)],
+        help: (
+            "o",
+            "sort by the next column (protocol order, method, runs, return, test); the \
+             header marks it",
+        ),
+        bar: Some(("o", "sort")),
+    },
+    Binding {
+        keys: &[(ch('O'), ComparisonCommand::FlipSort)],
+        help: ("O", "sort the other way"),
+        bar: Some(("O", "flip")),
+    },
+    Binding {
+        keys: &[
+            (code(KeyCode::Up), ComparisonCommand::Move(-1)),
+            (ch('k'), ComparisonCommand::Move(-1)),
+            (code(KeyCode::Down), ComparisonCommand::Move(1)),
+            (ch('j'), ComparisonCommand::Move(1)),
+            (code(KeyCode::PageUp), ComparisonCommand::Move(-10)),
+            (code(KeyCode::PageDown), ComparisonCommand::Move(10)),
+        ],
+        help: (
+            "↑ ↓ j k, PgUp PgDn",
+            "pick a method: its P(X > Y) over every other below",
+        ),
+        bar: Some(("↑↓", "method")),
+    },
 ];
 
 /// The methods side by side: aggregates with intervals, whiskers, pairs.
@@ -129,8 +181,11 @@ pub struct ComparisonView {
     /// The score whose pairs the view lists (and the only one it shows on a terminal too
     /// narrow for both).
     pub score: Score,
-    /// The picked method.
+    /// The picked method, by its place in the protocol.
     pub cursor: usize,
+    /// The column the table is sorted by, and whether the largest come first.
+    pub sort: SortColumn,
+    pub descending: bool,
 }
 
 impl Default for ComparisonView {
@@ -139,6 +194,8 @@ impl Default for ComparisonView {
             aggregate: Aggregate::Iqm,
             score: Score::Return,
             cursor: 0,
+            sort: SortColumn::Protocol,
+            descending: false,
         }
     }
 }
@@ -148,6 +205,66 @@ impl ComparisonView {
     pub fn refreshed(&mut self, folder: &Folder) {
         self.cursor = self.cursor.min(folder.methods().saturating_sub(1));
     }
+
+    /// The methods, by their place in the protocol, in the order the table lists them:
+    /// sorted by the view's column and direction, a method without a value last either
+    /// way, ties in the protocol's order.
+    pub fn order(&self, model: &Folder) -> Vec<usize> {
+        let labels = labels(model);
+        let mut order: Vec<usize> = (0..labels.len()).collect();
+        let row = |i: usize| {
+            model
+                .report
+                .as_ref()
+                .and_then(|r| r.comparison.iter().find(|c| c.method == labels[i]))
+        };
+        let value = |i: usize| -> Option<f64> {
+            match self.sort {
+                SortColumn::Protocol => Some(i as f64),
+                SortColumn::Method => None,
+                SortColumn::Runs => Some(row(i).map_or(0.0, |r| r.runs as f64)),
+                SortColumn::Score(score) => row(i)
+                    .and_then(|r| aggregates_of(r, score))
+                    .map(|a| estimate(a, self.aggregate).point)
+                    .filter(|v| v.is_finite()),
+            }
+        };
+        let direction = |o: std::cmp::Ordering| if self.descending { o.reverse() } else { o };
+        order.sort_by(|&a, &b| match self.sort {
+            SortColumn::Method => direction(labels[a].cmp(&labels[b])),
+            _ => match (value(a), value(b)) {
+                (Some(x), Some(y)) => direction(x.total_cmp(&y)),
+                (Some(_), None) => std::cmp::Ordering::Less,
+                (None, Some(_)) => std::cmp::Ordering::Greater,
+                (None, None) => std::cmp::Ordering::Equal,
+            },
+        });
+        order
+    }
+
+    /// `▼` or `▲` after the header of the column sorted by (none in the protocol's order).
+    fn mark(&self, column: SortColumn) -> &'static str {
+        match (
+            self.sort == column && column != SortColumn::Protocol,
+            self.descending,
+        ) {
+            (false, _) => "",
+            (true, true) => " ▼",
+            (true, false) => " ▲",
+        }
+    }
+}
+
+/// The protocol's methods' labels, in its order.
+fn labels(model: &Folder) -> Vec<String> {
+    model
+        .state
+        .config
+        .protocol
+        .methods
+        .iter()
+        .map(|m| m.label())
+        .collect()
 }
 
 impl View for ComparisonView {
@@ -162,9 +279,18 @@ impl View for ComparisonView {
     fn apply(&mut self, folder: &Folder, command: ComparisonCommand) -> Outcome<Intent> {
         match command {
             ComparisonCommand::Move(by) => {
-                let last = folder.methods().saturating_sub(1) as isize;
-                self.cursor = (self.cursor as isize + by).clamp(0, last) as usize;
+                // Along the table's order, not the protocol's.
+                let order = self.order(folder);
+                let at = order.iter().position(|&m| m == self.cursor).unwrap_or(0);
+                let last = order.len().saturating_sub(1) as isize;
+                let to = (at as isize + by).clamp(0, last) as usize;
+                self.cursor = order.get(to).copied().unwrap_or(0);
             }
+            ComparisonCommand::NextSort => {
+                self.sort = self.sort.next();
+                self.descending = self.sort.descending_first();
+            }
+            ComparisonCommand::FlipSort => self.descending = !self.descending,
             ComparisonCommand::NextAggregate => self.aggregate = self.aggregate.next(),
             ComparisonCommand::OtherScore => {
                 self.score = match self.score {
@@ -247,11 +373,12 @@ fn areas(area: Rect, model: &Folder) -> [Rect; 3] {
     .areas(area)
 }
 
-/// The methods the table's inside `inside` shows, below its header line and above its
-/// axis line.
-fn window(inside: Rect, view: &ComparisonView, model: &Folder) -> RowWindow {
+/// The table's rows (places in [`ComparisonView::order`]) its inside `inside` shows,
+/// below its header line and above its axis line.
+fn window(inside: Rect, order: &[usize], view: &ComparisonView) -> RowWindow {
     let room = usize::from(inside.height).saturating_sub(2);
-    RowWindow::new(model.methods(), room, [view.cursor])
+    let at = order.iter().position(|&m| m == view.cursor).unwrap_or(0);
+    RowWindow::new(order.len(), room, [at])
 }
 
 /// The method whose row of the table is at (`column`, `row`) of the screen, the view
@@ -270,7 +397,10 @@ fn method_at(
     if !(inside.x..inside.x + inside.width).contains(&column) || row < first {
         return None;
     }
-    window(inside, view, model).row_at(usize::from(row - first))
+    let order = view.order(model);
+    window(inside, &order, view)
+        .row_at(usize::from(row - first))
+        .and_then(|at| order.get(at).copied())
 }
 
 /// Over how many runs: every planned one, or (partial) the finished ones so far.
@@ -278,13 +408,19 @@ fn coverage(model: &Folder) -> String {
     let folder = &model.state;
     let (finished, planned) = (folder.finished_runs(), folder.runs.len());
     if model.report.is_none() {
-        format!(" {finished} of {planned} runs finished")
+        format!(" {}", runs_finished(finished, planned))
     } else if finished == planned {
-        format!(" over all {planned} runs (as comparison.csv and improvement.csv)")
+        let all = if planned == 1 {
+            "its one run".to_string()
+        } else {
+            format!("all {planned} runs")
+        };
+        format!(" over {all} (as comparison.csv and improvement.csv)")
     } else {
         format!(
-            " partial: over the {finished} finished runs of {planned} ({} not finished); \
-             made again as runs end",
+            " partial: over the {finished} finished of {} ({} not finished); made again as \
+             runs end",
+            counted(planned, "run"),
             planned - finished
         )
     }
@@ -357,13 +493,29 @@ fn axis_line(
     axis_line
 }
 
+/// A score's column's header: `return IQM [95% CI]`, marked when the table is sorted by it.
+fn score_header(report: &Report, score: Score, view: &ComparisonView) -> String {
+    format!(
+        "{} {} [95% CI]{}",
+        score_name(report, score),
+        view.aggregate.name(),
+        view.mark(SortColumn::Score(score))
+    )
+}
+
+/// The text of a method's aggregate: its interval, or its value alone over one run.
+fn value_text(row: Option<&MethodComparison>, e: &Estimate, digits: usize) -> String {
+    interval_of_runs(e, row.map_or(0, |r| r.runs), digits)
+}
+
 /// Each score's column: the intervals as text, and the whiskers' shared axis.
 fn score_columns(
     rows: &[Option<&MethodComparison>],
     scores: &[Score],
-    aggregate: Aggregate,
+    view: &ComparisonView,
     report: &Report,
 ) -> Vec<ScoreColumn> {
+    let aggregate = view.aggregate;
     let digits = digits(report, aggregate);
     scores
         .iter()
@@ -375,15 +527,12 @@ fn score_columns(
                         .map(|a| estimate(a, aggregate))
                 })
                 .collect();
-            let header = format!(
-                "{} {} [95% CI]",
-                score_name(report, score),
-                aggregate.name()
-            );
+            let header = score_header(report, score, view);
             let width = estimates
                 .iter()
-                .flatten()
-                .map(|e| interval(e, digits).chars().count())
+                .zip(rows)
+                .filter_map(|(e, row)| Some(value_text(*row, e.as_ref()?, digits)))
+                .map(|text| text.chars().count())
                 .chain([header.chars().count()])
                 .max()
                 .unwrap_or(1);
@@ -416,54 +565,45 @@ fn draw_table(
         return;
     }
     let folder = &model.state;
-    let labels: Vec<String> = folder
-        .config
-        .protocol
-        .methods
-        .iter()
-        .map(|m| m.label())
-        .collect();
+    let labels = labels(model);
     let rows: Vec<Option<&MethodComparison>> = labels
         .iter()
         .map(|l| report.comparison.iter().find(|c| &c.method == l))
         .collect();
     let scores = shown_scores(area.width, view.score);
     let digits = digits(report, aggregate);
-    let columns = score_columns(&rows, &scores, aggregate, report);
+    let columns = score_columns(&rows, &scores, view, report);
     let method_width = labels
         .iter()
         .map(|l| l.chars().count())
         .max()
         .unwrap_or(6)
         .clamp(6, 22);
-    let runs_width = 5;
+    let runs_width = 6;
     let texts: usize = columns.iter().map(|c| c.width + 2).sum();
     let spare = usize::from(inside.width).saturating_sub(method_width + 1 + runs_width + texts);
     let whisker_width = (spare / columns.len()).saturating_sub(1).max(3);
 
     let mut header = vec![Span::raw(format!(
         "{} {}",
-        fit("method", method_width),
-        fit("runs", runs_width)
+        fit(
+            &format!("method{}", view.mark(SortColumn::Method)),
+            method_width
+        ),
+        fit(&format!("runs{}", view.mark(SortColumn::Runs)), runs_width)
     ))];
     for column in &columns {
         header.push(Span::raw(format!(
             " {} ",
-            fit(
-                &format!(
-                    "{} {} [95% CI]",
-                    score_name(report, column.score),
-                    aggregate.name()
-                ),
-                column.width
-            )
+            fit(&score_header(report, column.score, view), column.width)
         )));
         header.push(Span::raw(format!("{} ", fit("", whisker_width))));
     }
     let mut lines = vec![Line::from(header).style(theme.dim())];
-    let window = window(inside, view, model);
+    let order = view.order(model);
+    let window = window(inside, &order, view);
     let styles = method_styles(folder, theme);
-    for i in window.rows() {
+    for i in window.rows().map(|at| order[at]) {
         let picked = i == view.cursor;
         let style = |s: Style| if picked { s.patch(theme.cursor()) } else { s };
         let runs = format!(
@@ -481,7 +621,7 @@ fn draw_table(
         for column in &columns {
             let (text, whisker) = match column.estimates[i] {
                 Some(e) => (
-                    interval(&e, digits),
+                    value_text(rows[i], &e, digits),
                     whisker(&e, column.axis, whisker_width),
                 ),
                 None => ("-".to_string(), String::new()),
@@ -604,6 +744,17 @@ fn draw_pairs(
         .max()
         .unwrap_or(4)
         .min(22);
+    let judgements: Vec<String> = rows.iter().map(|r| r.judgement()).collect();
+    // Aligned where the lines fit; on a narrow panel, not padded into a wrapped gap.
+    let judgement_width = if area.width >= BOTH_SCORES_WIDTH {
+        judgements
+            .iter()
+            .map(|j| j.chars().count())
+            .max()
+            .unwrap_or(0)
+    } else {
+        0
+    };
     let rule = Line::styled(
         format!(
             "separated: {BOOTSTRAP_SEEDS} seeds' intervals exclude ½, Holm p < 0.05 · s: other \
@@ -612,7 +763,7 @@ fn draw_pairs(
         theme.dim(),
     );
     let mut lines: Vec<Line> = std::iter::once(rule)
-        .chain(rows.iter().map(|r| {
+        .chain(rows.iter().zip(&judgements).map(|(r, judgement)| {
             let verdict_style = match r.verdict {
                 Verdict::Separated => theme.active(),
                 Verdict::Fragile => theme.spreading(),
@@ -620,13 +771,17 @@ fn draw_pairs(
             };
             let mut spans = vec![
                 Span::raw(format!(
-                    "over {}  P = {:.2} [{:.2}, {:.2}]  ",
+                    "vs {}  P = {:.2} [{:.2}, {:.2}]  ",
                     fit(&r.over, over_width),
                     r.p.point,
                     r.p.lo,
                     r.p.hi
                 )),
-                Span::styled(fit(r.verdict.name(), 13), verdict_style),
+                // The better method named first, whichever way the row reads.
+                Span::styled(
+                    fit(judgement, judgement_width.max(judgement.chars().count())),
+                    verdict_style,
+                ),
                 Span::raw(format!(
                     "  Holm p = {}, {}/{BOOTSTRAP_SEEDS} seeds",
                     p_value(r.holm_p),

@@ -210,13 +210,9 @@ fn draw(frame: &mut Frame, area: Rect, folder: &FolderState, cursor: usize, them
             ),
         ]));
     }
-    if rows.hidden_above() + rows.hidden_below() > 0 {
+    if let Some(more) = rows.marker() {
         lines.push(Line::styled(
-            format!(
-                "▲ {} more · ▼ {} more (↑↓ to move)",
-                rows.hidden_above(),
-                rows.hidden_below()
-            ),
+            format!("{} (↑↓ to move)", more.trim()),
             theme.dim(),
         ));
     }

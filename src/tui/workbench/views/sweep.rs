@@ -208,7 +208,10 @@ fn detail(status: &CellStatus, progress: Option<(usize, usize)>) -> String {
         CellStatus::Running(holder) => {
             let mut text = format!("written by {}", holder.describe());
             if let Some((finished, all)) = progress {
-                text.push_str(&format!(" · {finished} of {all} runs finished"));
+                text.push_str(&format!(
+                    " · {}",
+                    crate::tui::workbench::cells::runs_finished(finished, all)
+                ));
             }
             text
         }

@@ -1,9 +1,10 @@
-//! Drawing the Curves view: every method's learning curve across its runs — the IQM or mean over
-//! runs of each run's moving average (MA10), with its 95% bootstrap band — in the plots'
-//! colour of each method (without colour: a marker of its own along its line), beside a
-//! legend that switches methods on and off and gives each one's value where the view
-//! ends. The points are `sample_efficiency.csv`'s ([`super`]). `Enter` shows the
-//! picked method's runs one by one, each over its method's band.
+//! Drawing the Curves view: every method's curve of the metric picked across its runs —
+//! the IQM or mean over runs of each run's moving average (MA10), with its 95% bootstrap
+//! band — in the plots' colour of each method (without colour: a marker of its own along
+//! its line), beside a legend that switches methods on and off and gives each one's value
+//! where the view ends. The points are `sample_efficiency.csv`'s for the returns on the
+//! budget's axis ([`super`]). `Enter` shows the picked method's runs one by one, each over
+//! its method's band. While the curves are made, the view says so.
 
 use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::style::{Color, Modifier, Style};
@@ -12,12 +13,9 @@ use ratatui::widgets::canvas::{Canvas, Context, Line as Segment, Points};
 use ratatui::widgets::{Block, Paragraph};
 use ratatui::Frame;
 
-use super::{planned, runs_of, CurvesView as Curves};
-use crate::config::Budget;
-use crate::report::moving_average;
+use super::{runs_of, CurvesView as Curves};
+use crate::report::metric::{CurvePoint, Metric, XAxis};
 use crate::report::plots::palette::method_colours;
-use crate::report::sample_efficiency::{self, EfficiencyPoint};
-use crate::report::{step_axis, TrainingEpisodes};
 use crate::results::folder_state::FolderState;
 use crate::stats::Estimate;
 use crate::tui::row_window::RowWindow;
@@ -35,7 +33,13 @@ struct Shown {
     index: usize,
     label: String,
     colour: Color,
-    points: Vec<EfficiencyPoint>,
+    points: Vec<CurvePoint>,
+}
+
+/// A spinner's frame, turning ten times a second since `since`.
+fn spinner(since: std::time::Instant) -> char {
+    const FRAMES: [char; 10] = ['⠋', '⠙', '⠹', '⠸', '⠼', '⠴', '⠦', '⠧', '⠇', '⠏'];
+    FRAMES[(since.elapsed().as_millis() / 100) as usize % FRAMES.len()]
 }
 
 pub(super) fn draw(
@@ -45,6 +49,11 @@ pub(super) fn draw(
     folder: &FolderState,
     theme: Theme,
 ) {
+    let (made, making) = curves.curves(folder);
+    let Some(made) = made.filter(|m| m.error.is_none() || making.is_some()) else {
+        draw_waiting(frame, area, curves, folder, making, theme);
+        return;
+    };
     let colours = method_colours(&method_kinds(folder));
     let methods: Vec<Shown> = folder
         .config
@@ -58,12 +67,12 @@ pub(super) fn draw(
                 index,
                 label: method.label(),
                 colour: Color::Rgb(r, g, b),
-                points: curves.curve(folder, index),
+                points: made.methods.get(index).cloned().unwrap_or_default(),
             }
         })
         .collect();
     let range = curves.range(folder);
-    let block = Block::bordered().title(title(folder, curves, range, theme));
+    let block = Block::bordered().title(title(folder, curves, (range, making), theme));
     frame.render_widget(block, area);
     let inside = inner(area);
     if inside.height < 4 || inside.width < 30 {
@@ -78,13 +87,24 @@ pub(super) fn draw(
             };
             let runs = runs_of(folder, method.index);
             let k = k.min(runs.len().saturating_sub(1));
-            let window = folder.config.protocol.moving_average;
-            let averages = runs
-                .get(k)
-                .map(|r| run_line(&r.training, window, folder.config.protocol.budget))
-                .unwrap_or_default();
-            draw_chart(frame, chart, (&[method], &averages), curves, range, theme);
-            draw_runs_legend(frame, legend, folder, method, k, theme);
+            let lines = made.runs.get(method.index).cloned().unwrap_or_default();
+            let averages = lines.get(k).cloned().unwrap_or_default();
+            draw_chart(
+                frame,
+                chart,
+                (&[method], &averages),
+                (curves, curves.axis(folder)),
+                range,
+                theme,
+            );
+            draw_runs_legend(
+                frame,
+                legend,
+                (folder, curves),
+                (method, &lines, range),
+                k,
+                theme,
+            );
         }
         None => {
             let shown: Vec<&Shown> = methods
@@ -98,12 +118,18 @@ pub(super) fn draw(
                 .chain(shown.iter().filter(|m| m.index == curves.cursor))
                 .copied()
                 .collect();
-            draw_chart(frame, chart, (&ordered, &[]), curves, range, theme);
-            let budget = folder.config.protocol.budget;
+            draw_chart(
+                frame,
+                chart,
+                (&ordered, &[]),
+                (curves, curves.axis(folder)),
+                range,
+                theme,
+            );
             draw_legend(
                 frame,
                 legend,
-                (&methods, budget),
+                (&methods, curves.axis(folder)),
                 curves,
                 range,
                 label_width,
@@ -113,24 +139,69 @@ pub(super) fn draw(
     }
 }
 
-/// One run's line: its moving average at each episode, or under a step budget its step
-/// curve ([`step_axis`]).
-fn run_line(run: &TrainingEpisodes, window: usize, budget: Budget) -> Vec<(f64, f64)> {
-    match budget {
-        Budget::Episodes(_) => moving_average(&run.returns, window)
-            .into_iter()
-            .enumerate()
-            .map(|(i, a)| ((i + window) as f64, a))
-            .collect(),
-        Budget::Steps(budget) => {
-            let points = step_axis::points(budget, sample_efficiency::POINTS);
-            let curve = step_axis::curve(run, window, &points);
-            points
-                .iter()
-                .zip(curve)
-                .filter_map(|(&at, v)| v.map(|v| (at as f64, v)))
-                .collect()
+/// The view while its curves are made (or could not be): what is made, over how many
+/// runs, a spinner; or why not.
+fn draw_waiting(
+    frame: &mut Frame,
+    area: Rect,
+    curves: &Curves,
+    folder: &FolderState,
+    making: Option<std::time::Instant>,
+    theme: Theme,
+) {
+    let runs = folder
+        .runs
+        .iter()
+        .filter(|r| !r.training.is_empty())
+        .count();
+    let text = match making {
+        Some(since) => format!(
+            "{} Making the curves of {} ({}, {} over runs) against the {} over {}: reading \
+             the runs' files and bootstrapping each point…",
+            spinner(since),
+            metric_name(curves, folder),
+            match curves.window(folder) {
+                1 => "unsmoothed".to_string(),
+                w => format!("MA{w}"),
+            },
+            curves.statistic.name(),
+            curves.axis(folder).name(),
+            crate::tui::workbench::cells::counted(runs, "run"),
+        ),
+        None => {
+            let (made, _) = curves.curves(folder);
+            format!(
+                "The curves could not be made: {}",
+                made.and_then(|m| m.error).unwrap_or_default()
+            )
         }
+    };
+    frame.render_widget(
+        Paragraph::new(Line::styled(text, theme.dim()))
+            .wrap(ratatui::widgets::Wrap { trim: true })
+            .block(Block::bordered().title(Span::styled(" Curves ", theme.title()))),
+        area,
+    );
+}
+
+/// The metric as the view names it.
+fn metric_name(curves: &Curves, folder: &FolderState) -> String {
+    let sources: Vec<String> = folder.library.iter().map(|e| e.name.clone()).collect();
+    curves.metric.name(&sources)
+}
+
+/// A value of `metric` with its decimals.
+fn value(metric: Metric, x: f64) -> String {
+    format!("{x:.*}", metric.digits())
+}
+
+/// A place on `axis`: whole episodes and steps; seconds to a hundredth below ten (a tiny
+/// run's episodes take milliseconds), to a tenth below a thousand, else whole.
+fn place(axis: XAxis, x: f64) -> String {
+    match axis {
+        XAxis::Wall if x.abs() < 10.0 => format!("{x:.2}"),
+        XAxis::Wall if x.abs() < 1000.0 => format!("{x:.1}"),
+        XAxis::Wall | XAxis::Episode | XAxis::Step => format!("{x:.0}"),
     }
 }
 
@@ -196,48 +267,64 @@ fn legend_window(area: Rect, methods: usize, cursor: usize) -> RowWindow {
     )
 }
 
-/// What the view shows, over how many runs, and where on the episodes.
+/// What the view shows, over how many runs, and where on the axis; a spinner while the
+/// curves are made again.
 fn title(
     folder: &FolderState,
     curves: &Curves,
-    (from, to): (f64, f64),
+    ((from, to), making): ((f64, f64), Option<std::time::Instant>),
     theme: Theme,
 ) -> Line<'static> {
-    let window = folder.config.protocol.moving_average;
+    let window = curves.window(folder);
+    let axis = curves.axis(folder);
     let (finished, planned_runs) = (folder.finished_runs(), folder.runs.len());
-    let over = if finished == planned_runs {
+    let over = if finished == planned_runs && planned_runs == 1 {
+        "its one run".to_string()
+    } else if finished == planned_runs {
         format!("all {planned_runs} runs")
     } else {
-        format!("partial: {finished} of {planned_runs} runs finished, running ones so far")
+        format!(
+            "partial: {}, running ones so far",
+            crate::tui::workbench::cells::runs_finished(finished, planned_runs)
+        )
     };
     let zoom = if curves.zoom.is_some() {
-        let unit = match folder.config.protocol.budget {
-            Budget::Episodes(_) => "ep",
-            Budget::Steps(_) => "step",
-        };
-        format!(" · {unit} {from:.0}–{to:.0} of {:.0}", planned(folder))
+        let (_, all) = curves.extent(folder);
+        format!(
+            " · {} {}–{} of {}",
+            axis.short(),
+            place(axis, from),
+            place(axis, to),
+            place(axis, all)
+        )
     } else {
         String::new()
     };
+    let smoothed = if window > 1 {
+        format!(" MA{window}")
+    } else {
+        " unsmoothed".to_string()
+    };
     let what = match curves.run {
-        Some(_) => "one run's MA{window} over its method's".to_string(),
-        None => format!("MA{window} {} over runs,", curves.statistic.name()),
-    }
-    .replace("{window}", &window.to_string());
-    Line::from(vec![
+        Some(_) => format!("one run's{smoothed} over its method's"),
+        None => format!("{smoothed} {} over runs,", curves.statistic.name())
+            .trim_start()
+            .to_string(),
+    };
+    let mut spans = vec![
         Span::styled(" Curves ", theme.title()),
+        Span::styled(format!("{} ", metric_name(curves, folder)), theme.title()),
         Span::raw(format!("{what} 95% band · {over}{zoom} ")),
-    ])
+    ];
+    if let Some(since) = making {
+        spans.push(Span::styled(format!("{} ", spinner(since)), theme.active()));
+    }
+    Line::from(spans)
 }
 
-/// The points of a curve inside the episodes shown.
-fn in_range(
-    points: &[EfficiencyPoint],
-    (from, to): (f64, f64),
-) -> impl Iterator<Item = &EfficiencyPoint> {
-    points
-        .iter()
-        .filter(move |p| (from..=to).contains(&(p.at as f64)))
+/// The points of a curve inside the range shown.
+fn in_range(points: &[CurvePoint], (from, to): (f64, f64)) -> impl Iterator<Item = &CurvePoint> {
+    points.iter().filter(move |p| (from..=to).contains(&p.at))
 }
 
 /// The curves (each method's line and band; without colour the picked method's band
@@ -246,7 +333,7 @@ fn draw_chart(
     frame: &mut Frame,
     area: Rect,
     (methods, run): (&[&Shown], &[(f64, f64)]),
-    curves: &Curves,
+    (curves, axis): (&Curves, XAxis),
     range: (f64, f64),
     theme: Theme,
 ) {
@@ -280,7 +367,13 @@ fn draw_chart(
     } else {
         (low - 1.0, high + 1.0)
     };
-    let plot = draw_axes(frame, area, range, (low, high), theme);
+    let plot = draw_axes(
+        frame,
+        area,
+        (range, axis),
+        (low, high),
+        (curves.metric, theme),
+    );
     let picked = curves.cursor;
     let colour = |m: &Shown| if theme.color { m.colour } else { Color::Reset };
     // Without colour a marker every few columns along each line tells the lines apart.
@@ -292,7 +385,7 @@ fn draw_chart(
         .paint(|ctx: &mut Context| {
             for m in methods {
                 let estimates: Vec<(f64, Estimate)> = in_range(&m.points, range)
-                    .map(|p| (p.at as f64, statistic.of(p)))
+                    .map(|p| (p.at, statistic.of(p)))
                     .collect();
                 if theme.color || m.index == picked {
                     // The band's edges, dotted.
@@ -347,7 +440,7 @@ fn draw_chart(
                 for m in methods {
                     let mut next = f64::NEG_INFINITY;
                     for p in in_range(&m.points, range) {
-                        let x = p.at as f64;
+                        let x = p.at;
                         if x >= next {
                             ctx.print(x, statistic.of(p).point, MARKERS[m.index % MARKERS.len()]);
                             next = x + every;
@@ -364,9 +457,9 @@ fn draw_chart(
 fn draw_axes(
     frame: &mut Frame,
     area: Rect,
-    (from, to): (f64, f64),
+    ((from, to), axis): ((f64, f64), XAxis),
     (low, high): (f64, f64),
-    theme: Theme,
+    (metric, theme): (Metric, Theme),
 ) -> Rect {
     let [left, plot] =
         Layout::horizontal([Constraint::Length(Y_LABELS), Constraint::Fill(1)]).areas(area);
@@ -374,11 +467,22 @@ fn draw_axes(
         Layout::vertical([Constraint::Fill(1), Constraint::Length(1)]).areas(plot);
     let mut y_lines = vec![Line::from(""); usize::from(plot.height)];
     let last = y_lines.len().saturating_sub(1);
+    // Whole numbers where the axis spans ten or more; else the metric's decimals (ε,
+    // probabilities, losses), as many as fit.
+    let decimals = if high - low >= 10.0 {
+        0
+    } else {
+        metric.digits().clamp(1, 3)
+    };
     for (row, value) in [(0, high), (last / 2, (low + high) / 2.0), (last, low)] {
-        y_lines[row] = Line::styled(format!("{value:>6.0} "), theme.dim());
+        let text = format!("{value:>6.decimals$}");
+        y_lines[row] = Line::styled(format!("{} ", fit(&text, 6)), theme.dim());
     }
     frame.render_widget(Paragraph::new(y_lines), left);
-    let (first, end) = (format!("{from:.0}"), format!("episode {to:.0}"));
+    let (first, end) = (
+        place(axis, from),
+        format!("{} {}", axis.name(), place(axis, to)),
+    );
     let gap = usize::from(x_labels.width).saturating_sub(first.len() + end.len());
     frame.render_widget(
         Paragraph::new(Line::styled(
@@ -390,8 +494,8 @@ fn draw_axes(
     plot
 }
 
-/// The value of a curve where the view ends: its last point inside the episodes shown.
-pub fn value_at_end(points: &[EfficiencyPoint], range: (f64, f64)) -> Option<&EfficiencyPoint> {
+/// The value of a curve where the view ends: its last point inside the range shown.
+pub fn value_at_end(points: &[CurvePoint], range: (f64, f64)) -> Option<&CurvePoint> {
     in_range(points, range).last()
 }
 
@@ -400,22 +504,24 @@ pub fn value_at_end(points: &[EfficiencyPoint], range: (f64, f64)) -> Option<&Ef
 fn draw_legend(
     frame: &mut Frame,
     area: Rect,
-    (methods, folder_budget): (&[Shown], Budget),
+    (methods, axis): (&[Shown], XAxis),
     curves: &Curves,
     range: (f64, f64),
     label_width: usize,
     theme: Theme,
 ) {
     let width = usize::from(area.width);
-    let ends: Vec<Option<&EfficiencyPoint>> = methods
+    let ends: Vec<Option<&CurvePoint>> = methods
         .iter()
         .map(|m| value_at_end(&m.points, range))
         .collect();
-    let at = ends.iter().flatten().map(|p| p.at).max();
-    let unit = match folder_budget {
-        Budget::Episodes(_) => "ep",
-        Budget::Steps(_) => "step",
-    };
+    let at = ends
+        .iter()
+        .flatten()
+        .map(|p| p.at)
+        .fold(None, |a: Option<f64>, x| Some(a.map_or(x, |a| a.max(x))))
+        .map(|x| place(axis, x));
+    let unit = axis.short();
     // The intervals where the legend is wide enough for them.
     let intervals = width >= label_width + 27;
     let mut lines = vec![Line::styled(
@@ -449,15 +555,18 @@ fn draw_legend(
         } else {
             MARKERS[m.index % MARKERS.len()]
         };
+        let digits = curves.metric.digits();
         let value = end.map_or_else(
-            || "-".to_string(),
+            || "—".to_string(),
             |p| {
                 let e = curves.statistic.of(p);
-                // Returns, to a tenth, as the tables print them.
-                if intervals {
-                    crate::report::comparison::interval(&e, 1)
+                // Returns to a tenth, as the tables print them; each metric its decimals;
+                // the interval where it fits whole.
+                let with = crate::report::comparison::interval(&e, digits);
+                if intervals && with.chars().count() <= width.saturating_sub(label_width + 5) {
+                    with
                 } else {
-                    format!("{:.1}", e.point)
+                    format!("{:.digits$}", e.point)
                 }
             },
         );
@@ -485,17 +594,18 @@ fn draw_legend(
     frame.render_widget(Paragraph::new(lines), area);
 }
 
-/// The picked method's runs, the one shown marked, each with its status and last MA.
+/// The picked method's runs, the one shown marked, each with its status and its line's
+/// last value in the range shown.
 fn draw_runs_legend(
     frame: &mut Frame,
     area: Rect,
-    folder: &FolderState,
-    method: &Shown,
+    (folder, curves): (&FolderState, &Curves),
+    (method, run_lines, (from, to)): (&Shown, &[Vec<(f64, f64)>], (f64, f64)),
     shown: usize,
     theme: Theme,
 ) {
     let width = usize::from(area.width);
-    let window = folder.config.protocol.moving_average;
+    let window = curves.window(folder);
     let runs = runs_of(folder, method.index);
     let style = if theme.color {
         Style::new().fg(method.colour)
@@ -508,7 +618,14 @@ fn draw_runs_legend(
             style.add_modifier(Modifier::BOLD),
         ),
         Line::styled(
-            fit(&format!("run  status   episodes  MA{window}"), width),
+            fit(
+                &if window > 1 {
+                    format!("run  status   episodes  MA{window}")
+                } else {
+                    "run  status   episodes  last".to_string()
+                },
+                width,
+            ),
             theme.dim(),
         ),
     ];
@@ -519,9 +636,10 @@ fn draw_runs_legend(
         [shown],
     );
     for (k, run) in runs.iter().enumerate().skip(rows.first).take(rows.shown) {
-        let last = moving_average(&run.training.returns, window)
-            .last()
-            .map_or_else(|| "-".to_string(), |a| format!("{a:.1}"));
+        let last = run_lines
+            .get(k)
+            .and_then(|line| line.iter().rev().find(|(x, _)| (from..=to).contains(x)))
+            .map_or_else(|| "—".to_string(), |&(_, y)| value(curves.metric, y));
         let text = format!(
             "{} {} {} {}",
             fit(&run.run.to_string(), 4),

@@ -1,24 +1,36 @@
-//! The Curves view: what it keeps and what its keys do — the statistic over runs (IQM or
-//! mean), the methods shown, the picked one, the episodes in view, and the run shown
-//! alone when its method's runs are read one by one. Each method's curve is the one
-//! `sample_efficiency.csv` holds ([`sample_efficiency::curve`]: the same points, the same
-//! bootstrap seeds), made again only when that method's runs have grown. `chart.rs` draws
-//! it.
+//! The Curves view: what it keeps and what its keys do — the metric drawn (any number
+//! per episode the folder's files hold, [`run_metrics::on_file`]), the x axis (episode,
+//! environment step, wall time; the step by default where every run has steps), the
+//! smoothing (a moving average's window, cycled), the statistic over runs (IQM or mean),
+//! the methods shown, the picked one, the range in view, and the run shown alone when its
+//! method's runs are read one by one. The return against the budget's own axis, smoothed
+//! by the protocol's window, is the curve `sample_efficiency.csv` holds
+//! ([`sample_efficiency::curve`]: the same points, the same bootstrap seeds); any other
+//! choice is [`metric::curve`] of the runs' files. The curves are made on a thread of
+//! their own ([`background`]), the view saying that it works meanwhile, and made again
+//! only when the choice changes or a run has grown by a point's worth. `chart.rs` draws
+//! them.
 
 mod chart;
 
 use std::cell::RefCell;
 use std::collections::BTreeSet;
+use std::path::PathBuf;
+use std::sync::mpsc;
+use std::time::Instant;
 
 use crossterm::event::{KeyCode, MouseButton, MouseEvent, MouseEventKind};
 use ratatui::layout::Rect;
 use ratatui::Frame;
 
 use crate::config::Budget;
-use crate::report::sample_efficiency::{self, EfficiencyPoint};
+use crate::report::metric::{self, CurvePoint, Metric, RunMetric, XAxis};
+use crate::report::sample_efficiency;
 use crate::report::TrainingEpisodes;
 use crate::results::folder_state::{FolderState, RunProgress, RunStatus};
+use crate::results::run_metrics::{self, OnFile, RunFiles};
 use crate::stats::Estimate;
+use crate::tui::background;
 use crate::tui::keys::{ch, code, Binding};
 use crate::tui::theme::Theme;
 use crate::tui::view::{Outcome, View};
@@ -26,8 +38,12 @@ use crate::tui::workbench::folder::Folder;
 
 pub use chart::MARKERS;
 
-/// The fewest episodes the view zooms in to: a moving average's span or so.
+/// The fewest units (episodes, steps, seconds) the view zooms in to: a moving average's
+/// span or so.
 const NARROWEST: f64 = 20.0;
+
+/// The smoothing windows `s` cycles through after the protocol's own: none, then wider.
+const WINDOWS: [usize; 5] = [1, 5, 25, 50, 100];
 
 /// Which aggregate over runs the curves show, as `sample_efficiency.csv`'s `statistic`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -44,7 +60,7 @@ impl Statistic {
         }
     }
 
-    pub fn of(self, point: &EfficiencyPoint) -> Estimate {
+    pub fn of(self, point: &CurvePoint) -> Estimate {
         match self {
             Statistic::Iqm => point.iqm,
             Statistic::Mean => point.mean,
@@ -52,36 +68,91 @@ impl Statistic {
     }
 }
 
+/// What the curves are made of: the choice and the runs as they stood.
+#[derive(Debug, Clone, PartialEq)]
+struct Request {
+    metric: Metric,
+    axis: XAxis,
+    window: usize,
+    /// Each run with episodes: its method, its episodes in points' worths, whether it
+    /// had ended.
+    runs: Vec<(usize, u64, bool)>,
+}
+
+impl Request {
+    /// The same choice, whatever the runs.
+    fn same_choice(&self, other: &Request) -> bool {
+        (self.metric, self.axis, self.window) == (other.metric, other.axis, other.window)
+    }
+}
+
+/// The curves made for a request.
+#[derive(Debug, Clone, Default)]
+pub struct Made {
+    /// Each method's curve, in the protocol's order.
+    pub methods: Vec<Vec<CurvePoint>>,
+    /// Each method's runs' own lines (smoothed, at the curve's points), in the order of
+    /// [`runs_of`].
+    pub runs: Vec<Vec<Vec<(f64, f64)>>>,
+    /// The axis's extent: what "all" shows.
+    pub extent: (f64, f64),
+    /// Why they could not be made (a file that could not be read).
+    pub error: Option<String>,
+}
+
+/// The curves made and being made.
+#[derive(Default)]
+struct Curves {
+    made: Option<(Request, Made)>,
+    making: Option<(Request, Instant, mpsc::Receiver<Made>)>,
+    /// What the folder's files hold, and the runs' count it was looked at with.
+    on_file: Option<(PathBuf, usize, OnFile)>,
+}
+
 /// The Curves view's choices.
-#[derive(Debug)]
 pub struct CurvesView {
     pub statistic: Statistic,
+    /// The metric drawn.
+    pub metric: Metric,
+    /// The x axis; `None`: the default (the step where every run has steps).
+    pub axis: Option<XAxis>,
+    /// The moving average's window; `None`: the protocol's.
+    pub window: Option<usize>,
     /// Methods (by their place in the protocol) switched off.
     pub hidden: BTreeSet<usize>,
     /// The picked method (the legend's cursor).
     pub cursor: usize,
-    /// The episodes shown, first to last; `None`: all of them.
+    /// The range shown on the axis, first to last; `None`: all of it.
     pub zoom: Option<(f64, f64)>,
     /// When the picked method's runs are read one by one: which of its runs (by place
     /// among those with episodes).
     pub run: Option<usize>,
-    /// Each method's curve, with the episode counts of the runs it was made of.
-    cache: RefCell<Vec<Option<Cached>>>,
+    curves: RefCell<Curves>,
 }
 
-/// A method's curve and what its runs were when it was made (their episodes in points'
-/// worths, whether each had ended): made again when that changes.
-type Cached = (Vec<(u64, bool)>, Vec<EfficiencyPoint>);
+impl std::fmt::Debug for CurvesView {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CurvesView")
+            .field("metric", &self.metric)
+            .field("axis", &self.axis)
+            .field("window", &self.window)
+            .field("cursor", &self.cursor)
+            .finish_non_exhaustive()
+    }
+}
 
 impl Default for CurvesView {
     fn default() -> Self {
         Self {
             statistic: Statistic::Iqm,
+            metric: Metric::Return,
+            axis: None,
+            window: None,
             hidden: BTreeSet::new(),
             cursor: 0,
             zoom: None,
             run: None,
-            cache: RefCell::new(Vec::new()),
+            curves: RefCell::new(Curves::default()),
         }
     }
 }
@@ -96,8 +167,7 @@ pub fn runs_of(folder: &FolderState, index: usize) -> Vec<&RunProgress> {
         .collect()
 }
 
-/// The episodes (or, under a step budget, the steps) a run of the protocol is given: the x
-/// axis's end when not zoomed.
+/// The episodes (or, under a step budget, the steps) a run of the protocol is given.
 pub fn planned(folder: &FolderState) -> f64 {
     match folder.config.protocol.budget {
         Budget::Episodes(n) => f64::from(n.max(1)),
@@ -105,45 +175,288 @@ pub fn planned(folder: &FolderState) -> f64 {
     }
 }
 
-impl CurvesView {
-    /// The curve of method `index` over its runs so far: on a finished folder, that
-    /// method's rows of `sample_efficiency.csv`.
-    pub fn curve(&self, folder: &FolderState, index: usize) -> Vec<EfficiencyPoint> {
-        let runs = runs_of(folder, index);
-        // A curve is a bootstrap per point (a large protocol's, a good part of a second):
-        // made again when a run has grown by a point's worth of episodes, or ended — not
-        // at every refresh of a live folder.
-        let quantum = (planned(folder) as u64 / sample_efficiency::POINTS as u64).max(1);
-        let key: Vec<(u64, bool)> = runs
-            .iter()
-            .map(|r| (r.done() / quantum, r.status == RunStatus::Done))
-            .collect();
-        let mut cache = self.cache.borrow_mut();
-        if cache.len() <= index {
-            cache.resize(index + 1, None);
+/// The axis of the protocol's budget: what `sample_efficiency.csv` is drawn against.
+fn budget_axis(budget: Budget) -> XAxis {
+    match budget {
+        Budget::Episodes(_) => XAxis::Episode,
+        Budget::Steps(_) => XAxis::Step,
+    }
+}
+
+/// The curves of `request` for `runs` (on any thread).
+fn make(
+    request: &Request,
+    runs: &[RunFiles],
+    labels: &[String],
+    sources: &[String],
+    (budget, protocol_window): (Budget, usize),
+) -> Made {
+    let methods = labels.len();
+    // The return on the budget's axis by the protocol's window: sample_efficiency.csv's.
+    if request.metric == Metric::Return
+        && request.axis == budget_axis(budget)
+        && request.window == protocol_window
+    {
+        let mut made = Made {
+            extent: (
+                1.0,
+                match budget {
+                    Budget::Episodes(n) => f64::from(n.max(1)),
+                    Budget::Steps(n) => n.max(1) as f64,
+                },
+            ),
+            ..Made::default()
+        };
+        for (index, label) in labels.iter().enumerate() {
+            let training: Vec<TrainingEpisodes> = runs
+                .iter()
+                .filter(|r| r.method == index)
+                .map(|r| TrainingEpisodes::clone(&r.training))
+                .collect();
+            let points = sample_efficiency::curve(label, &training, protocol_window, budget);
+            made.runs.push(
+                training
+                    .iter()
+                    .map(|t| {
+                        let run = RunMetric {
+                            values: t.returns.iter().map(|&r| Some(r)).collect(),
+                            lengths: t.lengths.clone(),
+                            wall_s: None,
+                        };
+                        run_line(
+                            &run,
+                            request,
+                            &points.iter().map(|p| p.at as f64).collect::<Vec<_>>(),
+                        )
+                    })
+                    .collect(),
+            );
+            made.methods
+                .push(points.into_iter().map(CurvePoint::from).collect());
         }
-        if let Some((cached, points)) = &cache[index] {
-            if *cached == key {
-                return points.clone();
+        return made;
+    }
+    let mut made = Made::default();
+    let mut read: Vec<(usize, RunMetric)> = Vec::new();
+    for run in runs {
+        match run_metrics::read(run, request.metric, request.axis == XAxis::Wall, sources) {
+            Ok(values) => read.push((run.method, values)),
+            Err(error) => {
+                made.error = Some(format!("{error:#}"));
+                return made;
             }
         }
-        let Some(label) = folder.config.protocol.methods.get(index).map(|m| m.label()) else {
-            return Vec::new();
-        };
-        let training: Vec<TrainingEpisodes> = runs
+    }
+    let Some(extent) = metric::extent(read.iter().map(|(_, r)| r), request.axis) else {
+        made.methods = vec![Vec::new(); methods];
+        made.runs = vec![Vec::new(); methods];
+        return made;
+    };
+    made.extent = extent;
+    let points = metric::grid(extent.0, extent.1, sample_efficiency::POINTS);
+    let name = request.metric.name(sources);
+    for (index, label) in labels.iter().enumerate() {
+        let mine: Vec<RunMetric> = read
             .iter()
-            .map(|r| TrainingEpisodes::clone(&r.training))
+            .filter(|(m, _)| *m == index)
+            .map(|(_, r)| r.clone())
             .collect();
-        let protocol = &folder.config.protocol;
-        let points =
-            sample_efficiency::curve(&label, &training, protocol.moving_average, protocol.budget);
-        cache[index] = Some((key, points.clone()));
-        points
+        made.methods.push(metric::curve(
+            &format!("{label} {name}"),
+            &mine,
+            request.axis,
+            request.window,
+            &points,
+        ));
+        made.runs
+            .push(mine.iter().map(|r| run_line(r, request, &points)).collect());
+    }
+    made
+}
+
+/// One run's smoothed line at `points`, where it has a value.
+fn run_line(run: &RunMetric, request: &Request, points: &[f64]) -> Vec<(f64, f64)> {
+    points
+        .iter()
+        .zip(run.curve(request.axis, request.window, points))
+        .filter_map(|(&x, y)| Some((x, y?)))
+        .collect()
+}
+
+impl CurvesView {
+    /// What the folder's files hold (looked at again when runs gain episodes or files).
+    pub fn on_file(&self, folder: &FolderState) -> OnFile {
+        let runs = folder
+            .runs
+            .iter()
+            .filter(|r| !r.training.is_empty())
+            .count();
+        let mut curves = self.curves.borrow_mut();
+        if let Some((dir, count, on_file)) = &curves.on_file {
+            if *dir == folder.dir && *count == runs {
+                return on_file.clone();
+            }
+        }
+        let on_file = run_metrics::on_file(&run_metrics::run_files(folder), folder.library.len());
+        curves.on_file = Some((folder.dir.clone(), runs, on_file.clone()));
+        on_file
     }
 
-    /// The episodes shown, first to last.
+    /// The x axis drawn: the one picked, else the environment step where every run with
+    /// episodes has steps, else the episode.
+    pub fn axis(&self, folder: &FolderState) -> XAxis {
+        self.axis.unwrap_or_else(|| {
+            let stepped = folder
+                .runs
+                .iter()
+                .filter(|r| !r.training.is_empty())
+                .all(|r| r.training.lengths.iter().any(|&l| l > 0));
+            if stepped {
+                XAxis::Step
+            } else {
+                XAxis::Episode
+            }
+        })
+    }
+
+    /// The moving average's window: the one picked, else the protocol's.
+    pub fn window(&self, folder: &FolderState) -> usize {
+        self.window
+            .unwrap_or(folder.config.protocol.moving_average)
+            .max(1)
+    }
+
+    fn request(&self, folder: &FolderState) -> Request {
+        let quantum = (planned(folder) as u64 / sample_efficiency::POINTS as u64).max(1);
+        Request {
+            metric: self.metric,
+            axis: self.axis(folder),
+            window: self.window(folder),
+            runs: folder
+                .runs
+                .iter()
+                .filter(|r| !r.training.is_empty())
+                .map(|r| {
+                    (
+                        r.method.index,
+                        r.done() / quantum,
+                        r.status == RunStatus::Done,
+                    )
+                })
+                .collect(),
+        }
+    }
+
+    /// The curves of the view's choice: made, or being made (then the last ones of the
+    /// same choice if any, and since when). Starts making them when needed.
+    pub fn curves(&self, folder: &FolderState) -> (Option<Made>, Option<Instant>) {
+        let request = self.request(folder);
+        let mut curves = self.curves.borrow_mut();
+        if let Some((_, _, rx)) = &curves.making {
+            if let Ok(made) = rx.try_recv() {
+                let (done, _, _) = curves.making.take().expect("being made");
+                curves.made = Some((done, made));
+            }
+        }
+        let current = curves.made.as_ref().filter(|(r, _)| *r == request);
+        if let Some((_, made)) = current {
+            return (Some(made.clone()), None);
+        }
+        let started = match &curves.making {
+            Some((r, since, _)) if *r == request => *since,
+            _ => {
+                let runs = run_metrics::run_files(folder);
+                let labels: Vec<String> = folder
+                    .config
+                    .protocol
+                    .methods
+                    .iter()
+                    .map(|m| m.label())
+                    .collect();
+                let sources: Vec<String> = folder.library.iter().map(|e| e.name.clone()).collect();
+                let protocol = (
+                    folder.config.protocol.budget,
+                    folder.config.protocol.moving_average,
+                );
+                let job = request.clone();
+                let rx = background::spawn("workbench: making the curves", move || {
+                    make(&job, &runs, &labels, &sources, protocol)
+                });
+                let since = Instant::now();
+                curves.making = Some((request.clone(), since, rx));
+                since
+            }
+        };
+        // While a live folder's curves are made again, the last ones of the same choice.
+        let last = curves
+            .made
+            .as_ref()
+            .filter(|(r, _)| r.same_choice(&request))
+            .map(|(_, made)| made.clone());
+        (last, Some(started))
+    }
+
+    /// Waits for the curves being made (tests, which draw once and look).
+    pub fn settle(&self) {
+        let mut curves = self.curves.borrow_mut();
+        if let Some((request, _, rx)) = curves.making.take() {
+            if let Ok(made) = rx.recv() {
+                curves.made = Some((request, made));
+            }
+        }
+    }
+
+    /// The curves of the view's choice, made here and now.
+    pub fn made_now(&self, folder: &FolderState) -> Made {
+        let _ = self.curves(folder);
+        self.settle();
+        self.curves(folder).0.unwrap_or_default()
+    }
+
+    /// Method `index`'s curve of the view's choice, made here and now.
+    pub fn curve(&self, folder: &FolderState, index: usize) -> Vec<CurvePoint> {
+        self.made_now(folder)
+            .methods
+            .get(index)
+            .cloned()
+            .unwrap_or_default()
+    }
+
+    /// The axis's extent: the budget's on its own axis, else the curves' last made.
+    pub fn extent(&self, folder: &FolderState) -> (f64, f64) {
+        let axis = self.axis(folder);
+        if axis == budget_axis(folder.config.protocol.budget) {
+            return (1.0, planned(folder));
+        }
+        let runs = folder.runs.iter().filter(|r| !r.training.is_empty());
+        match axis {
+            XAxis::Episode => (1.0, runs.map(|r| r.episodes()).max().unwrap_or(1) as f64),
+            XAxis::Step => runs
+                .map(|r| {
+                    let first = r.training.lengths.first().copied().unwrap_or(0);
+                    (
+                        f64::from(first),
+                        r.training.lengths.iter().map(|&l| l as f64).sum(),
+                    )
+                })
+                .reduce(|(a, b), (c, d)| (f64::min(a, c), f64::max(b, d)))
+                .unwrap_or((0.0, 1.0)),
+            // On file only: the curves' once made.
+            XAxis::Wall => {
+                let request = self.request(folder);
+                self.curves
+                    .borrow()
+                    .made
+                    .as_ref()
+                    .filter(|(r, _)| r.same_choice(&request))
+                    .map_or((0.0, 1.0), |(_, made)| made.extent)
+            }
+        }
+    }
+
+    /// The range shown on the axis, first to last.
     pub fn range(&self, folder: &FolderState) -> (f64, f64) {
-        let all = (1.0, planned(folder));
+        let all = self.extent(folder);
         self.zoom.map_or(all, |zoom| clamp(zoom, all))
     }
 
@@ -153,10 +466,44 @@ impl CurvesView {
             self.hidden.insert(index);
         }
     }
+
+    /// The next metric on file (`by` 1) or the previous (-1).
+    fn next_metric(&mut self, folder: &FolderState, by: isize) {
+        let metrics = self.on_file(folder).metrics;
+        let at = metrics.iter().position(|&m| m == self.metric).unwrap_or(0) as isize;
+        let n = metrics.len().max(1) as isize;
+        self.metric = metrics
+            .get((at + by).rem_euclid(n) as usize)
+            .copied()
+            .unwrap_or(Metric::Return);
+    }
+
+    /// The next x axis on file: episode, step, wall time.
+    fn next_axis(&mut self, folder: &FolderState) {
+        let wall = self.on_file(folder).wall;
+        self.axis = Some(match self.axis(folder) {
+            XAxis::Episode => XAxis::Step,
+            XAxis::Step if wall => XAxis::Wall,
+            XAxis::Step | XAxis::Wall => XAxis::Episode,
+        });
+        self.zoom = None;
+    }
+
+    /// The next smoothing window: the protocol's, none, then wider.
+    fn next_window(&mut self, folder: &FolderState) {
+        let own = folder.config.protocol.moving_average.max(1);
+        let mut windows = vec![own];
+        windows.extend(WINDOWS.iter().copied().filter(|&w| w != own));
+        let at = windows
+            .iter()
+            .position(|&w| w == self.window(folder))
+            .unwrap_or(0);
+        self.window = Some(windows[(at + 1) % windows.len()]);
+    }
 }
 
-/// `range` in whole episodes, moved inside `all` (kept as wide as it fits) and no
-/// narrower than [`NARROWEST`] episodes (nor than `all`).
+/// `range` in whole units, moved inside `all` (kept as wide as it fits) and no narrower
+/// than [`NARROWEST`] units (nor than `all`).
 fn clamp((from, to): (f64, f64), (first, last): (f64, f64)) -> (f64, f64) {
     let span = last - first;
     let width = (to - from).round().clamp(NARROWEST.min(span), span);
@@ -167,13 +514,19 @@ fn clamp((from, to): (f64, f64), (first, last): (f64, f64)) -> (f64, f64) {
 /// What the Curves view's keys do.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CurvesCommand {
+    /// The next (1) or previous (-1) metric on file.
+    Metric(isize),
+    /// The next x axis.
+    Axis,
+    /// The next smoothing window.
+    Smoothing,
     /// The legend's cursor by one method.
     Pick(isize),
     Toggle,
     Statistic,
     ZoomIn,
     ZoomOut,
-    /// Along the episodes by this many quarters of the view.
+    /// Along the axis by this many quarters of the view.
     Pan(i8),
     All,
     /// The picked method's runs one by one, or back to every method.
@@ -186,8 +539,33 @@ pub enum CurvesCommand {
 
 use CurvesCommand as C;
 
-/// The Curves view's keys.
+/// The Curves view's keys (the status bar drops the last first on a narrow terminal).
 const KEYS: &[Binding<CurvesCommand>] = &[
+    Binding {
+        keys: &[(ch('y'), C::Metric(1)), (ch('Y'), C::Metric(-1))],
+        help: (
+            "y Y",
+            "the next metric on file, the previous: return, length, loss, ε, steps/s, each \
+             source's activation A and probability P (what the folder's files hold)",
+        ),
+        bar: Some(("y", "metric")),
+    },
+    Binding {
+        keys: &[(ch('x'), C::Axis)],
+        help: (
+            "x",
+            "the x axis: environment step, wall time (where on file), episode",
+        ),
+        bar: Some(("x", "axis")),
+    },
+    Binding {
+        keys: &[(ch('s'), C::Smoothing)],
+        help: (
+            "s",
+            "the smoothing: the protocol's moving average, none, 5, 25, 50, 100 episodes",
+        ),
+        bar: Some(("s", "smooth")),
+    },
     Binding {
         keys: &[
             (code(KeyCode::Up), C::Pick(-1)),
@@ -221,7 +599,7 @@ const KEYS: &[Binding<CurvesCommand>] = &[
         ],
         help: (
             "+ -, ← → h l, 0",
-            "zoom in and out, move along the episodes, all of them",
+            "zoom in and out, move along the axis, all of it",
         ),
         bar: Some(("+-←→", "zoom")),
     },
@@ -262,7 +640,7 @@ impl View for CurvesView {
     fn apply(&mut self, folder: &Folder, command: CurvesCommand) -> Outcome<super::Intent> {
         let folder = &folder.state;
         let methods = folder.config.protocol.methods.len();
-        let all = (1.0, planned(folder));
+        let all = self.extent(folder);
         let (from, to) = self.range(folder);
         let width = to - from;
         match command {
@@ -270,6 +648,9 @@ impl View for CurvesView {
             // there is no run to move to or come back from (Esc is then the screen's).
             C::Pick(_) if self.run.is_some() => return Outcome::Ignored,
             C::Back | C::Run(_) if self.run.is_none() => return Outcome::Ignored,
+            C::Metric(by) => self.next_metric(folder, by),
+            C::Axis => self.next_axis(folder),
+            C::Smoothing => self.next_window(folder),
             C::Pick(by) => {
                 let last = methods.saturating_sub(1) as isize;
                 self.cursor = (self.cursor as isize + by).clamp(0, last) as usize;
