@@ -215,9 +215,9 @@ pub const SUBCOMMANDS: &[SubcommandFlags] = &[
     },
     SubcommandFlags {
         name: "open",
-        reads: &[],
+        reads: &["--jobs", "--library", "--python", "--module-dir", "--allow-module"],
         config: None,
-        library: None,
+        library: Some("With R (resuming a stopped folder): the library root its protocol began with, as `sapnet --resume` reads it. Default: saved_policies"),
     },
     SubcommandFlags {
         name: "compare",
@@ -445,7 +445,9 @@ pub enum Command {
     Plot(PlotArgs),
     /// Open a results folder in the terminal UI, read only: finished, stopped, or live and
     /// being written by another process (`sapnet --headless --out DIR` running). Views:
-    /// Runs (r) and Comparison (c); `?` lists the keys. Nothing in the folder changes.
+    /// Runs (r), Comparison (c), Curves (v) and Run (f); `?` lists the keys. Nothing in
+    /// the folder changes unless R resumes its stopped protocol there (with --jobs,
+    /// --library and --python as `sapnet --resume` reads them).
     Open(OpenArgs),
     /// One comparison of finished protocols on different tasks (e.g. the variants of
     /// CartPole and of MountainCar): each method's scores normalised by each task's range

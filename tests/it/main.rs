@@ -53,5 +53,6 @@ mod tui_snapshots;
 mod tui_state;
 mod tui_tmux;
 mod variants_cli;
+mod ways_back;
 mod workbench;
 mod workbench_protocol;
