@@ -56,15 +56,23 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Open(args)) => {
             // SIGINT, SIGTERM or SIGHUP leave as `q` does, the terminal restored.
             let _stop = crate::signals::stop_on_signals()?;
-            // A sweep folder opens in the Sweep view, any other in the workbench's views.
-            if tui::workbench::sweep_folder::is_sweep(&args.dir) {
-                tui::workbench::screens::sweep::run(&args.dir)
-            } else {
-                // `R` resumes a stopped folder where it is shown, as `sapnet --resume`
-                // would.
-                let load = |path: &Path| load_picked(&cli, path);
-                let settings = session_settings(&cli, &load, Vec::new());
-                print_ended(tui::workbench::screens::opened::run(&args.dir, &settings)?)
+            // `R` resumes a stopped folder where it is shown, as `sapnet --resume` would.
+            let load = |path: &Path| load_picked(&cli, path);
+            let settings = session_settings(&cli, &load, Vec::new());
+            // A results folder opens in the workbench's views, a sweep folder in the Sweep
+            // view, any other lists the folders sapnet wrote under it.
+            match results::found::kind(&args.dir) {
+                Some(results::found::Kind::Protocol) => {
+                    print_ended(tui::workbench::screens::opened::run(&args.dir, &settings)?)
+                }
+                Some(results::found::Kind::Sweep) => tui::workbench::screens::sweep::run(&args.dir),
+                Some(results::found::Kind::Compare) => anyhow::bail!(
+                    "sapnet open {0}: a `sapnet compare` folder, whose views are not in the \
+                     workbench yet: its table is {0}/comparison.csv (as compare printed it), \
+                     its plots the .png files beside it",
+                    args.dir.display()
+                ),
+                None => print_ended(tui::workbench::screens::folders::run(&args.dir, &settings)?),
             }
         }
         Some(Command::Plot(args)) => {
