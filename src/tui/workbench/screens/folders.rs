@@ -45,7 +45,7 @@ pub const FOLDERS_KEYS: &[Binding<FoldersScreenCommand>] = &[
         keys: &QUIT_KEYS,
         help: (
             keys::QUIT_KEYS_SAID,
-            "quit (the folders are only read: nothing in them changes)",
+            "quit (the folders are only read: nothing in them changes unless R resumes one)",
         ),
         bar: Some(keys::QUIT_BAR),
     },
