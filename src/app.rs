@@ -56,11 +56,23 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Open(args)) => {
             // SIGINT, SIGTERM or SIGHUP leave as `q` does, the terminal restored.
             let _stop = crate::signals::stop_on_signals()?;
-            // A sweep folder opens in the Sweep view, any other in the workbench's views.
-            if tui::workbench::sweep_folder::is_sweep(&args.dir) {
-                tui::workbench::screens::sweep::run(&args.dir)
-            } else {
-                tui::workbench::screens::opened::run(&args.dir)
+            // `R` resumes a stopped folder where it is shown, as `sapnet --resume` would.
+            let load = |path: &Path| load_picked(&cli, path);
+            let settings = session_settings(&cli, &load, Vec::new());
+            // A results folder opens in the workbench's views, a sweep folder in the Sweep
+            // view, any other lists the folders sapnet wrote under it.
+            match results::found::kind(&args.dir) {
+                Some(results::found::Kind::Protocol) => {
+                    print_ended(tui::workbench::screens::opened::run(&args.dir, &settings)?)
+                }
+                Some(results::found::Kind::Sweep) => tui::workbench::screens::sweep::run(&args.dir),
+                Some(results::found::Kind::Compare) => anyhow::bail!(
+                    "sapnet open {0}: a `sapnet compare` folder, whose views are not in the \
+                     workbench yet: its table is {0}/comparison.csv (as compare printed it), \
+                     its plots the .png files beside it",
+                    args.dir.display()
+                ),
+                None => print_ended(tui::workbench::screens::folders::run(&args.dir, &settings)?),
             }
         }
         Some(Command::Plot(args)) => {
@@ -369,11 +381,8 @@ fn in_config_file(error: anyhow::Error, cli: &Cli) -> anyhow::Error {
     error.context(format!("config {origin}"))
 }
 
-/// `--headless --resume --out DIR`.
+/// `--resume --out DIR`: in the UI, or with `--headless` without it.
 fn resume_experiment(cli: &Cli) -> Result<()> {
-    if !cli.run.headless {
-        anyhow::bail!("--resume continues a --headless protocol: add --headless");
-    }
     let dir = cli
         .run
         .out
@@ -390,6 +399,9 @@ fn resume_experiment(cli: &Cli) -> Result<()> {
         }
         None => None,
     };
+    if !cli.run.headless {
+        return resume_in_ui(cli, dir, added.as_ref());
+    }
     let summary = experiment::resume(
         dir,
         cli.run.runs,
@@ -447,31 +459,99 @@ fn run_in_ui(cli: &Cli, config: Config) -> Result<()> {
     let opened = experiment::OpenedOutput::open(&output)?;
     // SIGTERM and SIGHUP stop the protocol as `q` does, the terminal restored.
     let _signals = on_interrupt()?;
-    let load = |path: &Path| -> Result<Config> {
-        let mut config = training_config(path)?;
-        apply_flags(cli, &mut config);
-        for (field, task) in config.tasks() {
-            env::spaces(task).with_context(|| format!("{}: {field}", path.display()))?;
-        }
-        Ok(config)
-    };
-    let settings = tui::workbench::screens::session::live::Settings {
-        options: run_options(cli),
-        python: cli.run.python_settings(),
-        load: &load,
-        reference,
-    };
-    let start = tui::workbench::screens::session::live::Start {
+    let load = |path: &Path| load_picked(cli, path);
+    let settings = session_settings(cli, &load, reference);
+    let start = tui::workbench::screens::session::live::Start::New {
         config,
         output,
         opened,
         followed,
     };
-    match tui::workbench::screens::session::live::run(start, &settings)? {
-        Some((Ok(summary), dir)) => headless::print_summary(&summary, &dir),
-        Some((Err(error), _)) => Err(error),
-        None => Ok(()),
+    print_ended(tui::workbench::screens::session::live::run(
+        start, &settings,
+    )?)
+}
+
+/// `--resume --out DIR` without `--headless`: the stopped protocol in the workbench, as
+/// `sapnet` runs a new one, its folder taken (and a folder that cannot be resumed said)
+/// before the screen opens.
+fn resume_in_ui(cli: &Cli, dir: &Path, added: Option<&experiment::AddedMethods>) -> Result<()> {
+    if !std::io::IsTerminal::is_terminal(&std::io::stdout()) {
+        anyhow::bail!(
+            "the protocol resumes in the terminal UI, and stdout is not a terminal: \
+             `sapnet --headless --resume --out {}` resumes it without the UI (progress on \
+             stderr)",
+            dir.display()
+        );
     }
+    let python = cli.run.python_settings();
+    let stopped = experiment::StoppedProtocol::take(dir, cli.run.runs, added, &python)?;
+    let config = stopped.config();
+    let followed = match (&cli.run.follow, cli.run.follow_run) {
+        (None, None) => None,
+        (follow, run) => tui::follow::followed_run(
+            &crate::trainer::MethodId::all(&config.protocol.methods),
+            follow.as_deref(),
+            run,
+            config.protocol.runs,
+        )?,
+    };
+    let reference = match &cli.run.compare {
+        Some(compare) => tui::reference::bands_of_folder(compare, &config.env.gym_id())?,
+        None => Vec::new(),
+    };
+    let _signals = on_interrupt()?;
+    let load = |path: &Path| load_picked(cli, path);
+    let settings = session_settings(cli, &load, reference);
+    let start = tui::workbench::screens::session::live::Start::Resume { stopped, followed };
+    print_ended(tui::workbench::screens::session::live::run(
+        start, &settings,
+    )?)
+}
+
+/// A config `L` picked, read with this command line's flags applied (`--quick`,
+/// `--episodes`, `--runs`, `--seed`), its tasks checked.
+fn load_picked(cli: &Cli, path: &Path) -> Result<Config> {
+    let mut config = training_config(path)?;
+    apply_flags(cli, &mut config);
+    for (field, task) in config.tasks() {
+        env::spaces(task).with_context(|| format!("{}: {field}", path.display()))?;
+    }
+    Ok(config)
+}
+
+/// What every protocol a session of the UI starts (`L`, `R`) runs with.
+fn session_settings<'a>(
+    cli: &Cli,
+    load: &'a dyn Fn(&Path) -> Result<Config>,
+    reference: Vec<tui::reference::Band>,
+) -> tui::workbench::screens::session::live::Settings<'a> {
+    tui::workbench::screens::session::live::Settings {
+        options: run_options(cli),
+        python: cli.run.python_settings(),
+        load,
+        reference,
+    }
+}
+
+/// What `--headless` prints, for every protocol the screen saw end, in order (`L` starts
+/// others into folders of their own: each is named); the first that failed is the error.
+fn print_ended(ended: tui::workbench::screens::session::live::Ended) -> Result<()> {
+    let mut failed = None;
+    for (outcome, dir) in ended {
+        match outcome {
+            Ok(summary) => headless::print_summary(&summary, &dir)?,
+            Err(error) => {
+                let error = error.context(format!("the protocol into {}", dir.display()));
+                if failed.is_none() {
+                    failed = Some(error);
+                } else {
+                    eprintln!("error: {error:#}");
+                }
+            }
+        }
+    }
+    failed.map_or(Ok(()), Err)
 }
 
 fn run_sources(cli: &Cli, args: &SourcesArgs) -> Result<()> {

@@ -215,9 +215,9 @@ pub const SUBCOMMANDS: &[SubcommandFlags] = &[
     },
     SubcommandFlags {
         name: "open",
-        reads: &[],
+        reads: &["--jobs", "--library", "--python", "--module-dir", "--allow-module"],
         config: None,
-        library: None,
+        library: Some("With R (resuming a stopped folder): the library root its protocol began with, as `sapnet --resume` reads it. Default: saved_policies"),
     },
     SubcommandFlags {
         name: "compare",
@@ -462,8 +462,11 @@ pub enum Command {
     /// Open a results folder in the terminal UI, read only: finished, stopped, or live and
     /// being written by another process (`sapnet --headless --out DIR` running). Views, a
     /// tab each: Runs (r or 1), Comparison (c, 2), Curves (v, 3) and a run's dashboard (f,
-    /// 4: Enter on a finished run in Runs); a sweep folder opens in the Sweep view. `?`
-    /// lists the keys. Nothing in the folder changes.
+    /// 4: Enter on a finished run in Runs); a sweep folder opens in the Sweep view, a compare
+    /// folder in its Comparison and Curves, a parent folder as the list of the results
+    /// folders under it. `?` lists the keys. Nothing in the folder changes unless R resumes
+    /// its stopped protocol there (with --jobs, --library and --python as `sapnet --resume`
+    /// reads them).
     Open(OpenArgs),
     /// One comparison of finished protocols on different tasks (e.g. the variants of
     /// CartPole and of MountainCar): each method's scores normalised by each task's range

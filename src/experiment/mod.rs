@@ -18,7 +18,8 @@ pub use library_copy::{policy_info, LibraryCopies};
 pub use output::{default_out_dir, OutputOptions};
 pub use plan::{plan, run_specs, ConfigField, Plan};
 pub use protocol::{
-    resume, resume_tapped, run, run_opened, AddedMethods, OpenedOutput, RunOptions,
+    resume, resume_taken, resume_tapped, run, run_opened, AddedMethods, OpenedOutput, RunOptions,
+    StoppedProtocol,
 };
 pub use tap::{Tap, Watched};
 pub use tensorboard_runs::TENSORBOARD_DIR;

@@ -83,10 +83,10 @@ pub(super) fn open_output(output: &OutputOptions) -> Result<(FolderLock, Option<
     }
     if !output.force {
         bail!(
-            "the output directory {} already holds results ({}); choose another --out, pass \
-             --force to replace them, or --resume to finish them",
+            "the output directory {} already holds results ({}); {}",
             dir.display(),
-            existing.join(", ")
+            existing.join(", "),
+            held_advice(dir)
         );
     }
     std::fs::create_dir(&replaced).with_context(|| {
@@ -123,6 +123,26 @@ pub(super) fn open_output(output: &OutputOptions) -> Result<(FolderLock, Option<
         .with_context(|| format!("writing {}", replaced.join(MOVED).display()))?;
     crate::failpoint::point("force-moved");
     Ok((lock, Some(replaced)))
+}
+
+/// What to type for a folder that holds results, by what its summary.json says they are:
+/// every command named here is one that works on such a folder (tests/it/resume_cli.rs
+/// follows each).
+fn held_advice(dir: &Path) -> String {
+    let at = dir.display();
+    let other = "choose another --out, or pass --force to replace them";
+    match results::read_header(dir).map(|h| h.status) {
+        Ok(Some(Status::Complete)) => {
+            format!("they are a complete protocol: `sapnet open {at}` shows them; {other}")
+        }
+        Ok(Some(status)) => format!(
+            "they are an unfinished protocol (status {}): `sapnet --resume --out {at}` \
+             finishes it in the UI, `sapnet --headless --resume --out {at}` without it; or \
+             {other}",
+            format!("{status:?}").to_lowercase()
+        ),
+        Ok(None) | Err(_) => other.to_string(),
+    }
 }
 
 /// What a killed `--force` left, finished before and after a `--resume`: the resumed
@@ -218,7 +238,7 @@ mod tests {
             dir: dir.clone(),
             force: false,
         });
-        assert!(format!("{:#}", refused.unwrap_err()).contains("--resume"));
+        assert!(format!("{:#}", refused.unwrap_err()).contains("--force"));
 
         let (_lock, replaced) = open_output(&OutputOptions {
             dir: dir.clone(),

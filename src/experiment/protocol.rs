@@ -175,73 +175,123 @@ pub fn resume_tapped(
     commands: &Receiver<Command>,
     tap: Option<&Tap>,
 ) -> Result<Summary> {
-    if !dir.is_dir() {
-        bail!(
-            "--out {}: no such results directory to resume (it would hold summary.json)",
-            dir.display()
-        );
-    }
-    let _lock = crate::folder_lock::FolderLock::acquire(dir, "a resume")?;
-    output::finish_replacement(dir)?;
-    let mut header = results::read_header(dir)?;
-    // The folder says what to train, never what program or module runs it.
-    header.config.check_received(python).map_err(|e| {
-        anyhow::anyhow!(
-            "{}: the stored config: {e}",
-            dir.join("summary.json").display()
-        )
-    })?;
-    header.config.run_with(python);
-    if let Some(runs) = runs {
-        let had = header.config.protocol.runs;
-        if runs < had {
+    let stopped = StoppedProtocol::take(dir, runs, added, python)?;
+    resume_taken(stopped, options, commands, tap)
+}
+
+/// A stopped, failed or killed protocol's folder taken for resuming it: its lock held, its
+/// stored config read and checked, its records found in their places. Taken before a
+/// terminal UI opens (as [`OpenedOutput`] is), so that a folder that cannot be resumed is
+/// said on the command line, or by `sapnet open`'s `R` without leaving the screen.
+pub struct StoppedProtocol {
+    lock: FolderLock,
+    dir: PathBuf,
+    header: results::SummaryHeader,
+}
+
+impl StoppedProtocol {
+    /// Takes `dir` for resuming, extended to `runs` per method or by `added`'s methods;
+    /// refused, saying why, when another process writes it or it holds nothing to resume.
+    pub fn take(
+        dir: &Path,
+        runs: Option<u32>,
+        added: Option<&AddedMethods>,
+        python: &PythonSettings,
+    ) -> Result<Self> {
+        if !dir.is_dir() {
             bail!(
-                "{} holds a protocol of {had} runs per method: --runs {runs} would drop runs \
-                 (--resume --runs can only extend it)",
+                "--out {}: no such results directory to resume (it would hold summary.json)",
                 dir.display()
             );
         }
-        if runs > had {
-            header.config.protocol.runs = runs;
-            header.config.validate().map_err(|e| {
-                anyhow::anyhow!("{}: --runs {runs}: {e}", dir.join("summary.json").display())
-            })?;
+        let lock = crate::folder_lock::FolderLock::acquire(dir, "a resume")?;
+        output::finish_replacement(dir)?;
+        let mut header = results::read_header(dir)?;
+        // The folder says what to train, never what program or module runs it.
+        header.config.check_received(python).map_err(|e| {
+            anyhow::anyhow!(
+                "{}: the stored config: {e}",
+                dir.join("summary.json").display()
+            )
+        })?;
+        header.config.run_with(python);
+        if let Some(runs) = runs {
+            let had = header.config.protocol.runs;
+            if runs < had {
+                bail!(
+                    "{} holds a protocol of {had} runs per method: --runs {runs} would drop runs \
+                     (--resume --runs can only extend it)",
+                    dir.display()
+                );
+            }
+            if runs > had {
+                header.config.protocol.runs = runs;
+                header.config.validate().map_err(|e| {
+                    anyhow::anyhow!("{}: --runs {runs}: {e}", dir.join("summary.json").display())
+                })?;
+                header.status = Some(Status::Stopped);
+            }
+        }
+        if let Some(added) = added {
+            add_methods(&mut header.config, added)
+                .map_err(|e| anyhow::anyhow!("--add-methods {}: {e}", added.origin.display()))?;
             header.status = Some(Status::Stopped);
         }
+        match header.status {
+            None | Some(Status::Complete) => bail!(
+                "{} holds a finished protocol (summary.json: status {}): nothing to resume",
+                dir.display(),
+                header
+                    .status
+                    .map_or("absent, written before --resume existed".into(), |s| {
+                        format!("{s:?}").to_lowercase()
+                    })
+            ),
+            Some(_) => {}
+        }
+        // Checked before anything is built or trained: a link planted among the records (or
+        // as `runs/` itself), or a record out of its place, ends the resume before it trains.
+        records::read(dir, &header.config)?;
+        Ok(Self {
+            lock,
+            dir: dir.to_path_buf(),
+            header,
+        })
     }
-    if let Some(added) = added {
-        add_methods(&mut header.config, added)
-            .map_err(|e| anyhow::anyhow!("--add-methods {}: {e}", added.origin.display()))?;
-        header.status = Some(Status::Stopped);
+
+    /// The config the protocol resumes with (its stored one, extended as asked).
+    pub fn config(&self) -> &Config {
+        &self.header.config
     }
-    match header.status {
-        None | Some(Status::Complete) => bail!(
-            "{} holds a finished protocol (summary.json: status {}): nothing to resume",
-            dir.display(),
-            header
-                .status
-                .map_or("absent, written before --resume existed".into(), |s| {
-                    format!("{s:?}").to_lowercase()
-                })
-        ),
-        Some(_) => {}
+
+    pub fn dir(&self) -> &Path {
+        &self.dir
     }
-    // Checked before anything is built or trained: a link planted among the records (or
-    // as `runs/` itself), or a record out of its place, ends the resume before it trains.
-    records::read(dir, &header.config)?;
+}
+
+/// Resumes the protocol of a folder taken for it, with `tap` (if any) told every run's
+/// events and commands as they come: what `--headless --resume` does, and the UI's.
+pub fn resume_taken(
+    stopped: StoppedProtocol,
+    options: &RunOptions,
+    commands: &Receiver<Command>,
+    tap: Option<&Tap>,
+) -> Result<Summary> {
+    let StoppedProtocol { lock, dir, header } = stopped;
     let options = RunOptions {
         trace: header.trace,
         ..options.clone()
     };
     let summary = protocol(
         &header.config,
-        dir,
+        &dir,
         &options,
         Some(header.library.as_deref()),
         commands,
         tap,
     )?;
-    output::finish_replacement(dir)?;
+    output::finish_replacement(&dir)?;
+    drop(lock);
     Ok(summary)
 }
 

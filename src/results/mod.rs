@@ -7,6 +7,7 @@ pub mod assemble;
 pub mod files;
 pub mod folder_changes;
 pub mod folder_state;
+pub mod found;
 pub mod plot_data;
 pub mod pool;
 pub mod recorded_run;

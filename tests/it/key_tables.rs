@@ -27,6 +27,7 @@ use sapnet::tui::event_loop::Flow;
 use sapnet::tui::keys::{ch, code, ctrl, Binding, Key};
 use sapnet::tui::theme::Theme;
 use sapnet::tui::view::View;
+use sapnet::tui::workbench::screens::folders::{FoldersScreen, FOLDERS_KEYS};
 use sapnet::tui::workbench::screens::opened::Opened;
 use sapnet::tui::workbench::screens::session::{overlays, Phase, Request, Session};
 use sapnet::tui::workbench::screens::sweep::{SweepScreen, SWEEP_KEYS};
@@ -34,6 +35,7 @@ use sapnet::tui::workbench::screens::workbench::{OPEN_KEYS, SESSION_KEYS};
 use sapnet::tui::workbench::sweep_folder::{CellRow, CellStatus, SweepState};
 use sapnet::tui::workbench::views::comparison::ComparisonView;
 use sapnet::tui::workbench::views::curves::CurvesView;
+use sapnet::tui::workbench::views::folders::{FolderList, FoldersView};
 use sapnet::tui::workbench::views::run::{LiveRun, RunView};
 use sapnet::tui::workbench::views::runs::RunsView;
 use sapnet::tui::workbench::views::sweep::SweepView;
@@ -67,6 +69,16 @@ impl Walked for Opened {
     fn drawn(&self) -> Buffer {
         draw(|f| self.draw(f, Theme::plain()));
         self.workbench.curves.settle();
+        draw(|f| self.draw(f, Theme::plain()))
+    }
+}
+
+impl Walked for FoldersScreen<'_> {
+    fn press(&mut self, key: KeyEvent) -> bool {
+        self.on_key(key) == Flow::Quit
+    }
+
+    fn drawn(&self) -> Buffer {
         draw(|f| self.draw(f, Theme::plain()))
     }
 }
@@ -384,5 +396,34 @@ fn every_sweep_key_listed_acts_and_every_key_acting_is_listed() {
             .collect(),
         acting: &["", "\t", "\tj"],
         resting: &["", "\tj"],
+    });
+}
+
+/// The Folders view of `sapnet open PARENT`, on a parent of a finished protocol, a stopped
+/// one and a compare folder: mid-list, filtered, and with a folder opened (Esc comes back).
+#[test]
+fn every_folders_key_listed_acts_and_every_key_acting_is_listed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let parent = crate::open_parent::parent(tmp.path());
+    let settings = crate::open_parent::settings();
+    let screen = || {
+        let list = FolderList {
+            parent: parent.clone(),
+            search: sapnet::results::found::find(&parent),
+        };
+        FoldersScreen::new(list, &settings)
+    };
+    let view = FoldersView::default();
+    apart("Folders", view.keys(), FOLDERS_KEYS);
+    walk(&Case {
+        name: "Folders",
+        make: &screen,
+        listed: listed(&[view.keys()])
+            .into_iter()
+            .chain(listed(&[FOLDERS_KEYS]))
+            .collect(),
+        // Mid-list (to move either way), filtered (Esc clears it).
+        acting: &["", "j", "/again\n"],
+        resting: &["", "j"],
     });
 }

@@ -18,7 +18,11 @@ use anyhow::{Context, Result};
 
 use crate::report::Report;
 use crate::results::folder_changes;
-use crate::results::folder_state::{FolderReader, FolderState};
+use crate::results::folder_state::{FolderReader, FolderState, RunStatus};
+use crate::results::Status;
+use crate::trainer::MethodId;
+use crate::tui::follow;
+use crate::tui::workbench::views::run::RunKey;
 
 /// How often the folder is read again: a run's episode is a fraction of a second, its end
 /// seconds to hours; a second keeps the progress current at a few small reads a second.
@@ -62,6 +66,54 @@ impl Folder {
     pub fn methods(&self) -> usize {
         self.state.config.protocol.methods.len()
     }
+}
+
+/// Whether `R` can resume `state`'s protocol where it is shown, and if not why, with what
+/// to type instead: every command said here works when typed (tests/it/resume_cli.rs
+/// follows each).
+pub fn resumable(state: &FolderState) -> Result<(), String> {
+    let dir = state.dir.display();
+    // This process's own lock is the session's protocol, which its phase says (the last
+    // read may have seen the lock before the protocol let it go).
+    let writer = state
+        .writer
+        .as_ref()
+        .filter(|w| w.pid != std::process::id());
+    if let Some(writer) = writer {
+        return Err(format!(
+            "{} writes this folder and goes on there; once it ends or is stopped, R here (or \
+             `sapnet --resume --out {dir}`) finishes what it left",
+            writer.describe()
+        ));
+    }
+    match state.status {
+        Some(Status::Stopped | Status::Failed | Status::Running | Status::Interrupted) => Ok(()),
+        Some(Status::Complete) => Err(format!(
+            "this protocol is complete: nothing to resume (`sapnet --resume --runs N --out \
+             {dir}`, N above its {}, adds runs to it)",
+            state.config.protocol.runs
+        )),
+        None => Err(
+            "summary.json has no status (written before --resume existed): nothing to resume"
+                .into(),
+        ),
+    }
+}
+
+/// The run a resumed protocol is followed in: the first not finished of the method the UI
+/// follows by default, else the first not finished.
+pub fn first_unfinished(state: &FolderState) -> Option<RunKey> {
+    let ids = MethodId::all(&state.config.protocol.methods);
+    let preferred = follow::followed_method(&ids, None).ok().flatten();
+    let unfinished = |method: Option<&MethodId>| {
+        state
+            .runs
+            .iter()
+            .filter(|r| r.status != RunStatus::Done)
+            .find(|r| method.is_none_or(|m| *m == r.method))
+            .map(|r| (r.method.label().to_string(), r.run))
+    };
+    unfinished(preferred.as_ref()).or_else(|| unfinished(None))
 }
 
 /// What the reading thread sends: the folder as read, with the report of its finished

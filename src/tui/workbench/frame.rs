@@ -127,11 +127,12 @@ pub fn protocol_state(folder: &FolderState) -> String {
     }
     match folder.status {
         None | Some(Status::Complete) => "complete".into(),
-        Some(Status::Stopped) => "stopped (--resume finishes it)".into(),
-        Some(Status::Failed) => "failed".into(),
+        // Every screen this is drawn on takes `R` (`sapnet open`, a session).
+        Some(Status::Stopped) => "stopped: R resumes it".into(),
+        Some(Status::Failed) => "failed: R resumes it".into(),
         // `running` with no process holding the lock: the process was killed.
         Some(Status::Running | Status::Interrupted) => {
-            "interrupted: no process writes it (--resume finishes it)".into()
+            "interrupted: no process writes it; R resumes it".into()
         }
     }
 }

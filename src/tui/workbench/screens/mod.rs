@@ -5,8 +5,11 @@
 //!   folder's views and the Run view a tab apart, the keys routed to them;
 //! - [`opened`]: `sapnet open DIR`;
 //! - [`session`]: `sapnet` (a protocol trained in the UI: stop, launch, resume);
-//! - [`sweep`]: `sapnet open SWEEP`.
+//! - [`sweep`]: `sapnet open SWEEP`;
+//! - [`folders`]: `sapnet open PARENT`, the folders under it, each opened on one of the
+//!   screens above.
 
+pub mod folders;
 pub mod opened;
 pub mod session;
 pub mod sweep;

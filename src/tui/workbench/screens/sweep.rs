@@ -97,7 +97,7 @@ impl SweepScreen {
 }
 
 /// The screen on the loop: the view, and the thread that reads the sweep again.
-struct Running {
+pub(crate) struct Running {
     screen: SweepScreen,
     reads: mpsc::Receiver<Read>,
     /// Dropped (however the screen ends), it wakes the thread and ends it.
@@ -129,25 +129,32 @@ impl Screen for Running {
 
 /// Opens the sweep folder `dir` in the Sweep view until the user quits.
 pub fn run(dir: &Path) -> Result<()> {
-    let sweep = SweepState::read(dir).with_context(|| format!("sapnet open {}", dir.display()))?;
-    // A done cell that cannot be read is refused before the terminal is taken.
-    let done = sweep.done();
-    let values =
-        comparisons(dir, &done).with_context(|| format!("sapnet open {}", dir.display()))?;
-    let (reads_tx, reads) = mpsc::channel();
-    let (stop_tx, stop) = mpsc::channel::<()>();
-    let owned = dir.to_path_buf();
-    std::thread::Builder::new()
-        .name("sapnet open: reading the sweep".into())
-        .spawn(move || read_on(&owned, done, &reads_tx, &stop))
-        .context("starting the thread that reads the sweep")?;
-    let mut running = Running {
-        screen: SweepScreen::new(SweepView::new(sweep, values)),
-        reads,
-        _stop: stop_tx,
-        theme: Theme::from_env(),
-    };
-    event_loop::show(&mut running)
+    event_loop::show(&mut Running::start(dir)?)
+}
+
+impl Running {
+    /// The Sweep view on `dir`, read once (a done cell that cannot be read is refused),
+    /// and the thread that reads it on.
+    pub(crate) fn start(dir: &Path) -> Result<Self> {
+        let sweep =
+            SweepState::read(dir).with_context(|| format!("sapnet open {}", dir.display()))?;
+        let done = sweep.done();
+        let values =
+            comparisons(dir, &done).with_context(|| format!("sapnet open {}", dir.display()))?;
+        let (reads_tx, reads) = mpsc::channel();
+        let (stop_tx, stop) = mpsc::channel::<()>();
+        let owned = dir.to_path_buf();
+        std::thread::Builder::new()
+            .name("sapnet open: reading the sweep".into())
+            .spawn(move || read_on(&owned, done, &reads_tx, &stop))
+            .context("starting the thread that reads the sweep")?;
+        Ok(Running {
+            screen: SweepScreen::new(SweepView::new(sweep, values)),
+            reads,
+            _stop: stop_tx,
+            theme: Theme::from_env(),
+        })
+    }
 }
 
 /// Reads the sweep every [`REFRESH`] until `stop` is dropped, with the comparisons made

@@ -88,15 +88,30 @@ const HELP: Binding<ScreenCommand> = Binding {
 /// `q`, Esc and Ctrl-C quit, from a view (Esc closes an overlay or leaves a mode first).
 const QUIT_KEYS: [(keys::Key, ScreenCommand); 3] = keys::quit_keys(S::Quit);
 
-/// `sapnet open`'s keys: it only reads.
+/// A session's `R`.
+const RESUME: Binding<ScreenCommand> = Binding {
+    keys: &[(ch('R'), S::Resume)],
+    help: ("R", "resume the stopped protocol of this folder"),
+    bar: Some(("R", "resume")),
+};
+
+/// `sapnet open`'s keys: it only reads, until `R` asks it to resume the folder.
 pub const OPEN_KEYS: &[Binding<ScreenCommand>] = &[
     TABS,
+    Binding {
+        keys: &[(ch('R'), S::Resume)],
+        help: (
+            "R",
+            "resume the stopped protocol here, as `sapnet --resume` would (or say why not)",
+        ),
+        bar: Some(("R", "resume")),
+    },
     HELP,
     Binding {
         keys: &QUIT_KEYS,
         help: (
             keys::QUIT_KEYS_SAID,
-            "quit (the folder is only read: nothing in it changes)",
+            "quit (the folder is only read: nothing in it changes unless R resumes it)",
         ),
         bar: Some(keys::QUIT_BAR),
     },
@@ -115,11 +130,7 @@ pub const SESSION_KEYS: &[Binding<ScreenCommand>] = &[
         help: ("S", "stop the protocol (asked once; its folder resumable)"),
         bar: Some(("S", "stop")),
     },
-    Binding {
-        keys: &[(ch('R'), S::Resume)],
-        help: ("R", "resume the stopped protocol of this folder"),
-        bar: Some(("R", "resume")),
-    },
+    RESUME,
     HELP,
     Binding {
         keys: &QUIT_KEYS,

@@ -6,12 +6,14 @@
 //! - [`comparison`]: the methods side by side, aggregates with intervals, whiskers, pairs;
 //! - [`curves`]: each method's learning curve over its runs, with its band;
 //! - [`run`]: one run's dashboard, followed live or read from its files;
-//! - [`sweep`]: a sweep folder's cells and each axis value's comparison.
+//! - [`sweep`]: a sweep folder's cells and each axis value's comparison;
+//! - [`folders`]: the folders sapnet wrote under a parent folder, to open one.
 //!
 //! The first three read the folder their screen keeps ([`super::folder::Folder`]).
 
 pub mod comparison;
 pub mod curves;
+pub mod folders;
 pub mod run;
 pub mod runs;
 pub mod sweep;

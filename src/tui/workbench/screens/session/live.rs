@@ -16,16 +16,18 @@ use super::stderr_capture::StderrCapture;
 use super::{overlays, Overlay, Phase, Request, Session};
 use crate::config::Config;
 use crate::env::PythonSettings;
-use crate::experiment::{self, OpenedOutput, OutputOptions, RunOptions};
+use crate::experiment::{self, OpenedOutput, OutputOptions, RunOptions, StoppedProtocol};
+use crate::results::folder_state::FolderReader;
 use crate::results::Summary;
 use crate::trainer::MethodId;
 use crate::tui::event_loop::{self, Flow, Screen};
 use crate::tui::follow;
 use crate::tui::reference::Band;
 use crate::tui::theme::Theme;
-use crate::tui::workbench::folder::FolderReads;
+use crate::tui::workbench::folder::{first_unfinished, FolderReads};
 use crate::tui::workbench::screens::workbench::Tab;
 use crate::tui::workbench::views::run::RunKey;
+use crate::tui::TerminalGuard;
 
 /// What every protocol of the session is run with.
 pub struct Settings<'a> {
@@ -38,52 +40,110 @@ pub struct Settings<'a> {
     pub reference: Vec<Band>,
 }
 
-/// The protocol the UI opens on: its config, and the folder already taken for it.
-pub struct Start {
-    pub config: Config,
-    pub output: OutputOptions,
-    pub opened: OpenedOutput,
-    /// The run followed from its start (`--follow`, `--follow-run`).
-    pub followed: Option<RunKey>,
+/// The protocol the UI opens on.
+pub enum Start {
+    /// A new protocol of `config`, into the folder already taken for it; `followed` is the
+    /// run followed from its start (`--follow`, `--follow-run`).
+    New {
+        config: Config,
+        output: OutputOptions,
+        opened: OpenedOutput,
+        followed: Option<RunKey>,
+    },
+    /// A stopped protocol, its folder taken (`sapnet --resume --out DIR`, `R` in `sapnet
+    /// open`); `followed` as for a new one, else the first run it has left.
+    Resume {
+        stopped: StoppedProtocol,
+        followed: Option<RunKey>,
+    },
 }
 
-/// How the session's last protocol ended, and its folder: what the command line says
-/// after the screen closes. `None`: the user quit while none had ended.
-pub type Ended = Option<(Result<Summary>, PathBuf)>;
+/// How each protocol of the session ended, with its folder, in the order they ended: what
+/// the command line says after the screen closes (every folder, `L`'s too). Empty: the
+/// user quit while none had ended.
+pub type Ended = Vec<(Result<Summary>, PathBuf)>;
 
 /// Runs `start`'s protocol in the UI until the user quits (after it ended, or stopping
 /// it); `L` and `R` start others in the same screen.
 pub fn run(start: Start, settings: &Settings) -> Result<Ended> {
-    let task = start.config.env.gym_id();
-    let dir = start.output.dir.clone();
-    let followed = start.followed.clone();
     let capture = StderrCapture::start();
     let (mut terminal, guard) = crate::tui::open_terminal()?;
-    let protocol = ProtocolRun::start(
-        start.config,
-        start.output,
-        start.opened,
-        settings.options.clone(),
-        followed.clone(),
-    )?;
-    let mut session = Session::new(&dir, &task, followed, Phase::Running);
+    run_in(&mut terminal, guard, capture, start, settings)
+}
+
+/// [`run`] on a terminal a screen already holds (`sapnet open`'s, after `R`): the screen
+/// changes, the terminal stays.
+pub(crate) fn resume_in(
+    terminal: &mut ratatui::DefaultTerminal,
+    guard: TerminalGuard,
+    start: Start,
+    settings: &Settings,
+) -> Result<Ended> {
+    let capture = StderrCapture::start();
+    run_in(terminal, guard, capture, start, settings)
+}
+
+fn run_in(
+    terminal: &mut ratatui::DefaultTerminal,
+    guard: TerminalGuard,
+    capture: Option<StderrCapture>,
+    start: Start,
+    settings: &Settings,
+) -> Result<Ended> {
+    let (protocol, session) = match start {
+        Start::New {
+            config,
+            output,
+            opened,
+            followed,
+        } => {
+            let task = config.env.gym_id();
+            let dir = output.dir.clone();
+            let protocol = ProtocolRun::start(
+                config,
+                output,
+                opened,
+                settings.options.clone(),
+                followed.clone(),
+            )?;
+            (
+                protocol,
+                Session::new(&dir, &task, followed, Phase::Running),
+            )
+        }
+        Start::Resume { stopped, followed } => {
+            let dir = stopped.dir().to_path_buf();
+            let task = stopped.config().env.gym_id();
+            let followed = followed.or_else(|| {
+                let state = FolderReader::new(&dir).read().ok()?;
+                first_unfinished(&state)
+            });
+            let protocol =
+                ProtocolRun::resume(stopped, settings.options.clone(), followed.clone())?;
+            let mut session = Session::new(&dir, &task, followed, Phase::Running);
+            session.workbench.notice = Some(format!("resuming {}", dir.display()));
+            (protocol, session)
+        }
+    };
+    let dir = protocol.dir.clone();
+    let mut session = session;
     session.workbench.run.reference = settings.reference.clone();
     let mut live = Live {
         session,
         protocol: Some(protocol),
         reads: FolderReads::start(&dir)?,
         quit_when_stopped: false,
-        ended: None,
+        ended: Vec::new(),
         settings,
         theme: Theme::from_env(),
     };
-    let result = event_loop::run(&mut terminal, &mut live);
+    let result = event_loop::run(terminal, &mut live);
     drop(guard);
     // A signal, or an error of the screen's: the protocol stops, its folder resumable.
     if let Some(protocol) = live.protocol.take() {
         protocol.stop();
         let dir = protocol.dir.clone();
-        live.ended = Some((protocol.join(), dir));
+        live.ended.push((protocol.join(), dir));
     }
     drop(capture);
     result.map(|()| live.ended)
@@ -193,7 +253,10 @@ impl Live<'_> {
             Ok(summary) => Phase::Ended(summary.status),
             Err(error) => Phase::Failed(format!("{error:#}")),
         };
-        self.ended = Some((outcome, dir));
+        // "resuming DIR" or "X started into DIR" said what began; the header now says how
+        // it ended.
+        session.workbench.notice = None;
+        self.ended.push((outcome, dir));
     }
 
     /// `L` picked `path`: its protocol starts into a new folder, or the picker says why
@@ -222,35 +285,25 @@ impl Live<'_> {
         }
     }
 
-    /// `R`: the folder shown, resumed as `--headless --resume` would; the run followed is
-    /// the first not finished of the method the UI follows by default.
+    /// `R`: the session's folder, taken and resumed as `--headless --resume` would; the
+    /// run followed is the first not finished of the method the UI follows by default.
+    /// The folder is read afresh: the views' last read may be older than the stop.
     fn resume(&mut self) {
         let (session, settings) = (&mut self.session, self.settings);
-        let Some(folder) = &session.workbench.folder else {
-            return;
-        };
-        let folder = &folder.state;
-        let ids = MethodId::all(&folder.config.protocol.methods);
-        let preferred = follow::followed_method(&ids, None).ok().flatten();
-        let unfinished = |method: Option<&MethodId>| {
-            folder
-                .runs
-                .iter()
-                .filter(|r| r.status != crate::results::folder_state::RunStatus::Done)
-                .find(|r| method.is_none_or(|m| *m == r.method))
-                .map(|r| (r.method.label().to_string(), r.run))
-        };
-        let followed = unfinished(preferred.as_ref()).or_else(|| unfinished(None));
-        let (dir, task) = (folder.dir.clone(), folder.config.env.gym_id());
-        match ProtocolRun::resume(
-            &dir,
-            settings.python.clone(),
-            settings.options.clone(),
-            followed.clone(),
-        )
-        .and_then(|protocol| Ok((protocol, FolderReads::start(&dir)?)))
-        {
-            Ok((protocol, reads)) => {
+        let dir = session.dir.clone();
+        let started =
+            StoppedProtocol::take(&dir, None, None, &settings.python).and_then(|stopped| {
+                let task = stopped.config().env.gym_id();
+                let followed = FolderReader::new(&dir)
+                    .read()
+                    .ok()
+                    .and_then(|state| first_unfinished(&state));
+                let protocol =
+                    ProtocolRun::resume(stopped, settings.options.clone(), followed.clone())?;
+                Ok((protocol, FolderReads::start(&dir)?, task, followed))
+            });
+        match started {
+            Ok((protocol, reads, task, followed)) => {
                 self.protocol = Some(protocol);
                 self.reads = reads;
                 session.restart(&dir, &task, followed);

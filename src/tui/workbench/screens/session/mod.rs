@@ -230,20 +230,12 @@ impl Session {
         if self.is_running() {
             return Err("the protocol is training: nothing to resume".into());
         }
-        let Some(folder) = &self.workbench.folder else {
-            return Err("the folder holds no protocol yet".into());
-        };
-        let folder = &folder.state;
-        if let Some(writer) = &folder.writer {
-            return Err(format!("{} writes this folder", writer.describe()));
-        }
-        match folder.status {
-            Some(Status::Stopped | Status::Failed | Status::Running | Status::Interrupted) => {
-                Ok(())
-            }
-            None | Some(Status::Complete) => {
-                Err("this protocol is complete: nothing to resume (L launches another)".into())
-            }
+        match (&self.workbench.folder, &self.phase) {
+            (Some(folder), _) => crate::tui::workbench::folder::resumable(&folder.state),
+            // Not read yet (stopped within a second of its start): how this session's own
+            // protocol ended says it.
+            (None, Phase::Ended(status)) if *status != Status::Complete => Ok(()),
+            (None, _) => Err("the folder holds no protocol yet".into()),
         }
     }
 

@@ -32,7 +32,9 @@ pub fn draw(frame: &mut Frame, session: &Session, theme: Theme) {
         },
     };
     let overlay = |frame: &mut Frame, area: Rect| match &session.overlay {
-        Some(Overlay::Stop { then_quit }) => draw_stop_question(frame, area, *then_quit, theme),
+        Some(Overlay::Stop { then_quit }) => {
+            draw_stop_question(frame, area, &session.dir, *then_quit, theme);
+        }
         Some(Overlay::Picker(picker)) => draw_picker(frame, area, picker, theme),
         None => {}
     };
@@ -70,12 +72,26 @@ fn centered(frame: &mut Frame, area: Rect, width: u16, height: u16) -> Rect {
     rect
 }
 
-fn draw_stop_question(frame: &mut Frame, area: Rect, then_quit: bool, theme: Theme) {
-    let rect = centered(frame, area, 60, 6);
-    let yes = if then_quit {
-        "y stops it and quits"
+fn draw_stop_question(
+    frame: &mut Frame,
+    area: Rect,
+    dir: &std::path::Path,
+    then_quit: bool,
+    theme: Theme,
+) {
+    let rect = centered(frame, area, 64, 7);
+    let dir = dir.display();
+    // What finishes it is what works after this answer: R only while the screen stays.
+    let (yes, later) = if then_quit {
+        (
+            "y stops it and quits",
+            format!("(`sapnet --resume --out {dir}` finishes it later)"),
+        )
     } else {
-        "y stops it"
+        (
+            "y stops it",
+            format!("(R here, or `sapnet --resume --out {dir}` later, finishes it)"),
+        )
     };
     let lines = vec![
         Line::from(Span::styled(
@@ -84,10 +100,7 @@ fn draw_stop_question(frame: &mut Frame, area: Rect, then_quit: bool, theme: The
         )),
         Line::from(""),
         Line::from(format!("{yes} · any other key: it goes on")),
-        Line::from(Span::styled(
-            "(R here, or --headless --resume, finishes it later)",
-            theme.dim(),
-        )),
+        Line::from(Span::styled(later, theme.dim())),
     ];
     frame.render_widget(
         Paragraph::new(lines).wrap(Wrap { trim: true }).block(
@@ -101,7 +114,7 @@ fn draw_stop_question(frame: &mut Frame, area: Rect, then_quit: bool, theme: The
 
 fn draw_picker(frame: &mut Frame, area: Rect, picker: &Picker, theme: Theme) {
     let error_lines = picker.error.as_ref().map_or(0, |_| 4);
-    let wanted = picker.entries.len() as u16 + 7 + error_lines;
+    let wanted = picker.entries.len() as u16 + 8 + error_lines;
     let rect = centered(
         frame,
         area,
@@ -109,33 +122,45 @@ fn draw_picker(frame: &mut Frame, area: Rect, picker: &Picker, theme: Theme) {
         wanted.min(area.height.saturating_sub(2)),
     );
     let inner_width = usize::from(rect.width.saturating_sub(2));
-    let rows = usize::from(rect.height.saturating_sub(7 + error_lines));
-    // The rows shown: a window that keeps the cursor in sight.
-    let total = picker.entries.len() + 1;
-    let first = picker.cursor.saturating_sub(rows.saturating_sub(1));
+    // The configs' rows: a window that keeps the cursor in sight, above the row that takes
+    // a typed path, which is always drawn (a list longer than the screen hid it).
+    let rows = usize::from(rect.height.saturating_sub(8 + error_lines)).max(1);
+    let first = picker
+        .cursor
+        .min(picker.entries.len().saturating_sub(1))
+        .saturating_sub(rows.saturating_sub(1));
     let name_width = picker
         .entries
         .iter()
         .map(|e| file_name(&e.path).chars().count())
         .max()
         .unwrap_or(0);
-    let mut lines: Vec<Line> = Vec::new();
-    for i in first..total.min(first + rows) {
+    let row = |i: usize, text: String| {
         let style = if i == picker.cursor {
             theme.cursor()
         } else {
             Style::new()
         };
-        let text = match picker.entries.get(i) {
-            Some(entry) => format!(" {:<name_width$}  {}", file_name(&entry.path), entry.about),
-            None => match &picker.typing {
-                Some(typed) => format!(" path: {typed}▏"),
-                None => " a path… (Enter, then type it)".into(),
-            },
-        };
         let text: String = text.chars().take(inner_width).collect();
-        lines.push(Line::from(Span::styled(text, style)));
+        Line::from(Span::styled(text, style))
+    };
+    let mut lines: Vec<Line> = Vec::new();
+    for (i, entry) in picker.entries.iter().enumerate().skip(first).take(rows) {
+        let text = format!(" {:<name_width$}  {}", file_name(&entry.path), entry.about);
+        lines.push(row(i, text));
     }
+    let hidden = picker.entries.len().saturating_sub(first + rows);
+    if hidden > 0 {
+        lines.push(Line::from(Span::styled(
+            format!(" ▼ {hidden} more"),
+            theme.dim(),
+        )));
+    }
+    let path_row = match &picker.typing {
+        Some(typed) => format!(" path: {typed}▏"),
+        None => " another config: Enter here, then type its path".into(),
+    };
+    lines.push(row(picker.entries.len(), path_row));
     lines.push(Line::from(""));
     if let Some(error) = &picker.error {
         lines.push(Line::from(Span::styled(error.clone(), theme.stopped())));

@@ -1,16 +1,17 @@
 //! A protocol trained behind the screen: the experiment layer's engine ([`experiment::run_opened`],
-//! [`experiment::resume_tapped`]: its scheduler, seeds and files) on a thread of its own,
+//! [`experiment::resume_taken`]: its scheduler, seeds and files) on a thread of its own,
 //! tapped so that the screen sees every run's events and can steer the one it follows.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::thread::JoinHandle;
 
 use anyhow::{Context, Result};
 
 use crate::config::Config;
-use crate::env::PythonSettings;
-use crate::experiment::{self, OpenedOutput, OutputOptions, RunOptions, Tap, Watched};
+use crate::experiment::{
+    self, OpenedOutput, OutputOptions, RunOptions, StoppedProtocol, Tap, Watched,
+};
 use crate::results::Summary;
 use crate::trainer::Command;
 use crate::tui::workbench::views::run::RunKey;
@@ -40,17 +41,15 @@ impl ProtocolRun {
         })
     }
 
-    /// Resumes the stopped protocol of `dir`, as `--headless --resume --out DIR` does;
-    /// `live` streams every step.
+    /// Resumes the stopped protocol of a folder taken for it, as `--headless --resume
+    /// --out DIR` does; `live` streams every step.
     pub fn resume(
-        dir: &Path,
-        python: PythonSettings,
+        stopped: StoppedProtocol,
         options: RunOptions,
         live: Option<RunKey>,
     ) -> Result<Self> {
-        let at = dir.to_path_buf();
-        Self::spawn(dir.to_path_buf(), live, move |commands, tap| {
-            experiment::resume_tapped(&at, None, None, &python, &options, commands, Some(tap))
+        Self::spawn(stopped.dir().to_path_buf(), live, move |commands, tap| {
+            experiment::resume_taken(stopped, &options, commands, Some(tap))
         })
     }
 
