@@ -36,7 +36,9 @@ mod tests {
     fn the_followed_methods_column_is_said_by_its_selector() {
         let lines = legend(Some(crate::reuse::gpi::SCORE));
         assert_eq!(lines.len(), SYMBOLS.len() + 1);
-        assert!(lines[SYMBOLS.len()].1.starts_with("wins: steps its Q won the max"));
+        assert!(lines[SYMBOLS.len()]
+            .1
+            .starts_with("wins: steps its Q won the max"));
         let dqn = crate::reuse::ScoreColumn::NONE;
         assert_eq!(legend(Some(dqn)).len(), SYMBOLS.len(), "no score, no line");
         assert_eq!(legend(None).len(), SYMBOLS.len());
