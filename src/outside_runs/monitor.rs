@@ -17,12 +17,20 @@ use std::path::Path;
 use super::table::{Comments, Table};
 use super::{Axis, Format, Gathered, OutsideRun, OutsideRunError};
 
-/// Reads the monitor file `file`, opened from `path`.
+/// Reads the monitor file `file`, opened from `path`: at most
+/// [`MAX_EPISODES`](crate::limits::MAX_EPISODES) rows.
 pub fn read(file: File, path: &Path) -> Result<OutsideRun, OutsideRunError> {
-    let mut table = Table::read(file, path, Comments::Skipped)?.at_most(
-        crate::limits::MAX_EPISODES as usize,
-        "episodes a run may have (a row each)",
-    );
+    read_at_most(file, path, crate::limits::MAX_EPISODES as usize)
+}
+
+/// [`read`], at most `rows` rows (a test's bound scaled down).
+pub(super) fn read_at_most(
+    file: File,
+    path: &Path,
+    rows: usize,
+) -> Result<OutsideRun, OutsideRunError> {
+    let mut table = Table::read(file, path, Comments::Skipped)?
+        .at_most(rows, "episodes a run may have (a row each)");
     let return_column = table.column(&["r"])?;
     let length_column = table.column(&["l"])?;
     let mut episodes = Gathered::new(Axis::Steps);

@@ -285,3 +285,27 @@ fn a_link_inside_a_folder_of_event_files_is_refused() {
     std::os::unix::fs::symlink(&elsewhere, &named_link).unwrap();
     assert_eq!(read(&named_link).unwrap().episodes.len(), 1);
 }
+
+#[test]
+fn a_monitor_file_is_read_up_to_its_bound_of_rows_and_refused_past_it() {
+    // MAX_EPISODES (10 M rows) scaled down to 3: at the bound it reads, past it the first
+    // row too many is named.
+    let dir = tempfile::tempdir().unwrap();
+    let rows = |n: usize| {
+        let mut text = String::from("#{\"t_start\": 0}\nr,l,t\n");
+        for i in 1..=n {
+            text.push_str(&format!("{i}.0,{i},0.1\n"));
+        }
+        write(dir.path(), &format!("{n}.monitor.csv"), text)
+    };
+    let at = rows(3);
+    let run = monitor::read_at_most(std::fs::File::open(&at).unwrap(), &at, 3).unwrap();
+    assert_eq!(run.episodes.returns, [1.0, 2.0, 3.0]);
+    assert_eq!(run.steps(), Some(6));
+    let past = rows(4);
+    let err = monitor::read_at_most(std::fs::File::open(&past).unwrap(), &past, 3)
+        .unwrap_err()
+        .to_string();
+    assert!(err.starts_with(&past.display().to_string()), "{err}");
+    assert!(err.contains("line 6") && err.contains('3'), "{err}");
+}
