@@ -1357,6 +1357,8 @@ fn an_endless_line_is_refused_at_its_bound() {
 
 /// `command`'s peak resident memory in KiB (from `wait4`, this child's own), and whether
 /// it exited 0.
+// The child is reaped by wait4, which gives its rusage; Child::wait cannot.
+#[allow(clippy::zombie_processes)]
 fn peak_kib(command: &mut Command) -> (bool, u64) {
     let child = command
         .stdout(Stdio::null())

@@ -520,7 +520,7 @@ mod tests {
         let kept = thinned(long.clone(), count);
         assert!(kept.len() <= 4 * SPANS, "{}", kept.len());
         assert_eq!(kept.first(), long.clone().next().as_ref());
-        assert_eq!(kept.last(), long.clone().last().as_ref());
+        assert_eq!(kept.last(), long.clone().next_back().as_ref());
         assert!(
             kept.windows(2).all(|w| w[0].0 < w[1].0),
             "in order, none twice"
