@@ -86,25 +86,25 @@ pub fn compare(args: &CompareArgs) -> Result<Report> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
 
     let kinds = kinds(methods.len());
-    let (budget, episodes) = alignment(args, &methods)?;
+    let budget = alignment(args, &methods)?;
     let window = args.window as usize;
     let scored: Vec<ScoredMethod> = methods
         .iter()
         .zip(&kinds)
-        .zip(&episodes)
-        .map(|((m, &kind), episodes)| ScoredMethod {
+        .map(|(m, &kind)| ScoredMethod {
             label: m.name.clone(),
             kind,
             runs: m
                 .runs
                 .iter()
-                .zip(episodes)
-                .map(|(r, episodes)| score(r, episodes, budget, window, last))
+                .map(|r| score(r, budget, window, last))
                 .collect(),
         })
         .collect();
     let report = Report::of_scored(&task, range, last.get(), &scored);
     report.write(out)?;
+    // The plots take the runs' episodes, which are not copied: what is left of each run
+    // is where it came from, for runs.csv.
     let data = PlotData {
         task: task.clone(),
         subject: None,
@@ -112,13 +112,16 @@ pub fn compare(args: &CompareArgs) -> Result<Report> {
         window,
         budget,
         curves: methods
-            .iter()
+            .iter_mut()
             .zip(&kinds)
-            .zip(episodes)
-            .map(|((m, &kind), runs)| Curve {
+            .map(|(m, &kind)| Curve {
                 label: m.name.clone(),
                 kind,
-                runs,
+                runs: m
+                    .runs
+                    .iter_mut()
+                    .map(|r| std::mem::take(&mut r.episodes))
+                    .collect(),
                 tests: Vec::new(),
             })
             .collect(),
@@ -131,108 +134,43 @@ pub fn compare(args: &CompareArgs) -> Result<Report> {
     Ok(report)
 }
 
-/// How the runs are put side by side, and each method's runs as sapnet's own: by step up to
-/// `--steps` or the steps every run reached, when every run says where its episodes ended
-/// (and `--by-episode` does not ask otherwise); else by episode.
-fn alignment(
-    args: &CompareArgs,
-    methods: &[Method],
-) -> Result<(Budget, Vec<Vec<TrainingEpisodes>>)> {
-    let by_step: Option<Vec<Vec<TrainingEpisodes>>> = methods
-        .iter()
-        .map(|m| m.runs.iter().map(training_episodes).collect())
-        .collect();
-    let most_episodes = methods
-        .iter()
-        .flat_map(|m| &m.runs)
-        .map(|r| r.episodes.len())
-        .max()
-        .unwrap_or(1);
-    let by_episode = || {
-        let runs = methods
-            .iter()
-            .map(|m| {
-                m.runs
-                    .iter()
-                    .map(|r| TrainingEpisodes {
-                        returns: r.returns().collect(),
-                        lengths: r
-                            .episodes
-                            .iter()
-                            .map(|e| e.length.unwrap_or(0) as u32)
-                            .collect(),
-                    })
-                    .collect()
-            })
-            .collect();
-        (Budget::Episodes(most_episodes as u32), runs)
-    };
+/// How the runs are put side by side: by step up to `--steps` or the steps every run
+/// reached, when every run says where its episodes ended (and `--by-episode` does not ask
+/// otherwise); else by episode.
+fn alignment(args: &CompareArgs, methods: &[Method]) -> Result<Budget> {
+    let runs = || methods.iter().flat_map(|m| &m.runs);
+    let by_step = runs().all(|r| r.placed().is_some());
+    let most_episodes = runs().map(|r| r.episodes.len()).max().unwrap_or(1);
+    let by_episode = Budget::Episodes(most_episodes as u32);
     match (by_step, args.by_episode, args.steps) {
-        (_, true, _) => Ok(by_episode()),
-        (Some(runs), false, given) => {
-            let reached = runs
-                .iter()
-                .flatten()
-                .map(|r| r.ends().last().copied().unwrap_or(0))
+        (_, true, _) => Ok(by_episode),
+        (true, false, given) => {
+            let reached = runs()
+                .filter_map(OutsideRun::placed)
+                .map(TrainingEpisodes::steps)
                 .min()
                 .unwrap_or(0);
             match given.unwrap_or(reached) {
-                0 => Ok(by_episode()),
-                budget => Ok((Budget::Steps(budget), runs)),
+                0 => Ok(by_episode),
+                budget => Ok(Budget::Steps(budget)),
             }
         }
-        (None, false, Some(_)) => {
-            let run = methods
-                .iter()
-                .flat_map(|m| &m.runs)
-                .find(|r| training_episodes(r).is_none())
+        (false, false, Some(_)) => {
+            let run = runs()
+                .find(|r| r.placed().is_none())
                 .map_or_else(String::new, |r| r.path.display().to_string());
             bail!(
                 "--steps: expected every run to say where its episodes ended (a step column, \
                  episode lengths, event files' steps); {run} gives neither"
             )
         }
-        (None, false, None) => Ok(by_episode()),
+        (false, false, None) => Ok(by_episode),
     }
 }
 
-/// `run`'s episodes as sapnet's own are kept, each with its length in steps, when its
-/// file places every episode by step (lengths are the steps between two ends) or
-/// gives every length; `None` otherwise.
-fn training_episodes(run: &OutsideRun) -> Option<TrainingEpisodes> {
-    let lengths: Vec<u32> = match run.axis {
-        outside_runs::Axis::Steps => {
-            let mut previous = 0i64;
-            run.episodes
-                .iter()
-                .map(|e| {
-                    let length = e.at.saturating_sub(previous).max(0);
-                    previous = previous.max(e.at);
-                    u32::try_from(length).unwrap_or(u32::MAX)
-                })
-                .collect()
-        }
-        outside_runs::Axis::Episodes => run
-            .episodes
-            .iter()
-            .map(|e| e.length.map(|l| u32::try_from(l).unwrap_or(u32::MAX)))
-            .collect::<Option<_>>()?,
-    };
-    Some(TrainingEpisodes {
-        returns: run.returns().collect(),
-        lengths,
-    })
-}
-
-/// What run `run` scored, read as `episodes` under `budget` (`window` the step curve's
-/// moving average, `last` the episodes of the final score).
-fn score(
-    run: &OutsideRun,
-    episodes: &TrainingEpisodes,
-    budget: Budget,
-    window: usize,
-    last: NonZeroUsize,
-) -> ScoredRun {
+/// What run `run` scored under `budget` (`window` the step curve's moving average, `last`
+/// the episodes of the final score).
+fn score(run: &OutsideRun, budget: Budget, window: usize, last: NonZeroUsize) -> ScoredRun {
     match budget {
         Budget::Episodes(_) => ScoredRun {
             training_return: run.training_return(),
@@ -241,9 +179,11 @@ fn score(
             steps: run.steps(),
         },
         Budget::Steps(budget) => {
+            // A step budget is chosen only when every run's lengths are known.
+            let episodes = &run.episodes;
             let points = step_axis::points(budget, sample_efficiency::POINTS);
             let curve = step_axis::curve(episodes, window, &points);
-            let ended = episodes.ends().partition_point(|&end| end <= budget);
+            let ended = step_axis::ended_by(episodes, budget);
             ScoredRun {
                 // Every run has an episode ended by the steps every run reached.
                 training_return: step_axis::area(&curve).unwrap_or(f64::NAN),
@@ -426,38 +366,41 @@ fn write_runs(path: &Path, methods: &[Method], scored: &[ScoredMethod]) -> Resul
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-    use crate::outside_runs::{Episode, Format};
-
-    fn run(returns: &[f64]) -> OutsideRun {
-        OutsideRun {
-            path: "run.csv".into(),
-            format: Format::Csv,
-            series: "return".into(),
-            axis: outside_runs::Axis::Episodes,
-            episodes: returns
-                .iter()
-                .enumerate()
-                .map(|(i, &r)| Episode {
-                    at: i as i64 + 1,
-                    episode_return: r,
-                    length: None,
-                })
-                .collect(),
-        }
-    }
+    use crate::outside_runs::{Axis, Format, Gathered};
 
     #[test]
     fn episodes_placed_by_step_give_their_lengths() {
-        let mut r = run(&[1.0, 2.0, 3.0]);
-        assert_eq!(training_episodes(&r), None, "no lengths, no steps");
-        r.axis = outside_runs::Axis::Steps;
-        for (e, at) in r.episodes.iter_mut().zip([10, 30, 60]) {
-            e.at = at;
+        let mut by_episode = Gathered::new(Axis::Episodes);
+        let mut by_step = Gathered::new(Axis::Steps);
+        for (at, r) in [(10, 1.0), (30, 2.0), (60, 3.0)] {
+            by_episode.push(at, r, None);
+            by_step.push(at, r, None);
         }
-        let episodes = training_episodes(&r).unwrap();
+        let r = by_episode.into_run("run.csv".as_ref(), Format::Csv, "return".into());
+        assert_eq!(r.placed(), None, "no lengths, no steps");
+        assert_eq!(r.steps(), None);
+        let r = by_step.into_run("run.csv".as_ref(), Format::Csv, "return".into());
+        let episodes = r.placed().unwrap();
         assert_eq!(episodes.lengths, [10, 20, 30]);
         assert_eq!(episodes.ends(), [10, 30, 60]);
         assert_eq!(r.steps(), Some(60));
+    }
+
+    #[test]
+    fn a_step_behind_the_furthest_is_a_length_of_0_and_a_gap_past_u32_is_cut() {
+        let mut by_step = Gathered::new(Axis::Steps);
+        for (at, r) in [(50, 1.0), (20, 2.0), (70, 3.0), (70 + (1 << 33), 4.0)] {
+            by_step.push(at, r, None);
+        }
+        let r = by_step.into_run("run.csv".as_ref(), Format::Csv, "return".into());
+        assert_eq!(r.episodes.lengths, [50, 0, 20, u32::MAX]);
+        assert_eq!(r.steps(), Some(70 + (1 << 33)));
+        // Lengths given on the episode axis: their sum, each cut at u32::MAX.
+        let mut by_episode = Gathered::new(Axis::Episodes);
+        by_episode.push(1, 1.0, Some(5));
+        by_episode.push(2, 1.0, Some(1 << 40));
+        let r = by_episode.into_run("run.csv".as_ref(), Format::Csv, "return".into());
+        assert_eq!(r.placed().unwrap().lengths, [5, u32::MAX]);
+        assert_eq!(r.steps(), Some(5 + (1 << 40)));
     }
 }

@@ -9,8 +9,7 @@ use std::path::{Path, PathBuf};
 
 use super::error::Location;
 use super::{
-    Axis, Episode, Format, OutsideRun, OutsideRunError, ReadOptions, LENGTH_TAG, RETURN_TAG,
-    ROLLOUT_MEAN_TAG,
+    Axis, Format, Gathered, OutsideRun, OutsideRunError, ReadOptions, RETURN_TAG, ROLLOUT_MEAN_TAG,
 };
 use crate::safe_io::Links;
 use crate::tensorboard::EventFile;
@@ -69,7 +68,6 @@ struct Scan {
     /// The return tags to try, in order.
     tags: Vec<String>,
     returns: Vec<Vec<Point>>,
-    lengths: Vec<Point>,
     files: Vec<PathBuf>,
     seen: BTreeSet<String>,
 }
@@ -86,7 +84,6 @@ impl Scan {
         Self {
             returns: tags.iter().map(|_| Vec::new()).collect(),
             tags,
-            lengths: Vec::new(),
             files: Vec::new(),
             seen: BTreeSet::new(),
         }
@@ -106,8 +103,6 @@ impl Scan {
                 };
                 if let Some(i) = self.tags.iter().position(|t| *t == scalar.tag) {
                     self.returns[i].push(point);
-                } else if scalar.tag == LENGTH_TAG {
-                    self.lengths.push(point);
                 }
                 self.seen.insert(scalar.tag);
             }
@@ -126,14 +121,8 @@ impl Scan {
         };
         let tag = &self.tags[chosen];
         let returns = &self.returns[chosen];
-        // CleanRL logs each episode's length beside its return; other tags have none.
-        let lengths = if tag == RETURN_TAG {
-            paired_lengths(returns, &self.lengths)
-        } else {
-            None
-        };
-        let mut episodes = Vec::with_capacity(returns.len());
-        for (i, point) in returns.iter().enumerate() {
+        let mut episodes = Gathered::new(Axis::Steps);
+        for point in returns {
             if !point.value.is_finite() {
                 return Err(OutsideRunError::NonFiniteReturn {
                     path: self.files[point.file].clone(),
@@ -144,34 +133,9 @@ impl Scan {
                     value: point.value,
                 });
             }
-            episodes.push(Episode {
-                at: point.step,
-                episode_return: point.value,
-                length: lengths.as_ref().map(|l| l[i]),
-            });
+            // Placed by their steps, episodes need no length (CleanRL's length tag).
+            episodes.push(point.step, point.value, None);
         }
-        Ok(OutsideRun {
-            path: path.to_path_buf(),
-            format: Format::EventFiles,
-            series: tag.clone(),
-            axis: Axis::Steps,
-            episodes,
-        })
+        Ok(episodes.into_run(path, Format::EventFiles, tag.clone()))
     }
-}
-
-/// The episodes' lengths, if the length scalars pair with the returns one to one, at the
-/// same steps, each a whole number of steps; else none (lengths are not guessed).
-fn paired_lengths(returns: &[Point], lengths: &[Point]) -> Option<Vec<u64>> {
-    if returns.len() != lengths.len() {
-        return None;
-    }
-    returns
-        .iter()
-        .zip(lengths)
-        .map(|(r, l)| {
-            let whole = l.value >= 0.0 && l.value.fract() == 0.0 && l.value < u64::MAX as f64;
-            (r.step == l.step && whole).then_some(l.value as u64)
-        })
-        .collect()
 }

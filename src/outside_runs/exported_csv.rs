@@ -11,7 +11,7 @@ use std::path::Path;
 
 use super::table::{Comments, Table};
 use super::{
-    Axis, Episode, Format, OutsideRun, OutsideRunError, PositionColumn, ReadOptions,
+    Axis, Format, Gathered, OutsideRun, OutsideRunError, PositionColumn, ReadOptions,
     EPISODE_COLUMNS, LENGTH_COLUMNS, RETURN_COLUMNS, STEP_COLUMNS,
 };
 
@@ -27,7 +27,7 @@ pub fn read(file: File, path: &Path, options: &ReadOptions) -> Result<OutsideRun
         Some(name) => Some(table.column(&[name])?),
         None => table.find(&LENGTH_COLUMNS),
     };
-    let mut episodes = Vec::new();
+    let mut episodes = Gathered::new(axis);
     while let Some(row) = table.next_row() {
         let row = row?;
         let return_cell = table.cell(&row, return_column);
@@ -38,11 +38,8 @@ pub fn read(file: File, path: &Path, options: &ReadOptions) -> Result<OutsideRun
             Some(cell) if !cell.is_empty() => Some(cell.length()?),
             _ => None,
         };
-        episodes.push(Episode {
-            at: table.cell(&row, position_column).whole()?,
-            episode_return: return_cell.episode_return()?,
-            length,
-        });
+        let at = table.cell(&row, position_column).whole()?;
+        episodes.push(at, return_cell.episode_return()?, length);
     }
     let series = table.name(return_column).to_string();
     if episodes.is_empty() {
@@ -51,13 +48,7 @@ pub fn read(file: File, path: &Path, options: &ReadOptions) -> Result<OutsideRun
             what: format!("the column {series:?}"),
         });
     }
-    Ok(OutsideRun {
-        path: path.to_path_buf(),
-        format: Format::Csv,
-        series,
-        axis,
-        episodes,
-    })
+    Ok(episodes.into_run(path, Format::Csv, series))
 }
 
 /// The column that places episodes, and what it counts: the one the caller named, else

@@ -31,6 +31,7 @@ mod table;
 use std::io::{Read, Seek};
 use std::path::{Path, PathBuf};
 
+use crate::report::TrainingEpisodes;
 use crate::safe_io::{self, Links};
 use crate::tensorboard::MAX_EVENT_FILE_BYTES;
 
@@ -73,7 +74,7 @@ pub enum Format {
     ResultsFolder,
 }
 
-/// What [`Episode::at`] counts.
+/// What a file places its episodes by.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Axis {
     /// Environment steps since the run began, at the episode's end.
@@ -82,18 +83,9 @@ pub enum Axis {
     Episodes,
 }
 
-/// One episode of a run.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Episode {
-    /// Where it ended on the run's [`Axis`].
-    pub at: i64,
-    /// Its return, finite.
-    pub episode_return: f64,
-    /// Its length in steps, if the file says.
-    pub length: Option<u64>,
-}
-
-/// A run made by another tool: its episodes in the file's order, never none.
+/// A run made by another tool: its episodes in the file's order, never none, each kept
+/// as sapnet keeps its own (a return and a length, 12 bytes, whatever the file spent on
+/// the row), so that a file of millions of rows costs about what its numbers do.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutsideRun {
     /// The file or folder it was read from.
@@ -101,9 +93,84 @@ pub struct OutsideRun {
     pub format: Format,
     /// The column or tag its returns were read from.
     pub series: String,
-    /// What its episodes' `at` counts.
+    /// What placed its episodes in the file.
     pub axis: Axis,
-    pub episodes: Vec<Episode>,
+    /// Each episode's return, finite, and its length in steps (cut at `u32::MAX`): on the
+    /// [`Axis::Steps`] the steps from the furthest end before it to its own (0 for an
+    /// episode placed before one already read); on the [`Axis::Episodes`] the file's
+    /// length, 0 where it gives none.
+    pub episodes: TrainingEpisodes,
+    /// Whether the lengths above are every episode's: always on the step axis, on the
+    /// episode axis only when the file gives each episode's length.
+    pub lengths_known: bool,
+    /// The environment steps the run took by its last episode's end, when its file places
+    /// episodes by step (the last one's step) or gives every length (their sum).
+    steps: Option<u64>,
+}
+
+/// An [`OutsideRun`]'s episodes gathered row by row, keeping only what it scores by.
+pub(crate) struct Gathered {
+    axis: Axis,
+    episodes: TrainingEpisodes,
+    /// The furthest step an episode ended at so far, and the last episode's.
+    furthest: i64,
+    last: i64,
+    /// The sum of the lengths so far, while every episode has one.
+    length_sum: Option<u64>,
+}
+
+impl Gathered {
+    pub fn new(axis: Axis) -> Self {
+        Self {
+            axis,
+            episodes: TrainingEpisodes::default(),
+            furthest: 0,
+            last: 0,
+            length_sum: Some(0),
+        }
+    }
+
+    /// An episode that ended at `at` on the axis (a step, or an episode number), with
+    /// its return and, if the file says, its length.
+    pub fn push(&mut self, at: i64, episode_return: f64, length: Option<u64>) {
+        let cut = |steps: u64| u32::try_from(steps).unwrap_or(u32::MAX);
+        let kept = match self.axis {
+            Axis::Steps => {
+                let since = at.saturating_sub(self.furthest).max(0);
+                self.furthest = self.furthest.max(at);
+                self.last = at;
+                cut(since as u64)
+            }
+            Axis::Episodes => {
+                self.length_sum = self
+                    .length_sum
+                    .and_then(|sum| length.map(|l| sum.saturating_add(l)));
+                length.map_or(0, cut)
+            }
+        };
+        self.episodes.push(episode_return, kept);
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.episodes.is_empty()
+    }
+
+    /// The run read from `path`'s `series`.
+    pub fn into_run(self, path: &Path, format: Format, series: String) -> OutsideRun {
+        let (steps, lengths_known) = match self.axis {
+            Axis::Steps => (Some(self.last.max(0) as u64), true),
+            Axis::Episodes => (self.length_sum, self.length_sum.is_some()),
+        };
+        OutsideRun {
+            path: path.to_path_buf(),
+            format,
+            series,
+            axis: self.axis,
+            episodes: self.episodes,
+            lengths_known,
+            steps,
+        }
+    }
 }
 
 /// A CSV column that places each episode: by steps or by episode number.

@@ -15,28 +15,32 @@ use std::fs::File;
 use std::path::Path;
 
 use super::table::{Comments, Table};
-use super::{Axis, Episode, Format, OutsideRun, OutsideRunError};
+use super::{Axis, Format, Gathered, OutsideRun, OutsideRunError};
 
-/// Reads the monitor file `file`, opened from `path`.
+/// Reads the monitor file `file`, opened from `path`: at most
+/// [`MAX_EPISODES`](crate::limits::MAX_EPISODES) rows.
 pub fn read(file: File, path: &Path) -> Result<OutsideRun, OutsideRunError> {
-    let mut table = Table::read(file, path, Comments::Skipped)?.at_most(
-        crate::limits::MAX_EPISODES as usize,
-        "episodes a run may have (a row each)",
-    );
+    read_at_most(file, path, crate::limits::MAX_EPISODES as usize)
+}
+
+/// [`read`], at most `rows` rows (a test's bound scaled down).
+pub(super) fn read_at_most(
+    file: File,
+    path: &Path,
+    rows: usize,
+) -> Result<OutsideRun, OutsideRunError> {
+    let mut table = Table::read(file, path, Comments::Skipped)?
+        .at_most(rows, "episodes a run may have (a row each)");
     let return_column = table.column(&["r"])?;
     let length_column = table.column(&["l"])?;
-    let mut episodes = Vec::new();
+    let mut episodes = Gathered::new(Axis::Steps);
     let mut steps: i64 = 0;
     while let Some(row) = table.next_row() {
         let row = row?;
         let episode_return = table.cell(&row, return_column).episode_return()?;
         let length = table.cell(&row, length_column).length()?;
         steps = steps.saturating_add(i64::try_from(length).unwrap_or(i64::MAX));
-        episodes.push(Episode {
-            at: steps,
-            episode_return,
-            length: Some(length),
-        });
+        episodes.push(steps, episode_return, Some(length));
     }
     if episodes.is_empty() {
         return Err(OutsideRunError::NoEpisode {
@@ -44,11 +48,5 @@ pub fn read(file: File, path: &Path) -> Result<OutsideRun, OutsideRunError> {
             what: "the column \"r\"".to_string(),
         });
     }
-    Ok(OutsideRun {
-        path: path.to_path_buf(),
-        format: Format::Monitor,
-        series: "r".to_string(),
-        axis: Axis::Steps,
-        episodes,
-    })
+    Ok(episodes.into_run(path, Format::Monitor, "r".to_string()))
 }

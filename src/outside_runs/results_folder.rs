@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use super::table::{Comments, Table};
-use super::{Axis, Episode, Format, OutsideRun, OutsideRunError};
+use super::{Axis, Format, Gathered, OutsideRun, OutsideRunError};
 use crate::safe_io;
 
 /// The file of a results folder that holds every episode of every run.
@@ -34,7 +34,7 @@ pub fn read_method(dir: &Path, method: &str) -> Result<Vec<OutsideRun>, OutsideR
     let method_column = table.column(&["method"])?;
     let episode_column = table.column(&["episode"])?;
     let reward_column = table.column(&["reward"])?;
-    let mut runs: BTreeMap<i64, Vec<Episode>> = BTreeMap::new();
+    let mut runs: BTreeMap<i64, Gathered> = BTreeMap::new();
     // The folder's other methods, in the order met, for the refusal: a set beside the list
     // keeps a file of 200,000 labels linear.
     let mut methods: Vec<String> = Vec::new();
@@ -50,12 +50,11 @@ pub fn read_method(dir: &Path, method: &str) -> Result<Vec<OutsideRun>, OutsideR
             continue;
         }
         let run = table.cell(&row, run_column).whole()?;
-        let episode = Episode {
-            at: table.cell(&row, episode_column).whole()?,
-            episode_return: table.cell(&row, reward_column).episode_return()?,
-            length: None,
-        };
-        runs.entry(run).or_default().push(episode);
+        let at = table.cell(&row, episode_column).whole()?;
+        let episode_return = table.cell(&row, reward_column).episode_return()?;
+        runs.entry(run)
+            .or_insert_with(|| Gathered::new(Axis::Episodes))
+            .push(at, episode_return, None);
     }
     if runs.is_empty() {
         return Err(OutsideRunError::NoSuchMethod {
@@ -66,12 +65,12 @@ pub fn read_method(dir: &Path, method: &str) -> Result<Vec<OutsideRun>, OutsideR
     }
     Ok(runs
         .into_iter()
-        .map(|(run, episodes)| OutsideRun {
-            path: run_path(dir, method, run),
-            format: Format::ResultsFolder,
-            series: "reward".to_string(),
-            axis: Axis::Episodes,
-            episodes,
+        .map(|(run, episodes)| {
+            episodes.into_run(
+                &run_path(dir, method, run),
+                Format::ResultsFolder,
+                "reward".to_string(),
+            )
         })
         .collect())
 }

@@ -3,20 +3,24 @@
 use std::num::NonZeroUsize;
 
 use super::OutsideRun;
+use crate::report::TrainingEpisodes;
 
 impl OutsideRun {
     /// The episodes' returns, in order.
     pub fn returns(&self) -> impl Iterator<Item = f64> + '_ {
-        self.episodes.iter().map(|e| e.episode_return)
+        self.episodes.returns.iter().copied()
     }
 
     /// The environment steps the run took by its last episode's end, when its file places
     /// episodes by step or gives their lengths.
     pub fn steps(&self) -> Option<u64> {
-        match self.axis {
-            super::Axis::Steps => self.episodes.last().map(|e| e.at.max(0) as u64),
-            super::Axis::Episodes => self.episodes.iter().map(|e| e.length).sum(),
-        }
+        self.steps
+    }
+
+    /// Its episodes as sapnet keeps its own, when every episode's length is known (see
+    /// [`OutsideRun::lengths_known`]): what a step axis reads.
+    pub fn placed(&self) -> Option<&TrainingEpisodes> {
+        self.lengths_known.then_some(&self.episodes)
     }
 
     /// The training return: the plain mean of every episode's return, as sapnet scores its
@@ -31,32 +35,23 @@ impl OutsideRun {
 
     /// The mean return of the last `k` episodes, or of all of them if the run has fewer.
     pub fn final_score(&self, k: NonZeroUsize) -> f64 {
-        let last = &self.episodes[self.episodes.len().saturating_sub(k.get())..];
-        last.iter().map(|e| e.episode_return).sum::<f64>() / last.len() as f64
+        let returns = &self.episodes.returns;
+        let last = &returns[returns.len().saturating_sub(k.get())..];
+        last.iter().sum::<f64>() / last.len() as f64
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::{Axis, Episode, Format};
+    use super::super::{Axis, Format, Gathered};
     use super::*;
 
     fn run(returns: &[f64]) -> OutsideRun {
-        OutsideRun {
-            path: "run.csv".into(),
-            format: Format::Csv,
-            series: "return".into(),
-            axis: Axis::Episodes,
-            episodes: returns
-                .iter()
-                .enumerate()
-                .map(|(i, &r)| Episode {
-                    at: i as i64 + 1,
-                    episode_return: r,
-                    length: None,
-                })
-                .collect(),
+        let mut episodes = Gathered::new(Axis::Episodes);
+        for (i, &r) in returns.iter().enumerate() {
+            episodes.push(i as i64 + 1, r, None);
         }
+        episodes.into_run("run.csv".as_ref(), Format::Csv, "return".into())
     }
 
     #[test]

@@ -17,11 +17,13 @@ fn read(path: &Path) -> Result<OutsideRun, OutsideRunError> {
     read_run(path, &ReadOptions::default())
 }
 
-/// `(at, return, length)` of each episode.
-fn episodes(run: &OutsideRun) -> Vec<(i64, f64, Option<u64>)> {
-    run.episodes
-        .iter()
-        .map(|e| (e.at, e.episode_return, e.length))
+/// `(step at its end, return)` of each episode of a run whose lengths are known.
+fn episodes(run: &OutsideRun) -> Vec<(u64, f64)> {
+    let placed = run.placed().expect("every length known");
+    placed
+        .ends()
+        .into_iter()
+        .zip(placed.returns.iter().copied())
         .collect()
 }
 
@@ -43,14 +45,9 @@ fn a_monitor_file_places_each_episode_at_the_sum_of_the_lengths_so_far() {
         (run.series.as_str(), run.path.as_path()),
         ("r", path.as_path())
     );
-    assert_eq!(
-        episodes(&run),
-        [
-            (10, 9.0, Some(10)),
-            (15, -2.5, Some(5)),
-            (46, 31.0, Some(31))
-        ]
-    );
+    assert_eq!(episodes(&run), [(10, 9.0), (15, -2.5), (46, 31.0)]);
+    assert_eq!(run.episodes.lengths, [10, 5, 31]);
+    assert_eq!(run.steps(), Some(46));
 }
 
 #[test]
@@ -61,9 +58,9 @@ fn a_real_stable_baselines3_monitor_file_reads_and_scores() {
     let run = read(&path).unwrap();
     assert_eq!(run.format, Format::Monitor);
     assert_eq!(run.episodes.len(), 15);
-    assert_eq!(run.episodes.last().unwrap().at, 288);
-    for e in &run.episodes {
-        assert_eq!(Some(e.episode_return as u64), e.length);
+    assert_eq!(run.steps(), Some(288));
+    for (&r, &length) in run.episodes.returns.iter().zip(&run.episodes.lengths) {
+        assert_eq!(r as u32, length);
     }
     // 288 / 15; the last five: (14 + 20 + 10 + 12 + 17) / 5 = 73 / 5.
     assert_eq!(run.training_return(), 288.0 / 15.0);
@@ -86,10 +83,10 @@ fn an_export_skips_rows_where_the_return_was_not_logged() {
     let run = read(&path).unwrap();
     assert_eq!((run.format, run.axis), (Format::Csv, Axis::Steps));
     assert_eq!(run.series, "charts/episodic_return");
-    assert_eq!(
-        episodes(&run),
-        [(120, 15.0, Some(15)), (640, 28.5, Some(28))]
-    );
+    // Placed by their steps: each episode's length is the steps since the one before (the
+    // length column is checked as numbers, its values not needed).
+    assert_eq!(episodes(&run), [(120, 15.0), (640, 28.5)]);
+    assert_eq!(run.episodes.lengths, [120, 520]);
 }
 
 #[test]
@@ -103,7 +100,8 @@ fn columns_named_by_the_caller_are_read_and_an_episode_column_counts_episodes() 
     let defaults = read(&path).unwrap();
     assert_eq!(defaults.axis, Axis::Episodes);
     assert_eq!(defaults.series, "return");
-    assert_eq!(episodes(&defaults), [(1, 100.0, None), (2, 200.0, None)]);
+    assert_eq!(defaults.episodes.returns, [100.0, 200.0]);
+    assert_eq!((defaults.placed(), defaults.steps()), (None, None));
     let named = ReadOptions {
         return_column: Some("score".into()),
         position_column: Some(PositionColumn::Step("return".into())),
@@ -111,7 +109,7 @@ fn columns_named_by_the_caller_are_read_and_an_episode_column_counts_episodes() 
     };
     let run = read_run(&path, &named).unwrap();
     assert_eq!((run.axis, run.series.as_str()), (Axis::Steps, "score"));
-    assert_eq!(episodes(&run), [(100, 5.0, None), (200, 7.0, None)]);
+    assert_eq!(episodes(&run), [(100, 5.0), (200, 7.0)]);
 }
 
 /// An event file in `dir` as CleanRL writes one: each episode's return and length at the
@@ -134,20 +132,13 @@ fn an_event_file_or_a_folder_of_them_reads_the_return_tag_with_its_lengths() {
     let run = read(&first).unwrap();
     assert_eq!((run.format, run.axis), (Format::EventFiles, Axis::Steps));
     assert_eq!(run.series, RETURN_TAG);
-    assert_eq!(episodes(&run), [(20, 20.0, Some(20)), (45, 25.0, Some(25))]);
+    assert_eq!(episodes(&run), [(20, 20.0), (45, 25.0)]);
     // A resumed run: a second file, later by name, read after the first.
     cleanrl_events(&run_dir, &[(80, 35.0, 35.0)]);
     std::fs::write(run_dir.join("notes.txt"), "not an event file").unwrap();
     let folder = read(&run_dir).unwrap();
     assert_eq!(folder.path, run_dir);
-    assert_eq!(
-        episodes(&folder),
-        [
-            (20, 20.0, Some(20)),
-            (45, 25.0, Some(25)),
-            (80, 35.0, Some(35))
-        ]
-    );
+    assert_eq!(episodes(&folder), [(20, 20.0), (45, 25.0), (80, 35.0)]);
 }
 
 #[test]
@@ -170,7 +161,7 @@ fn stable_baselines3s_rollout_mean_is_read_only_when_asked() {
     };
     let run = read_run(&path, &asked).unwrap();
     assert_eq!(run.series, ROLLOUT_MEAN_TAG);
-    assert_eq!(episodes(&run), [(2048, 22.5, None)]);
+    assert_eq!(episodes(&run), [(2048, 22.5)]);
 }
 
 #[test]
@@ -293,4 +284,28 @@ fn a_link_inside_a_folder_of_event_files_is_refused() {
     let named_link = dir.path().join("chosen");
     std::os::unix::fs::symlink(&elsewhere, &named_link).unwrap();
     assert_eq!(read(&named_link).unwrap().episodes.len(), 1);
+}
+
+#[test]
+fn a_monitor_file_is_read_up_to_its_bound_of_rows_and_refused_past_it() {
+    // MAX_EPISODES (10 M rows) scaled down to 3: at the bound it reads, past it the first
+    // row too many is named.
+    let dir = tempfile::tempdir().unwrap();
+    let rows = |n: usize| {
+        let mut text = String::from("#{\"t_start\": 0}\nr,l,t\n");
+        for i in 1..=n {
+            text.push_str(&format!("{i}.0,{i},0.1\n"));
+        }
+        write(dir.path(), &format!("{n}.monitor.csv"), text)
+    };
+    let at = rows(3);
+    let run = monitor::read_at_most(std::fs::File::open(&at).unwrap(), &at, 3).unwrap();
+    assert_eq!(run.episodes.returns, [1.0, 2.0, 3.0]);
+    assert_eq!(run.steps(), Some(6));
+    let past = rows(4);
+    let err = monitor::read_at_most(std::fs::File::open(&past).unwrap(), &past, 3)
+        .unwrap_err()
+        .to_string();
+    assert!(err.starts_with(&past.display().to_string()), "{err}");
+    assert!(err.contains("line 6") && err.contains('3'), "{err}");
 }

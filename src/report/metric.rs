@@ -130,12 +130,11 @@ impl RunMetric {
         let Some(ends) = self.ends(axis) else {
             return vec![None; points.len()];
         };
-        let (ends, values): (Vec<f64>, Vec<f64>) = ends
+        let episodes = ends
             .iter()
             .zip(&self.values)
-            .filter_map(|(&end, v)| Some((end, (*v)?)))
-            .unzip();
-        step_axis::means_at(&values, &ends, window, points)
+            .filter_map(|(&end, v)| Some(((*v)?, end)));
+        step_axis::means_at(episodes, window, points)
     }
 }
 

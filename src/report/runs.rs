@@ -40,6 +40,11 @@ impl TrainingEpisodes {
         self.returns.is_empty()
     }
 
+    /// The environment steps of all its episodes: where the last one ended.
+    pub fn steps(&self) -> u64 {
+        self.lengths.iter().map(|&l| u64::from(l)).sum()
+    }
+
     /// The environment step each episode ended at, counted from the run's first.
     pub fn ends(&self) -> Vec<u64> {
         self.lengths

@@ -7,7 +7,7 @@
 //! (`episode` or `step` in its second column), `sample_efficiency.png` draws the IQM.
 
 use crate::config::Budget;
-use crate::report::runs::{moving_average, TrainingEpisodes};
+use crate::report::runs::TrainingEpisodes;
 use crate::report::step_axis;
 use crate::seeds::{self, Part};
 use crate::stats::{aggregate, bootstrap, Estimate, Scores};
@@ -109,11 +109,15 @@ pub fn over_runs(label: &str, i: usize, values: Vec<f64>) -> Option<(usize, Esti
     ))
 }
 
-/// The points of an episode budget.
+/// The points of an episode budget. Each run's moving average is computed at the points
+/// only (as [`moving_average`](super::moving_average) would give it there), never kept whole.
 fn episode_curve(label: &str, runs: &[&[f64]], window: usize) -> Vec<EfficiencyPoint> {
     let window = window.max(1);
-    let averages: Vec<Vec<f64>> = runs.iter().map(|r| moving_average(r, window)).collect();
-    let longest = averages.iter().map(Vec::len).max().unwrap_or(0);
+    let longest = runs
+        .iter()
+        .map(|r| (r.len() + 1).saturating_sub(window))
+        .max()
+        .unwrap_or(0);
     if longest == 0 {
         return Vec::new();
     }
@@ -124,10 +128,21 @@ fn episode_curve(label: &str, runs: &[&[f64]], window: usize) -> Vec<EfficiencyP
     }
     at.into_iter()
         .filter_map(|i| {
-            let values: Vec<f64> = averages.iter().filter_map(|a| a.get(i).copied()).collect();
+            let values: Vec<f64> = runs
+                .iter()
+                .filter_map(|r| average_at(r, i, window))
+                .collect();
             point(label, (i + window) as u64, i, values)
         })
         .collect()
+}
+
+/// The `i`-th value of the moving average of `window` over `values`, if it has one: the
+/// mean of `values[i..i + window]`, summed in order as [`moving_average`](super::moving_average) sums
+/// it.
+pub fn average_at(values: &[f64], i: usize, window: usize) -> Option<f64> {
+    let w = values.get(i..i.checked_add(window)?)?;
+    Some(w.iter().sum::<f64>() / window as f64)
 }
 
 /// The header and rows of `sample_efficiency.csv`: one row per method, point and
@@ -197,6 +212,18 @@ mod tests {
         // Past episode 4000 only the longer run is left.
         assert_eq!(points.last().unwrap().runs, 1);
         assert_eq!(points[0].runs, 2);
+    }
+
+    #[test]
+    fn the_average_at_a_point_is_the_moving_averages_value_there() {
+        let values: Vec<f64> = (0..50).map(|i| (i as f64 * 0.37).sin() * 100.0).collect();
+        for window in [1, 3, 10, 50, 51] {
+            let whole = crate::report::moving_average(&values, window);
+            for i in 0..60 {
+                assert_eq!(average_at(&values, i, window), whole.get(i).copied());
+            }
+        }
+        assert_eq!(average_at(&values, usize::MAX, 2), None);
     }
 
     fn episodes(returns: &[Vec<f64>]) -> Vec<TrainingEpisodes> {

@@ -30,36 +30,62 @@ pub fn points(budget: u64, count: usize) -> Vec<u64> {
 
 /// The run's curve at `points` (ascending): at each, the mean return of the last `window`
 /// episodes that ended by it, or of all that did while fewer have; `None` before its first
-/// episode ended.
+/// episode ended. One pass over the episodes, keeping the last `window + 1` running sums:
+/// a run of millions of episodes costs no vector of its length.
 pub fn curve(run: &TrainingEpisodes, window: usize, points: &[u64]) -> Vec<Option<f64>> {
-    means_at(&run.returns, &run.ends(), window, points)
+    let mut end = 0u64;
+    let episodes = run.returns.iter().zip(&run.lengths).map(|(&r, &l)| {
+        end += u64::from(l);
+        (r, end)
+    });
+    means_at(episodes, window, points)
 }
 
-/// The same curve of any per-episode `values` whose episodes end at `ends` (ascending, on
-/// any axis: steps, episodes, seconds): at each of `points`, the mean of the last `window`
-/// values whose episodes ended by it, or of all that did while fewer have.
+/// The same curve of any per-episode values, each with the end of its episode (ascending,
+/// on any axis: steps, episodes, seconds): at each of `points` (ascending), the mean of the
+/// last `window` values whose episodes ended by it, or of all that did while fewer have.
+/// One pass, keeping the last `window + 1` running sums.
 pub fn means_at<X: PartialOrd + Copy>(
-    values: &[f64],
-    ends: &[X],
+    episodes: impl IntoIterator<Item = (f64, X)>,
     window: usize,
     points: &[X],
 ) -> Vec<Option<f64>> {
     let window = window.max(1);
-    // sums[i] = Σ values[..i], for every window's mean in O(1).
-    let sums: Vec<f64> = std::iter::once(0.0)
-        .chain(values.iter().scan(0.0, |sum, &r| {
-            *sum += r;
-            Some(*sum)
-        }))
-        .collect();
+    // sums[i % kept] = Σ values[..i] for the last `kept` values of i: every window's mean
+    // in O(1), each sum added up in the episodes' order.
+    let kept = window + 1;
+    let mut sums = vec![0.0; kept];
+    let mut sum = 0.0;
+    let mut ended = 0;
+    let mut episodes = episodes.into_iter().peekable();
     points
         .iter()
         .map(|&point| {
-            let ended = ends.partition_point(|&end| end <= point);
+            while let Some(&(value, end)) = episodes.peek() {
+                if end > point {
+                    break;
+                }
+                sum += value;
+                ended += 1;
+                sums[ended % kept] = sum;
+                episodes.next();
+            }
             let first = ended.saturating_sub(window);
-            (ended > 0).then(|| (sums[ended] - sums[first]) / (ended - first) as f64)
+            (ended > 0).then(|| (sums[ended % kept] - sums[first % kept]) / (ended - first) as f64)
         })
         .collect()
+}
+
+/// How many of the run's episodes ended by step `step`.
+pub fn ended_by(run: &TrainingEpisodes, step: u64) -> usize {
+    let mut end = 0u64;
+    run.lengths
+        .iter()
+        .take_while(|&&l| {
+            end += u64::from(l);
+            end <= step
+        })
+        .count()
 }
 
 /// The mean of the curve's points where it has a value: the area under it per step.
@@ -111,6 +137,58 @@ mod tests {
         // (15 + 15 + 25 + 35) / 4, the undefined point left out.
         assert_eq!(area(&curve(&r, 2, &[5, 30, 59, 60, 100])), Some(90.0 / 4.0));
         assert_eq!(area(&[None, None]), None);
+    }
+
+    /// The curve as first written, from every end and every running sum: the streaming
+    /// one must give the same bits.
+    fn curve_by_definition(
+        run: &TrainingEpisodes,
+        window: usize,
+        points: &[u64],
+    ) -> Vec<Option<f64>> {
+        let ends = run.ends();
+        let sums: Vec<f64> = std::iter::once(0.0)
+            .chain(run.returns.iter().scan(0.0, |sum, &r| {
+                *sum += r;
+                Some(*sum)
+            }))
+            .collect();
+        points
+            .iter()
+            .map(|&point| {
+                let ended = ends.partition_point(|&end| end <= point);
+                let first = ended.saturating_sub(window);
+                (ended > 0).then(|| (sums[ended] - sums[first]) / (ended - first) as f64)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_streamed_curve_is_the_definitions_to_the_bit() {
+        // Returns with fractions that round, lengths of 0 (an episode placed behind the
+        // furthest), windows shorter and longer than the run.
+        let mut r = TrainingEpisodes::default();
+        let mut x = 0.1f64;
+        for i in 0..3_000u32 {
+            x = (x * 3.7 + 0.123).fract();
+            r.push(
+                x * 500.0 - 100.0,
+                if i % 7 == 0 { 0 } else { 1 + (i * 31) % 400 },
+            );
+        }
+        let total = r.steps();
+        for window in [1, 2, 10, 100, 2_999, 3_000, 10_000] {
+            for count in [1, 7, 200, 5_000] {
+                let at = points(total + 1_000, count);
+                assert_eq!(curve(&r, window, &at), curve_by_definition(&r, window, &at));
+            }
+        }
+        for step in [0, 1, 399, total / 2, total, total + 1] {
+            assert_eq!(
+                ended_by(&r, step),
+                r.ends().partition_point(|&end| end <= step)
+            );
+        }
     }
 
     #[test]

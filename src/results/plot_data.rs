@@ -103,9 +103,6 @@ pub fn read(dir: &Path) -> Result<PlotData> {
     })
 }
 
-/// (method, run) → that run's values in order.
-pub(super) type ByRun = BTreeMap<(String, u32), Vec<f64>>;
-
 /// The runs of method `label` taken out of `map`, in run order.
 fn take_method<T>(map: &mut BTreeMap<(String, u32), T>, label: &str) -> Vec<T> {
     let keys: Vec<_> = map
@@ -120,11 +117,12 @@ fn take_method<T>(map: &mut BTreeMap<(String, u32), T>, label: &str) -> Vec<T> {
 /// [`MAX_VALUES_KEPT`], refused naming the file and the row.
 pub(super) fn training_episodes(path: &Path) -> Result<BTreeMap<(String, u32), TrainingEpisodes>> {
     let mut returns = ByRunReader::new(path, "reward");
-    let mut lengths = ByRunReader::new(path, "steps");
+    // Kept as they are read (a u32 each), not as a return is: 12 bytes an episode.
+    let mut lengths = ByRunReader::<u32>::new(path, "steps");
     each_row(path, |record, headers, at| {
         let row: EpisodeRow = parse(record, headers, path, at)?;
         returns.push(row.method, row.run, row.episode, row.reward, at)?;
-        lengths.push(row.method, row.run, row.episode, f64::from(row.steps), at)
+        lengths.push(row.method, row.run, row.episode, row.steps, at)
     })?;
     let mut lengths = lengths.finish();
     Ok(returns
@@ -132,7 +130,6 @@ pub(super) fn training_episodes(path: &Path) -> Result<BTreeMap<(String, u32), T
         .into_iter()
         .map(|(key, returns)| {
             let lengths = lengths.remove(&key).unwrap_or_default();
-            let lengths = lengths.into_iter().map(|l| l as u32).collect();
             (key, TrainingEpisodes { returns, lengths })
         })
         .collect())
@@ -188,24 +185,50 @@ pub(super) fn some_returns(
 /// order of their index (episode or test): runs side by side interleave their rows. A run's
 /// rows come numbered 1, 2, 3… (as sapnet writes them): then only the values are kept, and
 /// the indices only from a run whose rows come in another order.
-struct ByRunReader<'p> {
+struct ByRunReader<'p, T = f64> {
     path: &'p Path,
     /// What the value is, for messages (`reward`).
     column: &'static str,
-    runs: BTreeMap<String, BTreeMap<u32, Series>>,
+    runs: BTreeMap<String, BTreeMap<u32, Series<T>>>,
     kept: usize,
 }
 
-#[derive(Default)]
-struct Series {
-    values: Chunked<f64>,
+/// A value a [`ByRunReader`] keeps: a return (refused unless finite) or a length.
+trait Kept: Copy + std::fmt::Display {
+    fn is_finite(self) -> bool;
+}
+
+impl Kept for f64 {
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+}
+
+impl Kept for u32 {
+    fn is_finite(self) -> bool {
+        true
+    }
+}
+
+struct Series<T> {
+    values: Chunked<T>,
     /// The first row's index: the rows in order are `first`, `first + 1`, ….
     first: u32,
     /// Every row's index, once one broke the order.
     indices: Option<Chunked<u32>>,
 }
 
-impl<'p> ByRunReader<'p> {
+impl<T> Default for Series<T> {
+    fn default() -> Self {
+        Self {
+            values: Chunked::default(),
+            first: 0,
+            indices: None,
+        }
+    }
+}
+
+impl<'p, T: Kept> ByRunReader<'p, T> {
     fn new(path: &'p Path, column: &'static str) -> Self {
         Self {
             path,
@@ -215,7 +238,7 @@ impl<'p> ByRunReader<'p> {
         }
     }
 
-    fn push(&mut self, method: &str, run: u32, index: u32, value: f64, at: usize) -> Result<()> {
+    fn push(&mut self, method: &str, run: u32, index: u32, value: T, at: usize) -> Result<()> {
         if !value.is_finite() {
             bail!(
                 "{}: row {at}, column {}: the return {value} is not finite",
@@ -249,15 +272,15 @@ impl<'p> ByRunReader<'p> {
         Ok(())
     }
 
-    fn finish(self) -> ByRun {
-        let mut by_run = ByRun::new();
+    fn finish(self) -> BTreeMap<(String, u32), Vec<T>> {
+        let mut by_run = BTreeMap::new();
         for (method, runs) in self.runs {
             for (run, series) in runs {
                 let values = series.values.into_vec();
                 let values = match series.indices {
                     None => values,
                     Some(indices) => {
-                        let mut pairs: Vec<(u32, f64)> =
+                        let mut pairs: Vec<(u32, T)> =
                             indices.into_vec().into_iter().zip(values).collect();
                         pairs.sort_by_key(|&(index, _)| index);
                         pairs.into_iter().map(|(_, v)| v).collect()

@@ -1359,6 +1359,72 @@ fn an_endless_line_is_refused_at_its_bound() {
     assert!(started.elapsed() < Duration::from_secs(20));
 }
 
+/// `command`'s peak resident memory in KiB (from `wait4`, this child's own), and whether
+/// it exited 0.
+// The child is reaped by wait4, which gives its rusage; Child::wait cannot.
+#[allow(clippy::zombie_processes)]
+fn peak_kib(command: &mut Command) -> (bool, u64) {
+    let child = command
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let pid = child.id() as libc::pid_t;
+    let mut status = 0;
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    assert_eq!(unsafe { libc::wait4(pid, &mut status, 0, &mut usage) }, pid);
+    let ok = libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0;
+    (ok, usage.ru_maxrss as u64)
+}
+
+/// Item 6: a monitor file of 2 M short rows (30 MB) costs `compare` about its numbers (a
+/// return and a length, 12 bytes an episode), by step and by episode: within twice the
+/// file beyond what comparing two one-episode files costs. (It cost 10 times the file: an
+/// episode of 32 bytes, copied twice, and a learning curve of every episode.)
+#[test]
+fn a_big_monitor_file_costs_compare_about_its_numbers() {
+    use std::io::Write;
+    let tmp = tempfile::tempdir().unwrap();
+    let big = tmp.path().join("big.monitor.csv");
+    let mut out = std::io::BufWriter::new(std::fs::File::create(&big).unwrap());
+    writeln!(out, "#{{\"t_start\": 0}}\nr,l,t").unwrap();
+    for i in 0..2_000_000u32 {
+        let l = 10 + i % 90;
+        writeln!(out, "{l}.0,{l},0.{:04}", i % 10_000).unwrap();
+    }
+    drop(out);
+    let bytes = std::fs::metadata(&big).unwrap().len();
+    let small = tmp.path().join("small.monitor.csv");
+    std::fs::write(&small, "#{\"t_start\": 0}\nr,l,t\n10.0,10,0.1\n").unwrap();
+    let compare = |a: &Path, out: &str, by_episode: bool| {
+        let mut command = sapnet();
+        command
+            .args(["compare", "--range", "0", "500", "--method"])
+            .arg(format!("a={}", a.display()))
+            .arg("--method")
+            .arg(format!("s={}", small.display()))
+            .arg("--out")
+            .arg(tmp.path().join(out));
+        if by_episode {
+            command.arg("--by-episode");
+        }
+        let (ok, kib) = peak_kib(&mut command);
+        assert!(ok, "compare {out}");
+        kib
+    };
+    let floor = compare(&small, "floor", false);
+    for (out, by_episode) in [("by-step", false), ("by-episode", true)] {
+        let peak = compare(&big, out, by_episode);
+        assert!(
+            peak <= floor + 2 * bytes / 1024,
+            "{out}: {peak} KiB for a file of {bytes} bytes ({floor} KiB for two small ones)"
+        );
+        let runs = std::fs::read_to_string(tmp.path().join(out).join("runs.csv")).unwrap();
+        // By episode every episode is scored (by step, those ended by the small run's 10).
+        assert_eq!(runs.contains(",2000000,"), by_episode, "{runs}");
+    }
+}
+
 /// Item 8: `plot` keeps, in the top-level episodes.csv it makes again, a run whose record
 /// keeps its episodes only compressed.
 #[test]

@@ -10,8 +10,7 @@ use super::legend::{self, Entry, Swatch};
 use super::palette::{emphasised, method_pens, Pen, MANY};
 use super::{Curve, Drawn, PlotData, FAMILY};
 use crate::config::Budget;
-use crate::report::runs::moving_average;
-use crate::report::sample_efficiency::EfficiencyPoint;
+use crate::report::sample_efficiency::{average_at, EfficiencyPoint};
 use crate::seeds::{self, Part};
 use crate::stats::{aggregate, bootstrap, Estimate, Scores};
 
@@ -25,6 +24,53 @@ pub fn mean_over_runs(series: &[Vec<f64>]) -> Vec<f64> {
             values.iter().sum::<f64>() / values.len() as f64
         })
         .collect()
+}
+
+/// Lines of at most this many points are drawn whole: every figure of a protocol or a
+/// comparison of runs up to 65,536 episodes is drawn from every point.
+pub const DRAWN_WHOLE: usize = 1 << 16;
+
+/// A longer line is cut into this many spans of consecutive points, each drawn by its
+/// first, lowest, highest and last point: a figure is about a thousand pixels wide, so a
+/// span is under a pixel, and the line covers the same pixels (the same lowest and highest
+/// values, the same ends) from at most 4 × 4,096 points instead of millions.
+const SPANS: usize = 1 << 12;
+
+/// The `count` points of a line, thinned as [`SPANS`] says when they are more than
+/// [`DRAWN_WHOLE`]; else every one of them.
+pub fn thinned(points: impl Iterator<Item = (f64, f64)>, count: usize) -> Vec<(f64, f64)> {
+    if count <= DRAWN_WHOLE {
+        return points.collect();
+    }
+    let span = count.div_ceil(SPANS);
+    let mut kept = Vec::with_capacity(4 * SPANS);
+    let mut points = points.peekable();
+    while points.peek().is_some() {
+        let mut indexed = points.by_ref().take(span).enumerate();
+        let Some((_, first)) = indexed.next() else {
+            break;
+        };
+        let (mut low, mut high, mut last) = ((0, first), (0, first), (0, first));
+        for (i, p) in indexed {
+            if p.1 < low.1 .1 {
+                low = (i, p);
+            }
+            if p.1 > high.1 .1 {
+                high = (i, p);
+            }
+            last = (i, p);
+        }
+        let mut span_points = [(0, first), low, high, last];
+        span_points.sort_by_key(|&(i, _)| i);
+        let mut previous = None;
+        for (i, p) in span_points {
+            if previous != Some(i) {
+                kept.push(p);
+                previous = Some(i);
+            }
+        }
+    }
+    kept
 }
 
 /// Resamples per interval of a figure's band or whiskers: many intervals drawn at once,
@@ -188,16 +234,19 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
             .curves
             .iter()
             .map(|c| {
-                let averaged: Vec<Vec<f64>> = c
-                    .runs
+                // As mean_over_runs of each run's moving_average, one index at a time:
+                // no average kept whole.
+                let returns: Vec<&[f64]> = c.runs.iter().map(|r| r.returns.as_slice()).collect();
+                let longest = returns
                     .iter()
-                    .map(|r| moving_average(&r.returns, w))
-                    .collect();
-                let mean = mean_over_runs(&averaged);
-                mean.into_iter()
-                    .enumerate()
-                    .map(|(e, v)| ((e + w) as f64, v))
-                    .collect()
+                    .map(|r| (r.len() + 1).saturating_sub(w))
+                    .max()
+                    .unwrap_or(0);
+                let mean = (0..longest).map(|i| {
+                    let at = || returns.iter().filter_map(|r| average_at(r, i, w));
+                    ((i + w) as f64, at().sum::<f64>() / at().count() as f64)
+                });
+                thinned(mean, longest)
             })
             .collect(),
         Budget::Steps(_) => efficiency
@@ -210,6 +259,17 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
         .filter_map(|l| l.last().map(|&(x, _)| x as u64))
         .max()
         .unwrap_or(w as u64);
+    let thinned_lines = match data.budget {
+        Budget::Episodes(_) => data
+            .curves
+            .iter()
+            .map(|c| {
+                let longest = c.runs.iter().map(|r| (r.len() + 1).saturating_sub(w));
+                longest.max().unwrap_or(0) > DRAWN_WHOLE
+            })
+            .collect(),
+        Budget::Steps(_) => vec![false; lines.len()],
+    };
     let banded = |i: usize| data.curves[i].runs.len() > 1;
     let fit = axes::fit(
         lines.iter().flatten().map(|&(_, y)| y).chain(
@@ -252,6 +312,7 @@ pub(super) fn learning_curve<DB: DrawingBackend>(
             last,
             fit,
             lines,
+            thinned: thinned_lines,
             bands,
             notes,
         },
@@ -267,6 +328,9 @@ pub(super) struct Curves {
     pub last: u64,
     pub fit: Fit,
     pub lines: Vec<Vec<(f64, f64)>>,
+    /// Whether each line was [`thinned`]: drawn segment by segment, so that the wide
+    /// stroke's joins at its spans' sharp turns cannot spike out of the chart.
+    pub thinned: Vec<bool>,
     /// Each method's band, `(x, interval)`; none for a method without one.
     pub bands: Vec<Option<Vec<(u64, Estimate)>>>,
     /// The legend's notes before the faint pens' and the fit's.
@@ -287,6 +351,7 @@ pub(super) fn curves_chart<DB: DrawingBackend>(
         last,
         fit,
         lines,
+        thinned,
         bands,
         mut notes,
     } = curves;
@@ -305,7 +370,11 @@ pub(super) fn curves_chart<DB: DrawingBackend>(
         }
     }
     for i in in_drawing_order(&pens) {
-        legend::draw_line(&mut chart, lines[i].clone(), pens[i])?;
+        if thinned[i] {
+            legend::draw_segments(&mut chart, &lines[i], pens[i])?;
+        } else {
+            legend::draw_line(&mut chart, lines[i].clone(), pens[i])?;
+        }
     }
     let entries: Vec<Entry> = data
         .curves
@@ -439,6 +508,32 @@ pub(super) fn test_bars<DB: DrawingBackend>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_long_line_is_thinned_to_its_spans_lows_highs_and_ends() {
+        let short: Vec<(f64, f64)> = (0..DRAWN_WHOLE)
+            .map(|i| (i as f64, (i % 7) as f64))
+            .collect();
+        assert_eq!(thinned(short.iter().copied(), short.len()), short);
+        let count = 3 * DRAWN_WHOLE + 5;
+        let long = (0..count).map(|i| (i as f64, ((i * 7919) % 1000) as f64 - 500.0));
+        let kept = thinned(long.clone(), count);
+        assert!(kept.len() <= 4 * SPANS, "{}", kept.len());
+        assert_eq!(kept.first(), long.clone().next().as_ref());
+        assert_eq!(kept.last(), long.clone().next_back().as_ref());
+        assert!(
+            kept.windows(2).all(|w| w[0].0 < w[1].0),
+            "in order, none twice"
+        );
+        let extent = |points: &[(f64, f64)]| {
+            points
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                    (lo.min(p.1), hi.max(p.1))
+                })
+        };
+        assert_eq!(extent(&kept), extent(&long.collect::<Vec<_>>()));
+    }
 
     #[test]
     fn means_cover_the_runs_that_reach_each_index() {

@@ -53,6 +53,7 @@ pub(super) fn sample_efficiency<DB: DrawingBackend>(
             y_desc: format!("episode return, MA{w}: IQM over runs"),
             last,
             fit,
+            thinned: vec![false; points.len()],
             lines,
             bands,
             notes,

@@ -84,6 +84,23 @@ pub(super) fn draw_line<DB: DrawingBackend>(
     Ok(())
 }
 
+/// A line of `pen` through `points` drawn as its segments, each on its own (solid): no
+/// join between them, whose miter a wide stroke turning back on itself would stretch far
+/// past the points (a [`thinned`](super::curves::thinned) line turns back at every span).
+pub(super) fn draw_segments<DB: DrawingBackend>(
+    chart: &mut ChartContext<DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    points: &[(f64, f64)],
+    pen: Pen,
+) -> Drawn<DB> {
+    let style = pen.colour.stroke_width(pen.width());
+    chart.draw_series(
+        points
+            .windows(2)
+            .map(|w| PathElement::new(vec![w[0], w[1]], style)),
+    )?;
+    Ok(())
+}
+
 /// The entries, one a row, then the notes, wrapped to the column.
 pub(super) fn draw<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,

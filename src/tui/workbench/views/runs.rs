@@ -11,7 +11,7 @@ use ratatui::widgets::{Block, Paragraph};
 use ratatui::Frame;
 
 use super::Intent;
-use crate::report::moving_average;
+use crate::report::sample_efficiency::average_at;
 use crate::results::folder_state::{FolderState, RunProgress, RunStatus};
 use crate::tui::keys::{ch, code, Binding};
 use crate::tui::row_window::RowWindow;
@@ -125,18 +125,20 @@ fn draw(frame: &mut Frame, area: Rect, folder: &FolderState, cursor: usize, them
         return;
     }
     let window = folder.config.protocol.moving_average;
-    let averages: Vec<Vec<f64>> = folder
+    // Each run's moving average read where it is shown, never kept whole: a folder of
+    // millions of episodes costs no copy of them a frame.
+    let averages: Vec<Averages> = folder
         .runs
         .iter()
-        .map(|r| moving_average(&r.training.returns, window))
+        .map(|r| Averages::of(&r.training.returns, window))
         .collect();
     // One scale for every line, the lowest MA10 of the folder to its highest, so that
     // lines compare and a curve's shape shows even far below the task's best return.
     let range = averages
         .iter()
-        .flatten()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &a| {
-            (lo.min(a), hi.max(a))
+        .map(Averages::extent)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (a, b)| {
+            (lo.min(a), hi.max(b))
         });
     let Widths {
         method: method_width,
@@ -201,7 +203,10 @@ fn draw(frame: &mut Frame, area: Rect, folder: &FolderState, cursor: usize, them
                 format!(
                     " {} {} {} {} {}",
                     fit(&run.progress_text(), episodes_width),
-                    fit(&sparkline(averages, range, spark_width), spark_width),
+                    fit(
+                        &sparkline_of(averages.len, |i| averages.at(i), range, spark_width),
+                        spark_width
+                    ),
                     fit(&latest, 8),
                     fit(&eta, 7),
                     fit(run.source.as_deref().unwrap_or("-"), source_width),
@@ -311,16 +316,67 @@ fn status_style(status: RunStatus, theme: Theme) -> Style {
     }
 }
 
+/// A run's moving average of `window` returns (as [`crate::report::moving_average`]
+/// gives it), each value computed where it is read.
+struct Averages<'a> {
+    returns: &'a [f64],
+    window: usize,
+    /// How many values it has.
+    len: usize,
+}
+
+impl<'a> Averages<'a> {
+    fn of(returns: &'a [f64], window: usize) -> Self {
+        let len = if window == 0 {
+            0
+        } else {
+            (returns.len() + 1).saturating_sub(window)
+        };
+        Self {
+            returns,
+            window,
+            len,
+        }
+    }
+
+    fn at(&self, i: usize) -> f64 {
+        average_at(self.returns, i, self.window).unwrap_or(f64::NAN)
+    }
+
+    fn last(&self) -> Option<f64> {
+        self.len.checked_sub(1).map(|i| self.at(i))
+    }
+
+    /// Its lowest and highest value (infinities the wrong way round without one).
+    fn extent(&self) -> (f64, f64) {
+        (0..self.len)
+            .map(|i| self.at(i))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), a| {
+                (lo.min(a), hi.max(a))
+            })
+    }
+}
+
 /// The values as at most `width` block characters on the scale `low..high`, the last
 /// value of each of `width` equal stretches of the run (a long run's latest shape).
-pub fn sparkline(values: &[f64], (low, high): (f64, f64), width: usize) -> String {
-    if values.is_empty() || width == 0 {
+pub fn sparkline(values: &[f64], range: (f64, f64), width: usize) -> String {
+    sparkline_of(values.len(), |i| values[i], range, width)
+}
+
+/// [`sparkline`] of the `len` values `at` gives.
+fn sparkline_of(
+    len: usize,
+    at: impl Fn(usize) -> f64,
+    (low, high): (f64, f64),
+    width: usize,
+) -> String {
+    if len == 0 || width == 0 {
         return String::new();
     }
-    let shown = values.len().min(width);
+    let shown = len.min(width);
     (1..=shown)
         .map(|k| {
-            let v = values[k * values.len() / shown - 1];
+            let v = at(k * len / shown - 1);
             let level = if high > low {
                 ((v - low) / (high - low)).clamp(0.0, 1.0)
             } else {
