@@ -31,8 +31,8 @@ mod table;
 use std::io::{Read, Seek};
 use std::path::{Path, PathBuf};
 
-use crate::report::TrainingEpisodes;
 use crate::safe_io::{self, Links};
+use crate::stats::episodes::TrainingEpisodes;
 use crate::tensorboard::MAX_EVENT_FILE_BYTES;
 
 pub use error::{Location, OutsideRunError};

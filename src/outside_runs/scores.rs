@@ -3,7 +3,7 @@
 use std::num::NonZeroUsize;
 
 use super::OutsideRun;
-use crate::report::TrainingEpisodes;
+use crate::stats::episodes::TrainingEpisodes;
 
 impl OutsideRun {
     /// The episodes' returns, in order.

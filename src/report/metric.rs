@@ -162,7 +162,7 @@ impl From<EfficiencyPoint> for CurvePoint {
 
 /// `count` points evenly spaced from `from` to `to`, both included (one if they meet).
 pub fn grid(from: f64, to: f64, count: usize) -> Vec<f64> {
-    if !(to > from) || count < 2 {
+    if to.partial_cmp(&from) != Some(std::cmp::Ordering::Greater) || count < 2 {
         return vec![to];
     }
     (0..count)

@@ -19,6 +19,7 @@
 
 pub mod aggregate;
 pub mod bootstrap;
+pub mod episodes;
 pub mod improvement;
 pub mod multiplicity;
 pub mod normal;

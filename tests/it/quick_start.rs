@@ -214,7 +214,7 @@ fn check(dir: &Path, words: &[String], kind: Kind) {
             // Each view known by its own keys in the status bar.
             session.wait_for(&["a aggregate", "s score"]);
             session.keys("v");
-            session.wait_for(&["m IQM/mean", "⏎ runs"]);
+            session.wait_for(&["y metric", "x axis"]);
             session.keys("q");
             session.wait_for(&["SAPNET-EXITED 0"]);
         }

@@ -594,13 +594,16 @@ fn draw_legend(
     frame.render_widget(Paragraph::new(lines), area);
 }
 
+/// One method's runs as the legend draws them: the method, each run's line, the x range.
+type ShownRuns<'a> = (&'a Shown, &'a [Vec<(f64, f64)>], (f64, f64));
+
 /// The picked method's runs, the one shown marked, each with its status and its line's
 /// last value in the range shown.
 fn draw_runs_legend(
     frame: &mut Frame,
     area: Rect,
     (folder, curves): (&FolderState, &Curves),
-    (method, run_lines, (from, to)): (&Shown, &[Vec<(f64, f64)>], (f64, f64)),
+    (method, run_lines, (from, to)): ShownRuns<'_>,
     shown: usize,
     theme: Theme,
 ) {
