@@ -40,6 +40,7 @@ mod sapnet_properties;
 mod sapnet_selection;
 mod sapnet_spreading;
 mod sapnet_validation;
+mod shipped_folders;
 mod signals_cli;
 mod sources_cli;
 mod sweep_cli;
