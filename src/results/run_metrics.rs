@@ -202,15 +202,9 @@ fn read_columns(
     rows: usize,
 ) -> Result<HashMap<String, Vec<Option<f64>>>> {
     let mut out: HashMap<String, Vec<Option<f64>>> = HashMap::new();
-    if !crate::safe_io::csv_exists(path) {
+    let Some((mut reader, header)) = open_with_header(path)? else {
         return Ok(out);
-    }
-    let mut reader =
-        crate::safe_io::csv_reader(path).with_context(|| format!("reading {}", path.display()))?;
-    let header = reader
-        .headers()
-        .with_context(|| format!("reading {}", path.display()))?
-        .clone();
+    };
     let at: Vec<(&str, Option<usize>)> = columns
         .iter()
         .map(|&c| (c, header.iter().position(|h| h == c)))
@@ -232,12 +226,14 @@ fn read_columns(
     Ok(out)
 }
 
-/// Column `name` of `activations.csv` at `path`, placed by each row's `episode` (from 1)
-/// among a run's `episodes`.
-fn read_by_episode(path: &Path, name: &str, episodes: usize) -> Result<Vec<Option<f64>>> {
-    let mut values = vec![None; episodes];
+/// A run file's CSV reader, bounded by the safe reader.
+type CsvReader = csv::Reader<Box<dyn std::io::Read>>;
+
+/// The CSV file at `path` opened by the safe reader, with its header; none if the run
+/// did not write it.
+fn open_with_header(path: &Path) -> Result<Option<(CsvReader, csv::StringRecord)>> {
     if !crate::safe_io::csv_exists(path) {
-        return Ok(values);
+        return Ok(None);
     }
     let mut reader =
         crate::safe_io::csv_reader(path).with_context(|| format!("reading {}", path.display()))?;
@@ -245,6 +241,16 @@ fn read_by_episode(path: &Path, name: &str, episodes: usize) -> Result<Vec<Optio
         .headers()
         .with_context(|| format!("reading {}", path.display()))?
         .clone();
+    Ok(Some((reader, header)))
+}
+
+/// Column `name` of `activations.csv` at `path`, placed by each row's `episode` (from 1)
+/// among a run's `episodes`.
+fn read_by_episode(path: &Path, name: &str, episodes: usize) -> Result<Vec<Option<f64>>> {
+    let mut values = vec![None; episodes];
+    let Some((mut reader, header)) = open_with_header(path)? else {
+        return Ok(values);
+    };
     let (Some(episode_at), Some(value_at)) = (
         header.iter().position(|h| h == "episode"),
         header.iter().position(|h| h == name),
