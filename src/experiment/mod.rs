@@ -22,4 +22,4 @@ pub use protocol::{
     StoppedProtocol,
 };
 pub use tap::{Tap, Watched};
-pub use tensorboard_runs::TENSORBOARD_DIR;
+pub use tensorboard_runs::{event_dir_name, TENSORBOARD_DIR};

@@ -2,12 +2,19 @@
 //! `<out>/tensorboard/<method>-run<r>/`, written while it trains so that `tensorboard
 //! --logdir <out>/tensorboard` shows the protocol live.
 //!
+//! A run's folder is named by its method's label as the results show it (`dqn[100]-run0`),
+//! so that TensorBoard's run selector reads as the comparison table does.
+//!
 //! Tags are CleanRL's where it has one (`charts/episodic_return`, `charts/episodic_length`,
-//! `losses/td_loss`, `charts/epsilon`, each at the run's global step as CleanRL logs them)
-//! and sapnet's own for what a reusing run adds: `sapnet/activation/<source>` and
-//! `sapnet/probability/<source>` at each selector snapshot, `sapnet/acting_source` (the
-//! source that acted most in the episode). The run's settings are its hyper-parameters
-//! (TensorBoard's HParams tab), its end the session's status.
+//! `losses/td_loss`, `charts/epsilon`, `charts/SPS`, each at the run's global step as
+//! CleanRL logs them) and sapnet's own for what a reusing run adds:
+//! `sapnet/activation/<source>` and `sapnet/probability/<source>` at each selector
+//! snapshot, and `sapnet/acting_source/<source>`, 1 for the source that acted most in the
+//! episode and 0 for the others. Which source acted is a category: as one scalar (its
+//! index) TensorBoard would draw a line between sources and smooth it into indices that
+//! name none; as one indicator a source, smoothing gives the share of recent episodes each
+//! led. The run's settings are its hyper-parameters (TensorBoard's HParams tab), its end
+//! the session's status.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -64,7 +71,7 @@ impl TensorBoardRuns {
         method: &MethodId,
         run: u32,
     ) -> Result<()> {
-        let dir = self.root.join(run_name(method.label(), run));
+        let dir = self.root.join(event_dir_name(method.label(), run));
         // remove_dir_all removes a planted link itself, never what it points to.
         if std::fs::symlink_metadata(&dir).is_ok() {
             std::fs::remove_dir_all(&dir)
@@ -86,7 +93,8 @@ impl TensorBoardRuns {
         Ok(())
     }
 
-    /// An episode's return, length, loss, ε and acting source, at the step it ended.
+    /// An episode's return, length, loss, ε, steps per second and acting source, at the
+    /// step it ended.
     pub(super) fn episode(&mut self, record: &EpisodeRecord) -> Result<()> {
         let Some(log) = self.runs.get_mut(&(record.method.clone(), record.run)) else {
             return Ok(());
@@ -98,11 +106,18 @@ impl TensorBoardRuns {
             w.scalar("charts/episodic_return", step, record.reward as f32)?;
             w.scalar("charts/episodic_length", step, record.steps as f32)?;
             w.scalar("charts/epsilon", step, record.epsilon as f32)?;
+            // CleanRL's: the run's steps over its seconds so far.
+            if record.wall_s > 0.0 {
+                w.scalar("charts/SPS", step, (step as f64 / record.wall_s) as f32)?;
+            }
             if let Some(loss) = record.loss {
                 w.scalar("losses/td_loss", step, loss as f32)?;
             }
-            if let Some(source) = record.policy {
-                w.scalar("sapnet/acting_source", step, source as f32)?;
+            if let Some(acted) = record.policy {
+                for (i, name) in self.names.iter().enumerate() {
+                    let led = if i == acted as usize { 1.0 } else { 0.0 };
+                    w.scalar(&format!("sapnet/acting_source/{name}"), step, led)?;
+                }
             }
             // Each episode on disk as it ends: TensorBoard follows the run live.
             w.flush()
@@ -150,6 +165,18 @@ impl TensorBoardRuns {
         w.end_session(status)
             .and_then(|()| w.flush())
             .with_context(|| format!("writing {}", w.path().display()))
+    }
+}
+
+/// A run's event folder: its label as the results show it (a portable name but for the
+/// brackets and commas of a network's sizes, which file names allow), unless too long for
+/// a file name, then the run folder's name.
+pub fn event_dir_name(label: &str, run: u32) -> String {
+    const LONGEST: usize = 120;
+    if label.len() <= LONGEST {
+        format!("{label}-run{run}")
+    } else {
+        run_name(label, run)
     }
 }
 

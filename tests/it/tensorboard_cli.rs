@@ -6,11 +6,11 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use sapnet::results::records::run_name;
+use sapnet::experiment::event_dir_name;
 use sapnet::safe_io::Links;
 use sapnet::tensorboard::read_events;
 
-/// Each run's returns in `episodes.csv`, by its folder's name (`dqn-16-run0`).
+/// Each run's returns in `episodes.csv`, by its event folder's name (`dqn[16]-run0`).
 fn returns_in_episodes_csv(out: &Path) -> BTreeMap<String, Vec<f64>> {
     let mut reader = csv::Reader::from_path(out.join("episodes.csv")).unwrap();
     let header = reader.headers().unwrap().clone();
@@ -20,7 +20,7 @@ fn returns_in_episodes_csv(out: &Path) -> BTreeMap<String, Vec<f64>> {
         .map(|r| {
             let r = r.unwrap();
             (
-                run_name(&r[col("method")], r[col("run")].parse().unwrap()),
+                event_dir_name(&r[col("method")], r[col("run")].parse().unwrap()),
                 r[col("episode")].parse().unwrap(),
                 r[col("reward")].parse().unwrap(),
             )
@@ -66,7 +66,12 @@ fn each_runs_event_file_holds_its_episodic_returns() {
     let out = tmp.path().join("out");
     run_quick(&out);
     let expected = returns_in_episodes_csv(&out);
-    assert_eq!(expected.len(), 2, "two runs: {:?}", expected.keys());
+    let names: Vec<&String> = expected.keys().collect();
+    assert_eq!(
+        names,
+        ["dqn[16]-run0", "dqn[16]-run1"],
+        "named as the results name them"
+    );
     let mut python_runs = Vec::new();
     for (run, returns) in &expected {
         let dir = out.join("tensorboard").join(run);
@@ -89,6 +94,13 @@ fn each_runs_event_file_holds_its_episodic_returns() {
             assert_eq!(*step, steps, "{run}");
         }
         assert_eq!(scalars("charts/epsilon").len(), returns.len(), "{run}");
+        // CleanRL's steps per second, at each episode's end.
+        let sps = scalars("charts/SPS");
+        assert_eq!(sps.len(), returns.len(), "{run}");
+        assert!(
+            sps.iter().all(|(_, v)| v.is_finite() && *v > 0.0),
+            "{run}: {sps:?}"
+        );
         python_runs.push((run.clone(), dir));
     }
 
@@ -117,6 +129,85 @@ print(json.dumps([e.value for e in runs.Scalars("charts/episodic_return")]))
         let read: Vec<f64> = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(&read, &expected[&run], "TensorBoard's reader, {run}");
     }
+}
+
+/// Which source acted most in an episode is a category: one indicator a source, exactly one
+/// of them 1 at each episode's end, never one scalar of source indices.
+#[test]
+fn the_acting_source_is_one_indicator_a_source() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (library, out) = (tmp.path().join("lib"), tmp.path().join("out"));
+    let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/configs");
+    let run = |args: &[&std::ffi::OsStr]| {
+        let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    };
+    let sources = configs.join("tiny_sources.ron");
+    run(&[
+        "sources".as_ref(),
+        "--config".as_ref(),
+        sources.as_os_str(),
+        "--library".as_ref(),
+        library.as_os_str(),
+    ]);
+    let transfer = configs.join("tiny_transfer.ron");
+    run(&[
+        "--headless".as_ref(),
+        "--tensorboard".as_ref(),
+        "--config".as_ref(),
+        transfer.as_os_str(),
+        "--library".as_ref(),
+        library.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    let events = read_events(
+        &event_file(&out.join("tensorboard/sapnet-run0")),
+        Links::Refuse,
+    )
+    .unwrap();
+    let mut led: BTreeMap<i64, Vec<(String, f64)>> = BTreeMap::new();
+    for event in &events {
+        for s in &event.scalars {
+            assert_ne!(s.tag, "sapnet/acting_source", "a category drawn as a line");
+            if let Some(source) = s.tag.strip_prefix("sapnet/acting_source/") {
+                led.entry(event.step)
+                    .or_default()
+                    .push((source.to_owned(), s.value));
+            }
+        }
+    }
+    // An episode in which no source acted (the replay's random warm-up) leads none.
+    let mut reader = csv::Reader::from_path(out.join("episodes.csv")).unwrap();
+    let led_in_csv = reader
+        .deserialize::<BTreeMap<String, String>>()
+        .map(Result::unwrap)
+        .filter(|r| r["method"] == "sapnet" && r["run"] == "0" && !r["policy"].is_empty())
+        .count();
+    assert!(led_in_csv > 0);
+    assert_eq!(
+        led.len(),
+        led_in_csv,
+        "one set of indicators an episode a source led"
+    );
+    for (step, sources) in &led {
+        assert_eq!(
+            sources.len(),
+            3,
+            "every source of the tiny library, at step {step}"
+        );
+        let ones = sources.iter().filter(|(_, v)| *v == 1.0).count();
+        let zeros = sources.iter().filter(|(_, v)| *v == 0.0).count();
+        assert_eq!((ones, zeros), (1, 2), "at step {step}: {sources:?}");
+    }
+    assert!(out.join("tensorboard/dqn[8]-run0").is_dir());
 }
 
 /// The UI runs the protocol headless runs, into the same folder, so `--tensorboard` is
