@@ -248,7 +248,7 @@ fn read_path(method: &mut Method, path: &Path, options: &ReadOptions) -> Result<
             .runs
             .extend(results_folder::read_method(&dir, &label)?);
     } else {
-        method.runs.push(outside_runs::read_run(path, options)?);
+        method.runs.extend(outside_runs::read_runs(path, options)?);
     }
     Ok(())
 }

@@ -69,7 +69,7 @@ pub enum OutsideRunError {
         tried: Vec<String>,
         found: Vec<String>,
     },
-    #[error("{}: no scalar tagged {} (the tags are {})", path.display(), either(tried), listed(found))]
+    #[error("{}: no scalar tagged {} (the tags are {}){}", path.display(), either(tried), listed(found), rollout_mean_hint(tried, found))]
     MissingTag {
         path: PathBuf,
         tried: Vec<String>,
@@ -85,6 +85,21 @@ pub enum OutsideRunError {
     Csv { path: PathBuf, error: csv::Error },
     #[error(transparent)]
     EventFile(#[from] EventFileError),
+}
+
+/// Stable-Baselines3 logs no episode's return to TensorBoard, only the mean of its recent
+/// episodes: where that is the tag there, say how to read it (and what it is).
+fn rollout_mean_hint(tried: &[String], found: &[String]) -> String {
+    let tag = super::ROLLOUT_MEAN_TAG;
+    if found.iter().any(|t| t == tag) && !tried.iter().any(|t| t == tag) {
+        format!(
+            "; {tag:?} is Stable-Baselines3's mean return of its recent episodes, not each \
+             episode's: `--rollout-mean` reads it, each logged mean taken as one episode (its \
+             monitor.csv, where it wrote one, has every episode)"
+        )
+    } else {
+        String::new()
+    }
 }
 
 /// `"a", "b" or "c"`.

@@ -2,6 +2,10 @@
 //! `tfevents` (TensorBoard's own rule), in the order of their names (TensorBoard's order,
 //! which is the order a run resumed in one folder wrote them). Each scalar logged under the
 //! return tag is one episode, at its event's step.
+//!
+//! A folder without event files holds runs as TensorBoard's logdir does: each folder of
+//! event files under it is one run. Stable-Baselines3's `tensorboard_log=tb/dqn-0` writes
+//! `tb/dqn-0/DQN_1/events…`, so its folders are looked for [`RUN_FOLDER_DEPTH`] levels down.
 
 use std::collections::BTreeSet;
 use std::fs::File;
@@ -25,28 +29,104 @@ pub fn read_file(
     scan.into_run(path)
 }
 
-/// Reads the event files of the folder `dir`. A link among them is refused, as any link
-/// inside a folder is (see [`crate::safe_io`]); sub-folders are not looked in.
-pub fn read_folder(dir: &Path, options: &ReadOptions) -> Result<OutsideRun, OutsideRunError> {
+/// How many levels under a folder without event files its runs' folders are looked for:
+/// a folder of Stable-Baselines3 seeds' logs (`tb/dqn-0/DQN_1/`) is two above its files.
+pub const RUN_FOLDER_DEPTH: usize = 2;
+
+/// How many entries the search for run folders reads before it refuses: a folder named by
+/// mistake (a home directory) is refused at once, not walked.
+const MAX_ENTRIES_SEARCHED: usize = 100_000;
+
+/// A folder's event files (by TensorBoard's rule, a name holding `tfevents`) and its
+/// sub-folders, each sorted. A link is neither: a linked event file is listed, to be
+/// refused when opened; a linked folder is never entered.
+struct Listing {
+    files: Vec<PathBuf>,
+    folders: Vec<PathBuf>,
+    entries: usize,
+}
+
+fn list(dir: &Path) -> Result<Listing, OutsideRunError> {
     let io_error = |error| OutsideRunError::Io {
         path: dir.to_path_buf(),
         error,
     };
-    let mut files = Vec::new();
+    let mut listing = Listing {
+        files: Vec::new(),
+        folders: Vec::new(),
+        entries: 0,
+    };
     for entry in std::fs::read_dir(dir).map_err(io_error)? {
         let entry = entry.map_err(io_error)?;
-        let is_dir = entry.file_type().map_err(io_error)?.is_dir();
-        if !is_dir && entry.file_name().to_string_lossy().contains("tfevents") {
-            files.push(entry.path());
+        listing.entries += 1;
+        if listing.entries > MAX_ENTRIES_SEARCHED {
+            break;
+        }
+        let kind = entry.file_type().map_err(io_error)?;
+        if kind.is_dir() {
+            listing.folders.push(entry.path());
+        } else if entry.file_name().to_string_lossy().contains("tfevents") {
+            listing.files.push(entry.path());
         }
     }
+    listing.files.sort();
+    listing.folders.sort();
+    Ok(listing)
+}
+
+/// The runs under the folder `dir`: `dir` itself if it holds event files, else every folder
+/// that does within [`RUN_FOLDER_DEPTH`] levels under it, in the order of their paths.
+pub fn run_folders(dir: &Path) -> Result<Vec<PathBuf>, OutsideRunError> {
+    let mut runs = Vec::new();
+    let mut level = vec![dir.to_path_buf()];
+    let mut searched = 0;
+    for depth in 0..=RUN_FOLDER_DEPTH {
+        let mut next = Vec::new();
+        for folder in level {
+            let listing = list(&folder)?;
+            searched += listing.entries;
+            if searched > MAX_ENTRIES_SEARCHED {
+                return Err(OutsideRunError::UnknownFormat {
+                    path: dir.to_path_buf(),
+                    why: "more than 100,000 entries searched for folders of event files: \
+                          name the run folders themselves",
+                });
+            }
+            if !listing.files.is_empty() {
+                runs.push(folder);
+            } else if depth < RUN_FOLDER_DEPTH {
+                next.extend(listing.folders);
+            }
+        }
+        level = next;
+    }
+    if runs.is_empty() {
+        return Err(OutsideRunError::UnknownFormat {
+            path: dir.to_path_buf(),
+            why: "a folder without event files (no file name in it, or in the folders two \
+                  levels under it, holds \"tfevents\")",
+        });
+    }
+    if runs.len() > crate::limits::MAX_RUNS as usize {
+        return Err(OutsideRunError::UnknownFormat {
+            path: dir.to_path_buf(),
+            why: "more than 10,000 folders of event files, each a run (at most 10,000 a method)",
+        });
+    }
+    runs.sort();
+    Ok(runs)
+}
+
+/// Reads the event files of the folder `dir` as one run. A link among them is refused, as
+/// any link inside a folder is (see [`crate::safe_io`]); sub-folders are not looked in.
+pub fn read_folder(dir: &Path, options: &ReadOptions) -> Result<OutsideRun, OutsideRunError> {
+    let files = list(dir)?.files;
     if files.is_empty() {
         return Err(OutsideRunError::UnknownFormat {
             path: dir.to_path_buf(),
             why: "a folder without event files (no file name in it holds \"tfevents\")",
         });
     }
-    files.sort();
     let mut scan = Scan::new(options);
     for path in &files {
         scan.file(path, EventFile::open(path, Links::Refuse)?)?;

@@ -204,6 +204,25 @@ const MAX_FILE_BYTES: u64 = if safe_io::MAX_CSV_BYTES > MAX_EVENT_FILE_BYTES {
     MAX_EVENT_FILE_BYTES
 };
 
+/// Every run `path` holds: a file is one run; a folder is one run if it holds event files,
+/// else each folder of event files under it is (TensorBoard's logdir, Stable-Baselines3's
+/// `tensorboard_log` layout `tb/DQN_1/events…`).
+pub fn read_runs(path: &Path, options: &ReadOptions) -> Result<Vec<OutsideRun>, OutsideRunError> {
+    let is_dir = std::fs::metadata(path)
+        .map_err(|error| OutsideRunError::Io {
+            path: path.to_path_buf(),
+            error,
+        })?
+        .is_dir();
+    if !is_dir {
+        return Ok(vec![read_run(path, options)?]);
+    }
+    event_files::run_folders(path)?
+        .iter()
+        .map(|dir| event_files::read_folder(dir, options))
+        .collect()
+}
+
 /// Reads the run in `path`, a file (its format told from its content) or a folder of
 /// event files. `path` is the user's: it may be a link; files inside a folder may not.
 pub fn read_run(path: &Path, options: &ReadOptions) -> Result<OutsideRun, OutsideRunError> {

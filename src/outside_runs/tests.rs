@@ -141,6 +141,38 @@ fn an_event_file_or_a_folder_of_them_reads_the_return_tag_with_its_lengths() {
     assert_eq!(episodes(&folder), [(20, 20.0), (45, 25.0), (80, 35.0)]);
 }
 
+/// Stable-Baselines3's `tensorboard_log`: `tb/<seed>/DQN_1/events…`. The seed's folder is
+/// its one run; their parent holds each seed's run, in the order of their paths; a linked
+/// folder is never entered, and a folder with none within two levels is refused.
+#[test]
+fn a_folder_without_event_files_holds_the_runs_of_the_folders_under_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let tb = dir.path().join("tb");
+    cleanrl_events(&tb.join("dqn-1/DQN_1"), &[(30, 30.0, 30.0)]);
+    cleanrl_events(
+        &tb.join("dqn-0/DQN_1"),
+        &[(20, 20.0, 20.0), (45, 25.0, 25.0)],
+    );
+    std::os::unix::fs::symlink(tb.join("dqn-0"), tb.join("dqn-link")).unwrap();
+    let options = ReadOptions::default();
+    let seed = read_runs(&tb.join("dqn-0"), &options).unwrap();
+    assert_eq!(seed.len(), 1);
+    assert_eq!(seed[0].path, tb.join("dqn-0/DQN_1"));
+    assert_eq!(episodes(&seed[0]), [(20, 20.0), (45, 25.0)]);
+    let seeds = read_runs(&tb, &options).unwrap();
+    let paths: Vec<&Path> = seeds.iter().map(|r| r.path.as_path()).collect();
+    assert_eq!(paths, [tb.join("dqn-0/DQN_1"), tb.join("dqn-1/DQN_1")]);
+    // A file is one run, and a folder of event files one run, as before.
+    assert_eq!(
+        read_runs(&tb.join("dqn-1/DQN_1"), &options).unwrap().len(),
+        1
+    );
+    let deep = dir.path().join("deep");
+    cleanrl_events(&deep.join("a/b/c"), &[(10, 10.0, 10.0)]);
+    let err = read_runs(&deep, &options).unwrap_err().to_string();
+    assert!(err.contains("two levels under it"), "{err}");
+}
+
 #[test]
 fn stable_baselines3s_rollout_mean_is_read_only_when_asked() {
     let dir = tempfile::tempdir().unwrap();
@@ -152,7 +184,8 @@ fn stable_baselines3s_rollout_mean_is_read_only_when_asked() {
     let err = message(read(&path));
     assert!(
         err.contains("no scalar tagged \"charts/episodic_return\"")
-            && err.contains("the tags are \"rollout/ep_rew_mean\", \"train/loss\""),
+            && err.contains("the tags are \"rollout/ep_rew_mean\", \"train/loss\"")
+            && err.contains("`--rollout-mean` reads it"),
         "{err}"
     );
     let asked = ReadOptions {
