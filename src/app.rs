@@ -365,7 +365,7 @@ fn run_experiment(cli: &Cli) -> Result<()> {
     let options = run_options(cli);
     let summary = experiment::run(&config, &output, &options, &on_interrupt()?)
         .map_err(|error| in_config_file(error, cli))?;
-    headless::print_summary(&summary, &output.dir)
+    headless::print_summary(&summary, &output.dir, headless::RanIn::Headless)
 }
 
 /// Names the config's file in an error one of its fields caused (a field only the library
@@ -410,7 +410,7 @@ fn resume_experiment(cli: &Cli) -> Result<()> {
         &run_options(cli),
         &on_interrupt()?,
     )?;
-    headless::print_summary(&summary, dir)
+    headless::print_summary(&summary, dir, headless::RanIn::Headless)
 }
 
 fn run_options(cli: &Cli) -> RunOptions {
@@ -540,7 +540,7 @@ fn print_ended(ended: tui::workbench::screens::session::live::Ended) -> Result<(
     let mut failed = None;
     for (outcome, dir) in ended {
         match outcome {
-            Ok(summary) => headless::print_summary(&summary, &dir)?,
+            Ok(summary) => headless::print_summary(&summary, &dir, headless::RanIn::Ui)?,
             Err(error) => {
                 let error = error.context(format!("the protocol into {}", dir.display()));
                 if failed.is_none() {

@@ -4,4 +4,4 @@
 
 mod summary;
 
-pub use summary::{print_comparison, print_summary};
+pub use summary::{print_comparison, print_summary, RanIn};

@@ -8,13 +8,25 @@ use anyhow::{Context, Result};
 
 use crate::{report, results};
 
-/// What a headless protocol did: where its files are, each run on stderr, the comparison
-/// on stdout.
-pub fn print_summary(summary: &results::Summary, dir: &Path) -> Result<()> {
+/// Where a protocol ran: a stopped one is advised to resume where it was.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RanIn {
+    Headless,
+    Ui,
+}
+
+/// What a protocol did: where its files are, each run on stderr, the comparison on stdout.
+pub fn print_summary(summary: &results::Summary, dir: &Path, ran_in: RanIn) -> Result<()> {
     let config = &summary.config;
     let dir = dir.display();
     if summary.stopped() {
-        eprintln!("stopped by the user: what was done so far is in {dir} (episodes.csv, tests.csv, summary.json, plots); `sapnet --headless --resume --out {dir}` finishes it");
+        let resume = match ran_in {
+            RanIn::Headless => format!("`sapnet --headless --resume --out {dir}` finishes it"),
+            RanIn::Ui => format!(
+                "`sapnet --resume --out {dir}` finishes it in the UI (with --headless, without it)"
+            ),
+        };
+        eprintln!("stopped by the user: what was done so far is in {dir} (episodes.csv, tests.csv, summary.json, plots); {resume}");
     } else {
         eprintln!("results in {dir}: episodes.csv, tests.csv, activations.csv, comparison.csv, improvement.csv, scores.csv, summary.json, runs/, policies/, intervals.png, profiles.png, improvement.png, learning_curve.png, sample_efficiency.csv, sample_efficiency.png, tests.png, activations.png, selections.png (the plots also as .svg)");
     }
