@@ -135,7 +135,8 @@ pub struct RunArgs {
     pub jobs: Option<usize>,
 
     /// The policy library's root directory: SAP-Net reuses <LIBRARY>/<source task>/.
-    /// Default: saved_policies (trained on first use if missing). A library given here
+    /// Default: ./saved_policies (trained on first use if missing), or where there is none
+    /// the library shipped beside the source sapnet was built from. A library given here
     /// must exist, unless --train-library.
     #[arg(long, value_name = "DIR", global = true)]
     pub library: Option<PathBuf>,
@@ -179,7 +180,7 @@ pub struct SubcommandFlags {
 }
 
 /// `--library` for the commands that train or read one library.
-const SOURCES_LIBRARY: &str = "The policy library's root directory: the library is <LIBRARY>/<source task>/. Default: saved_policies";
+const SOURCES_LIBRARY: &str = "The policy library's root directory: the library is <LIBRARY>/<source task>/. Default: ./saved_policies, or where there is none the one shipped with sapnet";
 
 /// Every subcommand's flags, as [`SubcommandFlags`] says.
 pub const SUBCOMMANDS: &[SubcommandFlags] = &[
@@ -217,7 +218,7 @@ pub const SUBCOMMANDS: &[SubcommandFlags] = &[
         name: "open",
         reads: &["--jobs", "--library", "--python", "--module-dir", "--allow-module"],
         config: None,
-        library: Some("With R (resuming a stopped folder): the library root its protocol began with, as `sapnet --resume` reads it. Default: saved_policies"),
+        library: Some("With R (resuming a stopped folder): the library root its protocol began with, as `sapnet --resume` reads it. Default: ./saved_policies, or where there is none the one shipped with sapnet"),
     },
     SubcommandFlags {
         name: "compare",
@@ -241,7 +242,7 @@ pub const SUBCOMMANDS: &[SubcommandFlags] = &[
         name: "sweep plan",
         reads: &["--config", "--library", "--python", "--module-dir", "--allow-module"],
         config: Some("A RON config that replaces the grid's base config"),
-        library: Some("The library root the cells reuse, read-only (`sweep prepare` trains what is missing). Default: saved_policies"),
+        library: Some("The library root the cells reuse, read-only (`sweep prepare` trains what is missing). Default: ./saved_policies, or where there is none the one shipped with sapnet"),
     },
     SubcommandFlags {
         name: "sweep prepare",
@@ -386,6 +387,31 @@ fn edits_in_order(teach: &clap::ArgMatches) -> Vec<(&'static str, Vec<String>)> 
 /// The library root when `--library` is not given.
 pub const DEFAULT_LIBRARY: &str = "saved_policies";
 
+/// The default library: `./saved_policies`, else, where the folder sapnet is started in has
+/// none, the one shipped beside the source sapnet was built from (a binary installed with
+/// `cargo install --path .` and started elsewhere reuses the shipped library rather than
+/// train ten sources for minutes into a new folder), else `./saved_policies`, trained there
+/// on first use. Said once when it is the shipped one.
+fn default_library() -> PathBuf {
+    let here = PathBuf::from(DEFAULT_LIBRARY);
+    if here.exists() {
+        return here;
+    }
+    let shipped = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(DEFAULT_LIBRARY);
+    if !shipped.is_dir() {
+        return here;
+    }
+    static SAID: std::sync::Once = std::sync::Once::new();
+    SAID.call_once(|| {
+        eprintln!(
+            "the source library: {} (shipped with sapnet; no ./{DEFAULT_LIBRARY} here, \
+             --library DIR names another)",
+            shipped.display()
+        );
+    });
+    shipped
+}
+
 impl RunArgs {
     /// The flags given, as the user spelled them: a subcommand refuses those it does not
     /// read rather than ignore them.
@@ -418,11 +444,9 @@ impl RunArgs {
         .collect()
     }
 
-    /// `--library`, or the default.
+    /// `--library`, or the default library.
     pub fn library_path(&self) -> PathBuf {
-        self.library
-            .clone()
-            .unwrap_or_else(|| PathBuf::from(DEFAULT_LIBRARY))
+        self.library.clone().unwrap_or_else(default_library)
     }
 
     /// How this machine runs Gymnasium tasks, as the flags say.

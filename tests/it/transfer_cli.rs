@@ -839,3 +839,33 @@ fn the_fields_baselines_run_and_say_whom_they_followed() {
     let tests = csv_rows(&out.join("tests.csv"));
     assert_eq!(tests.iter().filter(|r| r["method"] == "gpi[8]").count(), 4);
 }
+
+/// Started in a folder without `saved_policies/`, the default protocol reuses the library
+/// shipped beside sapnet's source, says so, and trains nothing into the folder.
+#[test]
+fn started_elsewhere_the_default_library_is_the_shipped_one() {
+    let tmp = tempfile::tempdir().unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_sapnet"))
+        .args([
+            "--headless",
+            "--quick",
+            "--episodes",
+            "3",
+            "--runs",
+            "1",
+            "--out",
+            "out",
+        ])
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", stderr(&output));
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("saved_policies");
+    let said = format!(
+        "the source library: {} (shipped with sapnet",
+        shipped.display()
+    );
+    assert!(stderr(&output).contains(&said), "{}", stderr(&output));
+    assert!(!stderr(&output).contains("no source library"));
+    assert!(!tmp.path().join("saved_policies").exists());
+}
