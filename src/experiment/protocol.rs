@@ -359,49 +359,22 @@ fn protocol(
     tap: Option<&Tap>,
 ) -> Result<Summary> {
     let mut plan = experiment::plan(config, &options.library, options.jobs, commands)?;
-    let library: Option<Vec<LibraryEntry>> = plan.sources.as_ref().map(|sources| {
-        sources
-            .iter()
-            .map(|s| LibraryEntry {
-                name: s.name.clone(),
-                hidden: s.description.hidden.clone(),
-                task: s.description.source_task.clone(),
-                activation: s.description.activation.clone(),
-                final_score: s.final_score,
-            })
-            .collect()
-    });
-    let mut kept = Vec::new();
-    if let Some(began_with) = resumed {
-        if began_with != library.as_deref() {
-            bail!(
-                "the source library in {} is not the one {} began with (summary.json lists \
-                 its names, architectures and scores): resume with the same --library",
-                crate::sources::library_dir(&options.library.path, config).display(),
-                out.display()
-            );
+    let library: Option<Vec<LibraryEntry>> = plan.sources.as_deref().map(|s| library_entries(s));
+    let kept = match resumed {
+        Some(began_with) => {
+            if began_with != library.as_deref() {
+                bail!(
+                    "the source library in {} is not the one {} began with (summary.json \
+                     lists its names, architectures and scores): resume with the same \
+                     --library",
+                    crate::sources::library_dir(&options.library.path, config).display(),
+                    out.display()
+                );
+            }
+            keep_finished(out, config, &mut plan.specs, tap.is_none())?
         }
-        let found = records::read(out, config)?;
-        records::clear_unfinished(out, &found)?;
-        kept = found
-            .into_iter()
-            .filter(|f| !f.summary.record.stopped)
-            .collect();
-        plan.specs.retain(|spec| {
-            !kept
-                .iter()
-                .any(|f| f.summary.record.method == spec.method && f.summary.record.run == spec.run)
-        });
-        // A screen on the terminal says it itself.
-        if tap.is_none() {
-            eprintln!(
-                "resuming {}: {} runs finished before, {} to run",
-                out.display(),
-                kept.len(),
-                plan.specs.len()
-            );
-        }
-    }
+        None => Vec::new(),
+    };
     for spec in &mut plan.specs {
         spec.stream.trace = options.trace && spec.method.kind.spreads;
     }
@@ -429,14 +402,6 @@ fn protocol(
     let copies = options
         .copy_chosen
         .then(|| LibraryCopies::new(config, out, &options.library.path));
-    // A step budget bounds runs in steps, else their episodes do.
-    let (unit, planned) = match config.protocol.budget {
-        Budget::Steps(steps) => (Unit::Steps, steps * plan.specs.len() as u64),
-        Budget::Episodes(episodes) => (
-            Unit::Episodes,
-            u64::from(episodes) * plan.specs.len() as u64,
-        ),
-    };
     let tensorboard = if options.tensorboard {
         Some(TensorBoardRuns::new(out, names.clone(), &plan.specs)?)
     } else {
@@ -444,7 +409,9 @@ fn protocol(
     };
     // Bars on stderr would be drawn over a screen on the terminal: a tapped protocol
     // shows its progress there instead.
-    let progress = tap.is_none().then(|| Progress::new(planned, unit));
+    let progress = tap
+        .is_none()
+        .then(|| planned_progress(config, plan.specs.len()));
     let mut files = Tapped {
         files: ResultFiles::new(
             out.to_path_buf(),
@@ -460,26 +427,76 @@ fn protocol(
     let started = Instant::now();
     let outcome = crate::trainer::schedule(plan.specs, options.jobs, commands, &mut files);
     files.files.finish_progress(matches!(outcome, Ok(false)));
-    let ending = match outcome {
-        Ok(false) => Ending {
-            status: Status::Complete,
-            error: None,
-            wall_s: started.elapsed().as_secs_f64(),
-        },
-        Ok(true) => Ending {
-            status: Status::Stopped,
-            error: None,
-            wall_s: started.elapsed().as_secs_f64(),
-        },
-        Err(err) => Ending {
-            status: Status::Failed,
-            error: Some(format!("{err:#}")),
-            wall_s: started.elapsed().as_secs_f64(),
-        },
+    let (status, error) = match outcome {
+        Ok(false) => (Status::Complete, None),
+        Ok(true) => (Status::Stopped, None),
+        Err(err) => (Status::Failed, Some(format!("{err:#}"))),
+    };
+    let ending = Ending {
+        status,
+        error,
+        wall_s: started.elapsed().as_secs_f64(),
     };
     let summary = assemble(out, config, library, options.trace, ending)?;
     if let Some(error) = &summary.error {
         bail!("{error}");
     }
     Ok(summary)
+}
+
+/// What summary.json records of the library: enough to tell, on resuming, that it is the
+/// one the protocol began with.
+fn library_entries(sources: &[crate::trainer::SourcePolicy]) -> Vec<LibraryEntry> {
+    sources
+        .iter()
+        .map(|s| LibraryEntry {
+            name: s.name.clone(),
+            hidden: s.description.hidden.clone(),
+            task: s.description.source_task.clone(),
+            activation: s.description.activation.clone(),
+            final_score: s.final_score,
+        })
+        .collect()
+}
+
+/// A resumed protocol's finished runs, kept: what its unfinished ones left is cleared and
+/// they leave `specs`, which the protocol runs again from their seeds.
+fn keep_finished(
+    out: &Path,
+    config: &Config,
+    specs: &mut Vec<crate::trainer::RunSpec>,
+    say: bool,
+) -> Result<Vec<records::RunFolder>> {
+    let found = records::read(out, config)?;
+    records::clear_unfinished(out, &found)?;
+    let kept: Vec<records::RunFolder> = found
+        .into_iter()
+        .filter(|f| !f.summary.record.stopped)
+        .collect();
+    specs.retain(|spec| {
+        !kept
+            .iter()
+            .any(|f| f.summary.record.method == spec.method && f.summary.record.run == spec.run)
+    });
+    // A screen on the terminal says it itself.
+    if say {
+        eprintln!(
+            "resuming {}: {} runs finished before, {} to run",
+            out.display(),
+            kept.len(),
+            specs.len()
+        );
+    }
+    Ok(kept)
+}
+
+/// The progress bar of `runs` runs: a step budget bounds runs in steps, else their episodes
+/// do.
+fn planned_progress(config: &Config, runs: usize) -> Progress {
+    match config.protocol.budget {
+        Budget::Steps(steps) => Progress::new(steps * runs as u64, Unit::Steps),
+        Budget::Episodes(episodes) => {
+            Progress::new(u64::from(episodes) * runs as u64, Unit::Episodes)
+        }
+    }
 }
