@@ -63,8 +63,12 @@ fn a_real_stable_baselines3_monitor_file_reads_and_scores() {
         assert_eq!(r as u32, length);
     }
     // 288 / 15; the last five: (14 + 20 + 10 + 12 + 17) / 5 = 73 / 5.
-    assert_eq!(run.training_return(), 288.0 / 15.0);
-    assert_eq!(run.final_score(NonZeroUsize::new(5).unwrap()), 73.0 / 5.0);
+    let scored = crate::report::scored::RunEpisodes::of(&run);
+    assert_eq!(scored.training_return(), 288.0 / 15.0);
+    assert_eq!(
+        scored.final_score(NonZeroUsize::new(5).unwrap()),
+        73.0 / 5.0
+    );
 }
 
 #[test]
