@@ -46,7 +46,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Compare(args)) => {
             let report = crate::compare::compare(args)?;
             eprintln!(
-                "compared {} methods into {}: comparison.csv, improvement.csv, scores.csv, runs.csv, sample_efficiency.csv and the plots; `test` is each run's final score, the mean return of its last {} episodes",
+                "compared {0} methods into {1}: comparison.csv, improvement.csv, scores.csv, runs.csv, sample_efficiency.csv and the plots, with run_episodes.csv and compare.json (what `sapnet open {1}` shows them from); `test` is each run's final score, the mean return of its last {2} episodes",
                 report.comparison.len(),
                 args.out.display(),
                 args.last
