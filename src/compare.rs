@@ -160,10 +160,23 @@ fn alignment(args: &CompareArgs, methods: &[Method]) -> Result<Budget> {
                 .map(TrainingEpisodes::steps)
                 .min()
                 .unwrap_or(0);
-            match given.unwrap_or(reached) {
-                0 => Ok(by_episode),
-                budget => Ok(Budget::Steps(budget)),
+            let budget = match given.unwrap_or(reached) {
+                0 => return Ok(by_episode),
+                budget => budget,
+            };
+            let named = methods.iter().map(|m| (m.name.as_str(), m.runs.as_slice()));
+            if let Some((name, r, first)) = compare_folder::unended_by(named, budget) {
+                let chosen = match given {
+                    Some(_) => format!("--steps {budget}"),
+                    None => format!("the steps every run reached ({budget})"),
+                };
+                bail!(
+                    "{chosen}: {name} run {r}'s first episode ends at step {first}, later: a \
+                     run scored by step needs an episode ended by then (give --steps N of at \
+                     least {first}, or --by-episode)"
+                );
             }
+            Ok(Budget::Steps(budget))
         }
         (false, false, Some(_)) => {
             let run = runs()

@@ -166,6 +166,21 @@ pub fn write(dir: &Path, scoring: &Scoring, methods: &[(&str, &[OutsideRun])]) -
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// The first run of `methods` none of whose episodes ended by step `step` — its method,
+/// its place, the step its first episode ended at —: set side by side by step to there it
+/// would have no score.
+pub fn unended_by<'a>(
+    methods: impl IntoIterator<Item = (&'a str, &'a [OutsideRun])>,
+    step: u64,
+) -> Option<(&'a str, usize, u64)> {
+    methods.into_iter().find_map(|(name, runs)| {
+        runs.iter().enumerate().find_map(|(r, run)| {
+            let first = u64::from(*run.episodes.lengths.first()?);
+            (first > step).then_some((name, r, first))
+        })
+    })
+}
+
 /// Whether `dir` holds the record [`write`] makes: compare folders written before it did
 /// hold only their report.
 pub fn is_recorded(dir: &Path) -> bool {
@@ -188,7 +203,7 @@ pub fn read(dir: &Path) -> Result<Recorded> {
     })?;
     check(&path, &file)?;
     let methods = read_episodes(&dir.join(EPISODES), &file)?;
-    if let Alignment::Steps(_) = file.scoring.alignment {
+    if let Alignment::Steps(budget) = file.scoring.alignment {
         for (name, runs) in &methods {
             if let Some(r) = runs.iter().position(|run| run.placed().is_none()) {
                 bail!(
@@ -197,6 +212,16 @@ pub fn read(dir: &Path) -> Result<Recorded> {
                     dir.join(EPISODES).display()
                 );
             }
+        }
+        let runs = methods
+            .iter()
+            .map(|(n, runs)| (n.as_str(), runs.as_slice()));
+        if let Some((name, r, first)) = unended_by(runs, budget) {
+            bail!(
+                "{}: scoring.alignment.steps: {budget} comes before {name} run {r}'s first \
+                 episode ends (step {first}): expected a step every run has an episode ended by",
+                path.display()
+            );
         }
     }
     Ok(Recorded {
@@ -463,6 +488,24 @@ mod tests {
             }
         }
         assert_eq!(read.methods[0].1[0].steps(), Some(20));
+    }
+
+    #[test]
+    fn a_step_before_a_runs_first_episode_ends_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = [run(&[(10, 1.0), (20, 2.0)], Axis::Steps)];
+        let b = [run(&[(4, 1.0), (30, 2.0)], Axis::Steps)];
+        let scoring = Scoring {
+            alignment: Alignment::Steps(5),
+            ..scoring()
+        };
+        write(dir.path(), &scoring, &[("a", &a), ("b", &b)]).unwrap();
+        let error = format!("{:#}", read(dir.path()).unwrap_err());
+        assert!(
+            error.contains("compare.json: scoring.alignment.steps: 5 comes before a run 0's")
+                && error.contains("(step 10)"),
+            "{error}"
+        );
     }
 
     #[test]

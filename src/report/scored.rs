@@ -92,7 +92,8 @@ pub fn score(run: RunEpisodes, scoring: &Scoring) -> ScoredRun {
             let points = step_axis::points(budget, sample_efficiency::POINTS);
             let curve = step_axis::curve(episodes, scoring.window, &points);
             ScoredRun {
-                // Every run has an episode ended by the steps every run reached.
+                // Every run has an episode ended by the budget: compare and the compare
+                // folder's reader refuse a budget before one's first episode ends.
                 training_return: step_axis::area(&curve).unwrap_or(f64::NAN),
                 final_score: step_axis::curve(episodes, scoring.last.get(), &[budget])[0]
                     .unwrap_or(f64::NAN),
