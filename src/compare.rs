@@ -18,6 +18,10 @@
 //! normalise scores (the optimality gap, the profiles) are fixed by `--range`, else taken
 //! from the results folders' task, else from the data, with a warning: then adding a run
 //! can move every normalised score.
+//!
+//! Beside the report, the folder records the runs as read and how they were scored
+//! ([`compare_folder`]): `sapnet open` shows the comparison from those, through the same
+//! scoring ([`scored::compare_report`]), wherever the runs' own files have gone.
 
 use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
