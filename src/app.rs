@@ -46,7 +46,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Compare(args)) => {
             let report = crate::compare::compare(args)?;
             eprintln!(
-                "compared {} methods into {}: comparison.csv, improvement.csv, scores.csv, runs.csv, sample_efficiency.csv and the plots; `test` is each run's final score, the mean return of its last {} episodes",
+                "compared {0} methods into {1}: comparison.csv, improvement.csv, scores.csv, runs.csv, sample_efficiency.csv and the plots, with run_episodes.csv and compare.json (what `sapnet open {1}` shows them from); `test` is each run's final score, the mean return of its last {2} episodes",
                 report.comparison.len(),
                 args.out.display(),
                 args.last
@@ -60,18 +60,16 @@ pub fn run(cli: Cli) -> Result<()> {
             let load = |path: &Path| load_picked(&cli, path);
             let settings = session_settings(&cli, &load, Vec::new());
             // A results folder opens in the workbench's views, a sweep folder in the Sweep
-            // view, any other lists the folders sapnet wrote under it.
+            // view, a compare folder in its Comparison and Curves, any other lists the
+            // folders sapnet wrote under it.
             match results::found::kind(&args.dir) {
                 Some(results::found::Kind::Protocol) => {
                     print_ended(tui::workbench::screens::opened::run(&args.dir, &settings)?)
                 }
                 Some(results::found::Kind::Sweep) => tui::workbench::screens::sweep::run(&args.dir),
-                Some(results::found::Kind::Compare) => anyhow::bail!(
-                    "sapnet open {0}: a `sapnet compare` folder, whose views are not in the \
-                     workbench yet: its table is {0}/comparison.csv (as compare printed it), \
-                     its plots the .png files beside it",
-                    args.dir.display()
-                ),
+                Some(results::found::Kind::Compare) => {
+                    tui::workbench::screens::compared::run(&args.dir)
+                }
                 None => print_ended(tui::workbench::screens::folders::run(&args.dir, &settings)?),
             }
         }

@@ -18,6 +18,10 @@
 //! normalise scores (the optimality gap, the profiles) are fixed by `--range`, else taken
 //! from the results folders' task, else from the data, with a warning: then adding a run
 //! can move every normalised score.
+//!
+//! Beside the report, the folder records the runs as read and how they were scored
+//! ([`compare_folder`]): `sapnet open` shows the comparison from those, through the same
+//! scoring ([`scored::compare_report`]), wherever the runs' own files have gone.
 
 use std::num::NonZeroUsize;
 use std::path::{Path, PathBuf};
@@ -26,11 +30,11 @@ use anyhow::{bail, Context, Result};
 
 use crate::cli::CompareArgs;
 use crate::config::Budget;
+use crate::outside_runs::compare_folder::{self, is_method_name, Scoring, LONGEST_NAME};
 use crate::outside_runs::{self, results_folder, OutsideRun, PositionColumn, ReadOptions};
 use crate::report::plots::{Curve, PlotData};
-use crate::report::scored::{ScoredMethod, ScoredRun};
-use crate::report::{self, sample_efficiency, step_axis, Report, TrainingEpisodes};
-use crate::reuse::{MethodKind, Tested};
+use crate::report::scored::{self, RunEpisodes, ScoredMethod};
+use crate::report::{self, Report, TrainingEpisodes};
 
 /// One `--method`: its name and the runs read for it.
 struct Method {
@@ -65,6 +69,14 @@ pub fn compare(args: &CompareArgs) -> Result<Report> {
     if methods.len() < 2 {
         bail!("--method: expected at least two methods to compare (each `--method NAME=PATH`)");
     }
+    if methods.len() > crate::limits::MAX_METHODS {
+        bail!(
+            "--method: {} methods, more than the {} a comparison sets side by side (every \
+             pair is bootstrapped)",
+            methods.len(),
+            crate::limits::MAX_METHODS
+        );
+    }
     let (task, range) = task_and_range(args, &methods)?;
     let out = &args.out;
     match std::fs::metadata(out) {
@@ -85,38 +97,40 @@ pub fn compare(args: &CompareArgs) -> Result<Report> {
     }
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
 
-    let kinds = kinds(methods.len());
     let budget = alignment(args, &methods)?;
-    let window = args.window as usize;
-    let scored: Vec<ScoredMethod> = methods
+    let scoring = Scoring {
+        task: task.clone(),
+        range,
+        alignment: scored::alignment(budget),
+        window: args.window as usize,
+        last,
+    };
+    let runs: Vec<(&str, &[OutsideRun])> = methods
         .iter()
-        .zip(&kinds)
-        .map(|(m, &kind)| ScoredMethod {
-            label: m.name.clone(),
-            kind,
-            runs: m
-                .runs
-                .iter()
-                .map(|r| score(r, budget, window, last))
-                .collect(),
-        })
+        .map(|m| (m.name.as_str(), m.runs.as_slice()))
         .collect();
-    let report = Report::of_scored(&task, range, last.get(), &scored);
+    let episodes: Vec<(&str, Vec<RunEpisodes>)> = runs
+        .iter()
+        .map(|&(name, runs)| (name, runs.iter().map(RunEpisodes::of).collect()))
+        .collect();
+    let (scored, report) = scored::compare_report(&scoring, &episodes);
     report.write(out)?;
+    // What `sapnet open` scores the runs again from, the files they came from aside.
+    compare_folder::write(out, &scoring, &runs)?;
     // The plots take the runs' episodes, which are not copied: what is left of each run
     // is where it came from, for runs.csv.
     let data = PlotData {
         task: task.clone(),
         subject: None,
         return_range: Some(range),
-        window,
+        window: scoring.window,
         budget,
         curves: methods
             .iter_mut()
-            .zip(&kinds)
-            .map(|(m, &kind)| Curve {
+            .zip(&scored)
+            .map(|(m, scored)| Curve {
                 label: m.name.clone(),
-                kind,
+                kind: scored.kind,
                 runs: m
                     .runs
                     .iter_mut()
@@ -150,10 +164,23 @@ fn alignment(args: &CompareArgs, methods: &[Method]) -> Result<Budget> {
                 .map(TrainingEpisodes::steps)
                 .min()
                 .unwrap_or(0);
-            match given.unwrap_or(reached) {
-                0 => Ok(by_episode),
-                budget => Ok(Budget::Steps(budget)),
+            let budget = match given.unwrap_or(reached) {
+                0 => return Ok(by_episode),
+                budget => budget,
+            };
+            let named = methods.iter().map(|m| (m.name.as_str(), m.runs.as_slice()));
+            if let Some((name, r, first)) = compare_folder::unended_by(named, budget) {
+                let chosen = match given {
+                    Some(_) => format!("--steps {budget}"),
+                    None => format!("the steps every run reached ({budget})"),
+                };
+                bail!(
+                    "{chosen}: {name} run {r}'s first episode ends at step {first}, later: a \
+                     run scored by step needs an episode ended by then (give --steps N of at \
+                     least {first}, or --by-episode)"
+                );
             }
+            Ok(Budget::Steps(budget))
         }
         (false, false, Some(_)) => {
             let run = runs()
@@ -166,46 +193,6 @@ fn alignment(args: &CompareArgs, methods: &[Method]) -> Result<Budget> {
         }
         (false, false, None) => Ok(by_episode),
     }
-}
-
-/// What run `run` scored under `budget` (`window` the step curve's moving average, `last`
-/// the episodes of the final score).
-fn score(run: &OutsideRun, budget: Budget, window: usize, last: NonZeroUsize) -> ScoredRun {
-    match budget {
-        Budget::Episodes(_) => ScoredRun {
-            training_return: run.training_return(),
-            final_score: run.final_score(last),
-            episodes: run.episodes.len(),
-            steps: run.steps(),
-        },
-        Budget::Steps(budget) => {
-            // A step budget is chosen only when every run's lengths are known.
-            let episodes = &run.episodes;
-            let points = step_axis::points(budget, sample_efficiency::POINTS);
-            let curve = step_axis::curve(episodes, window, &points);
-            let ended = step_axis::ended_by(episodes, budget);
-            ScoredRun {
-                // Every run has an episode ended by the steps every run reached.
-                training_return: step_axis::area(&curve).unwrap_or(f64::NAN),
-                final_score: step_axis::curve(episodes, last.get(), &[budget])[0]
-                    .unwrap_or(f64::NAN),
-                episodes: ended,
-                steps: Some(budget),
-            }
-        }
-    }
-}
-
-/// The longest method name: a legend's line.
-const LONGEST_NAME: usize = 120;
-
-/// Whether `name` may name a method: the characters of sapnet's own labels (a results
-/// folder's are matched against it), none that a terminal or a plot would take otherwise.
-fn is_method_name(name: &str) -> bool {
-    (1..=LONGEST_NAME).contains(&name.len())
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || "._-[],+".contains(c))
 }
 
 /// `NAME=PATH[,PATH…]`: the method's name and its paths.
@@ -311,22 +298,6 @@ fn task_and_range(args: &CompareArgs, methods: &[Method]) -> Result<(String, (f6
         );
     }
     Ok((task, range))
-}
-
-/// Each method a family of its own, its hue a golden angle from the last: methods from
-/// elsewhere are not variants of one another.
-fn kinds(count: usize) -> Vec<MethodKind> {
-    (0..count)
-        .map(|i| MethodKind {
-            family: "Outside",
-            hue: ((i as f64 * 137.508 + 210.0) % 360.0) as u16,
-            saturation: 65,
-            reuses: false,
-            tested: Tested::LastEpisodes,
-            picks_by_probability: false,
-            spreads: false,
-        })
-        .collect()
 }
 
 /// `runs.csv`: where each run came from and what it scored (as the report does: on the step

@@ -23,6 +23,11 @@ pub const MAX_BATCH: usize = 1 << 16;
 /// (hundreds separate the closest methods), and refused before anything is planned.
 pub const MAX_RUNS: u32 = 10_000;
 
+/// The most methods a comparison of runs from elsewhere (`sapnet compare`, a compare
+/// folder opened) sets side by side: every pair of them is bootstrapped, so a count a
+/// file could make large would cost hours; a legend is unreadable long before.
+pub const MAX_METHODS: usize = 100;
+
 /// The most environment steps a run, an exclusion or a schedule may count: 10^12, a
 /// million times the paper's longest run. Step arithmetic below it cannot overflow a u64.
 pub const MAX_STEPS: u64 = 1_000_000_000_000;

@@ -10,7 +10,9 @@
 //!   tag, [`RETURN_TAG`] unless the caller names another.
 //!
 //! - a sapnet results folder (`results_folder.rs`): the runs of one of its methods, each
-//!   run one run.
+//!   run one run;
+//! - a `sapnet compare` folder's own record of the runs it compared (`compare_folder.rs`),
+//!   which compare writes and `sapnet open` reads back.
 //!
 //! The format is told from the file's content (`detect.rs`), never from its name. Files are
 //! read through [`crate::safe_io`]: regular files only, bounded in size; the path given
@@ -19,6 +21,7 @@
 //! What a run scores is in `scores.rs`: [`OutsideRun::training_return`] and
 //! [`OutsideRun::final_score`].
 
+pub mod compare_folder;
 mod detect;
 mod error;
 mod event_files;

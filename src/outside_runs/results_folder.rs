@@ -109,7 +109,7 @@ mod tests {
         assert_eq!(returns, [vec![20.0, 30.0], vec![10.0]]);
         assert!(runs[1].path.to_string_lossy().ends_with("#ucb1/1"));
         let dqn = read_method(dir.path(), "dqn[100]").unwrap();
-        assert_eq!(dqn[0].training_return(), 9.0);
+        assert_eq!(dqn[0].returns().collect::<Vec<_>>(), [9.0]);
     }
 
     #[test]

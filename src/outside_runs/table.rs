@@ -129,6 +129,13 @@ pub struct Row {
     line: u64,
 }
 
+impl Row {
+    /// Its line in the file, 1-based, counting the header and comment lines.
+    pub fn line(&self) -> u64 {
+        self.line
+    }
+}
+
 /// One cell, with what it takes to say where it is.
 pub struct Cell<'a> {
     table: &'a Table,

@@ -3,10 +3,142 @@
 //! of returns the caller fixes. Every measure, pair and plot is then made as for a
 //! protocol's own runs; the final score stands where a protocol's greedy test score does
 //! (the method's kind says so: [`crate::reuse::Tested::LastEpisodes`]).
+//!
+//! [`compare_report`] scores each run under compare's [`Scoring`] and makes the report:
+//! `sapnet compare` writes its files by it, and `sapnet open` shows a compare folder by it,
+//! from the runs the folder recorded ([`crate::outside_runs::compare_folder`]), so that
+//! what the workbench shows is what the folder's CSV files hold.
 
-use super::{MethodRuns, Report, RunScores, TestScore, Units};
-use crate::reuse::MethodKind;
+use std::num::NonZeroUsize;
+
+use super::{sample_efficiency, step_axis, MethodRuns, Report, RunScores, TestScore, Units};
+use crate::config::Budget;
+use crate::outside_runs::compare_folder::{Alignment, Scoring};
+use crate::outside_runs::OutsideRun;
+use crate::reuse::{MethodKind, Tested};
+use crate::stats::episodes::TrainingEpisodes;
 use crate::stats::Scores;
+
+/// A run's episodes as compare scores them: an outside run as read, or as a compare folder
+/// recorded it.
+#[derive(Debug, Clone, Copy)]
+pub struct RunEpisodes<'a> {
+    pub episodes: &'a TrainingEpisodes,
+    /// Whether every episode's length is known (else those not given are 0): a step axis
+    /// needs each one.
+    pub lengths_known: bool,
+    /// The environment steps its file says it took by its last episode's end.
+    pub steps: Option<u64>,
+}
+
+impl<'a> RunEpisodes<'a> {
+    pub fn of(run: &'a OutsideRun) -> Self {
+        Self {
+            episodes: &run.episodes,
+            lengths_known: run.lengths_known,
+            steps: run.steps(),
+        }
+    }
+
+    /// The training return by episode: the plain mean of every episode's return, as
+    /// sapnet scores its own runs (`RunScores::of` in `report/scores.rs`: the sum of the
+    /// training returns over their count, the area under the learning curve per episode).
+    /// No moving average enters it: sapnet's window only smooths the curves and places the
+    /// episode at which a threshold was reached.
+    pub fn training_return(&self) -> f64 {
+        let returns = &self.episodes.returns;
+        // A run has at least one episode (reading refuses an empty one).
+        returns.iter().sum::<f64>() / returns.len() as f64
+    }
+
+    /// The mean return of the last `k` episodes, or of all of them if the run has fewer.
+    pub fn final_score(&self, k: NonZeroUsize) -> f64 {
+        let returns = &self.episodes.returns;
+        let last = &returns[returns.len().saturating_sub(k.get())..];
+        last.iter().sum::<f64>() / last.len() as f64
+    }
+}
+
+/// compare's alignment as the budget its curves and step scores are read under.
+pub fn budget(alignment: Alignment) -> Budget {
+    match alignment {
+        Alignment::Steps(n) => Budget::Steps(n),
+        // A compare folder's episodes are bounded far below u32::MAX.
+        Alignment::Episodes(n) => Budget::Episodes(u32::try_from(n).unwrap_or(u32::MAX)),
+    }
+}
+
+/// `budget` as compare records its alignment.
+pub fn alignment(budget: Budget) -> Alignment {
+    match budget {
+        Budget::Steps(n) => Alignment::Steps(n),
+        Budget::Episodes(n) => Alignment::Episodes(u64::from(n)),
+    }
+}
+
+/// What `run` scored under `scoring`: by episode, its mean return and the mean of its last
+/// episodes; by step (chosen only when every run's lengths are known), its step curve's
+/// area and the curve at the budget.
+pub fn score(run: RunEpisodes, scoring: &Scoring) -> ScoredRun {
+    match scoring.alignment {
+        Alignment::Episodes(_) => ScoredRun {
+            training_return: run.training_return(),
+            final_score: run.final_score(scoring.last),
+            episodes: run.episodes.len(),
+            steps: run.steps,
+        },
+        Alignment::Steps(budget) => {
+            let episodes = run.episodes;
+            let points = step_axis::points(budget, sample_efficiency::POINTS);
+            let curve = step_axis::curve(episodes, scoring.window, &points);
+            ScoredRun {
+                // Every run has an episode ended by the budget: compare and the compare
+                // folder's reader refuse a budget before one's first episode ends.
+                training_return: step_axis::area(&curve).unwrap_or(f64::NAN),
+                final_score: step_axis::curve(episodes, scoring.last.get(), &[budget])[0]
+                    .unwrap_or(f64::NAN),
+                episodes: step_axis::ended_by(episodes, budget),
+                steps: Some(budget),
+            }
+        }
+    }
+}
+
+/// Each of `count` methods from elsewhere a family of its own, its hue a golden angle from
+/// the last: methods from elsewhere are not variants of one another.
+pub fn outside_kinds(count: usize) -> Vec<MethodKind> {
+    (0..count)
+        .map(|i| MethodKind {
+            family: "Outside",
+            hue: ((i as f64 * 137.508 + 210.0) % 360.0) as u16,
+            saturation: 65,
+            reuses: false,
+            tested: Tested::LastEpisodes,
+            picks_by_probability: false,
+            spreads: false,
+        })
+        .collect()
+}
+
+/// The report of `methods` (each a name and its runs) scored under `scoring`, with what
+/// each run scored: the report `sapnet compare` writes, and the one `sapnet open` shows
+/// of the folder it wrote.
+pub fn compare_report(
+    scoring: &Scoring,
+    methods: &[(&str, Vec<RunEpisodes>)],
+) -> (Vec<ScoredMethod>, Report) {
+    let scored: Vec<ScoredMethod> = methods
+        .iter()
+        .zip(outside_kinds(methods.len()))
+        .map(|((name, runs), kind)| ScoredMethod {
+            label: name.to_string(),
+            kind,
+            runs: runs.iter().map(|&r| score(r, scoring)).collect(),
+        })
+        .collect();
+    let report = Report::of_scored(&scoring.task, scoring.range, scoring.last.get(), &scored);
+    (scored, report)
+}
 
 /// One method's runs, as scored elsewhere.
 #[derive(Debug, Clone)]
@@ -106,7 +238,24 @@ fn method_runs(method: &ScoredMethod, range: (f64, f64)) -> Option<MethodRuns> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::reuse::Tested;
+
+    #[test]
+    fn the_training_return_is_the_mean_of_every_episode_as_sapnet_scores_its_own() {
+        // sapnet's own scores test: (10 + 30 + 50 + 70 + 20 + 20) / 6 = 200 / 6.
+        let episodes = TrainingEpisodes::uniform(&[10.0, 30.0, 50.0, 70.0, 20.0, 20.0], 0);
+        let r = RunEpisodes {
+            episodes: &episodes,
+            lengths_known: false,
+            steps: None,
+        };
+        assert_eq!(r.training_return(), 200.0 / 6.0);
+        let k = |k| NonZeroUsize::new(k).unwrap();
+        // The last two: (20 + 20) / 2; the last four: (50 + 70 + 20 + 20) / 4 = 40.
+        assert_eq!(r.final_score(k(2)), 20.0);
+        assert_eq!(r.final_score(k(4)), 40.0);
+        // More than the run has: all of them.
+        assert_eq!(r.final_score(k(100)), r.training_return());
+    }
 
     fn kind() -> MethodKind {
         MethodKind {

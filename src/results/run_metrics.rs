@@ -70,11 +70,18 @@ pub struct OnFile {
     pub wall: bool,
 }
 
-/// What `runs`' files hold, from their headers: returns and lengths always; the columns
-/// of `episodes.csv` present in the first run's; a source's activation and probability
-/// where some run has `activations.csv` (`sources` in the library).
+/// What `runs`' files hold, from their headers: returns always; lengths where every run
+/// has them (a run from elsewhere may give its returns alone); the columns of
+/// `episodes.csv` present in the first run's; a source's activation and probability where
+/// some run has `activations.csv` (`sources` in the library).
 pub fn on_file(runs: &[RunFiles], sources: usize) -> OnFile {
-    let mut metrics = vec![Metric::Return, Metric::Length];
+    let mut metrics = vec![Metric::Return];
+    if runs
+        .iter()
+        .all(|r| r.training.lengths.iter().any(|&l| l > 0))
+    {
+        metrics.push(Metric::Length);
+    }
     let mut wall = false;
     let first = runs.iter().find_map(|r| r.dir.as_ref());
     if let Some(dir) = first {

@@ -104,6 +104,11 @@ pub const fn quit_keys<C: Copy>(quit: C) -> [(Key, C); 3] {
 }
 pub const QUIT_BAR: (&str, &str) = ("q", "quit");
 pub const QUIT_KEYS_SAID: &str = "q, Esc, Ctrl-C";
+/// `?`'s line for quitting a screen that only reads its folder.
+pub const QUIT_READING: (&str, &str) = (
+    QUIT_KEYS_SAID,
+    "quit (the folder is only read: nothing in it changes)",
+);
 
 /// What a key does while `?`'s overlay is up.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

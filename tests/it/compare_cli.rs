@@ -11,7 +11,7 @@ fn fixtures() -> PathBuf {
 }
 
 /// `NAME=` and the three monitor files of `algo`.
-fn method(algo: &str) -> String {
+pub fn method(algo: &str) -> String {
     let paths: Vec<String> = (0..3)
         .map(|s| {
             fixtures()
@@ -23,9 +23,27 @@ fn method(algo: &str) -> String {
     format!("{algo}={}", paths.join(","))
 }
 
+/// `sapnet compare` of DQN's and PPO's three monitor files, its other flags to come.
+pub fn dqn_and_ppo() -> std::process::Command {
+    let mut command = sapnet();
+    command.args([
+        "compare",
+        "--method",
+        &method("dqn"),
+        "--method",
+        &method("ppo"),
+    ]);
+    command
+}
+
 /// `comparison.csv`'s rows as (method, column → cell).
 fn comparison(dir: &Path) -> Vec<std::collections::HashMap<String, String>> {
-    let text = std::fs::read_to_string(dir.join("comparison.csv")).unwrap();
+    rows(&dir.join("comparison.csv"))
+}
+
+/// A CSV file's rows, each as column → cell.
+pub fn rows(path: &Path) -> Vec<std::collections::HashMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap();
     let mut reader = csv::Reader::from_reader(text.as_bytes());
     let header: Vec<String> = reader.headers().unwrap().iter().map(String::from).collect();
     reader
@@ -44,14 +62,7 @@ fn comparison(dir: &Path) -> Vec<std::collections::HashMap<String, String>> {
 fn sb3_monitor_files_give_rliables_intervals() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("compared");
-    let output = sapnet()
-        .args([
-            "compare",
-            "--method",
-            &method("dqn"),
-            "--method",
-            &method("ppo"),
-        ])
+    let output = dqn_and_ppo()
         .args([
             "--range",
             "0",
@@ -132,14 +143,7 @@ fn sb3_monitor_files_give_rliables_intervals() {
 fn monitor_files_of_different_episode_counts_are_aligned_by_step() {
     let tmp = tempfile::tempdir().unwrap();
     let compare = |out: &Path, extra: &[&str]| {
-        let output = sapnet()
-            .args([
-                "compare",
-                "--method",
-                &method("dqn"),
-                "--method",
-                &method("ppo"),
-            ])
+        let output = dqn_and_ppo()
             .args(["--range", "0", "500", "--last", "20"])
             .args(extra)
             .arg("--out")
@@ -193,18 +197,7 @@ fn monitor_files_of_different_episode_counts_are_aligned_by_step() {
 fn without_a_range_the_bounds_come_from_the_data_with_a_warning() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("compared");
-    let output = sapnet()
-        .args([
-            "compare",
-            "--method",
-            &method("dqn"),
-            "--method",
-            &method("ppo"),
-        ])
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let output = dqn_and_ppo().arg("--out").arg(&out).output().unwrap();
     assert!(output.status.success(), "{}", stderr(&output));
     assert!(
         stderr(&output).contains("warning: no --range"),

@@ -27,11 +27,12 @@ use sapnet::tui::event_loop::Flow;
 use sapnet::tui::keys::{ch, code, ctrl, Binding, Key};
 use sapnet::tui::theme::Theme;
 use sapnet::tui::view::View;
+use sapnet::tui::workbench::screens::compared::CompareScreen;
 use sapnet::tui::workbench::screens::folders::{FoldersScreen, FOLDERS_KEYS};
 use sapnet::tui::workbench::screens::opened::Opened;
 use sapnet::tui::workbench::screens::session::{overlays, Phase, Request, Session};
 use sapnet::tui::workbench::screens::sweep::{SweepScreen, SWEEP_KEYS};
-use sapnet::tui::workbench::screens::workbench::{OPEN_KEYS, SESSION_KEYS};
+use sapnet::tui::workbench::screens::workbench::{COMPARE_KEYS, OPEN_KEYS, SESSION_KEYS};
 use sapnet::tui::workbench::sweep_folder::{CellRow, CellStatus, SweepState};
 use sapnet::tui::workbench::views::comparison::ComparisonView;
 use sapnet::tui::workbench::views::curves::CurvesView;
@@ -60,16 +61,30 @@ fn draw(draw: impl FnOnce(&mut ratatui::Frame)) -> Buffer {
     terminal.backend().buffer().clone()
 }
 
+/// Drawn once the Curves view's curves are made (in the background).
+fn drawn_with_curves(screen: impl Fn(&mut ratatui::Frame), curves: &CurvesView) -> Buffer {
+    draw(&screen);
+    curves.settle();
+    draw(&screen)
+}
+
 impl Walked for Opened {
     fn press(&mut self, key: KeyEvent) -> bool {
         self.on_key(key) == Flow::Quit
     }
 
-    /// Drawn once the Curves view's curves are made (in the background).
     fn drawn(&self) -> Buffer {
-        draw(|f| self.draw(f, Theme::plain()));
-        self.workbench.curves.settle();
-        draw(|f| self.draw(f, Theme::plain()))
+        drawn_with_curves(|f| self.draw(f, Theme::plain()), &self.workbench.curves)
+    }
+}
+
+impl Walked for CompareScreen {
+    fn press(&mut self, key: KeyEvent) -> bool {
+        self.on_key(key) == Flow::Quit
+    }
+
+    fn drawn(&self) -> Buffer {
+        drawn_with_curves(|f| self.draw(f, Theme::plain()), &self.workbench.curves)
     }
 }
 
@@ -364,6 +379,56 @@ fn every_key_listed_acts_and_every_key_acting_is_listed() {
         acting: &["", "jj", "c"],
         resting: &[""],
     });
+}
+
+/// A view walked: its name, the keys that show it, its own keys, its acting and resting
+/// states.
+type ViewCase<'a> = (&'a str, &'a str, Vec<Key>, &'a [&'a str], &'a [&'a str]);
+
+/// A compare folder's Comparison and Curves on `sapnet open`'s screen: its keys are the
+/// two views' and the screen's, none of a protocol's (Runs, Run, `R`).
+#[test]
+fn every_compare_key_listed_acts_and_every_key_acting_is_listed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("compared");
+    crate::open_compare::by_step(&out);
+    let open = |tab: &str| {
+        let mut screen = CompareScreen::start(&out).unwrap();
+        screen.settle();
+        for key in keys(tab) {
+            screen.on_key(key);
+        }
+        screen
+    };
+    let (comparison, curves) = (ComparisonView::default(), CurvesView::default());
+    apart("Comparison", comparison.keys(), COMPARE_KEYS);
+    apart("Curves", curves.keys(), COMPARE_KEYS);
+    // Each view's keys and states: the Curves' as on a protocol's folder.
+    let views: [ViewCase; 2] = [
+        (
+            "compare: Comparison",
+            "",
+            listed(&[comparison.keys()]),
+            &["", "j", "v"],
+            &["", "j"],
+        ),
+        (
+            "compare: Curves",
+            "v",
+            listed(&[curves.keys()]),
+            &["", "+", "\n", "\n]", "j", "c"],
+            &["", "\n"],
+        ),
+    ];
+    for (name, tab, own, acting, resting) in views {
+        walk(&Case {
+            name,
+            make: &|| open(tab),
+            listed: own.into_iter().chain(listed(&[COMPARE_KEYS])).collect(),
+            acting,
+            resting,
+        });
+    }
 }
 
 /// The Sweep view, on a sweep of three cells, none done: the arrows move among the cells.

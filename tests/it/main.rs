@@ -28,6 +28,7 @@ mod judgment_signals;
 mod key_tables;
 mod layers;
 mod method_behaviour;
+mod open_compare;
 mod open_parent;
 mod other_agents;
 mod pinned_numbers;

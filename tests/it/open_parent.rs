@@ -22,7 +22,8 @@ use crate::common::cli::{configs, sapnet, stderr};
 const SIZES: [(u16, u16); 2] = [(120, 40), (80, 24)];
 
 /// A parent of three folders sapnet wrote, at different depths — a finished protocol
-/// (two DQNs, three runs each), a stopped copy of it, a compare folder — beside a link to
+/// (two DQNs, three runs each), a stopped copy of it, a compare folder as an older compare
+/// wrote it (its report only, no record of its runs) — beside a link to
 /// the first (not listed) and a folder sapnet did not write.
 pub fn parent(tmp: &Path) -> PathBuf {
     let parent = tmp.join("logs");
@@ -169,7 +170,7 @@ fn a_parent_lists_its_folders_filters_them_and_opens_one() {
     screen.on_key(key(KeyCode::Esc));
     assert_eq!(screen.view.shown(&screen.list).len(), 3);
 
-    // The compare folder says what it holds, and stays on the list.
+    // The older compare folder says what makes it openable, and stays on the list.
     screen.on_key(key(KeyCode::Enter));
     assert!(!screen.is_inside());
     assert!(
@@ -199,7 +200,7 @@ fn a_parent_lists_its_folders_filters_them_and_opens_one() {
 }
 
 /// Refused before a terminal is taken, saying what `open` reads: a folder under which
-/// sapnet wrote nothing, and a compare folder.
+/// sapnet wrote nothing, and a compare folder of an older compare.
 #[test]
 fn open_says_what_it_cannot_show() {
     let tmp = tempfile::tempdir().unwrap();

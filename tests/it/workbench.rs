@@ -421,9 +421,9 @@ fn open_refuses_a_bad_file_naming_it_before_the_screen_opens() {
     }
 }
 
-/// `sample_efficiency.csv`'s rows of `method` and `statistic`, as (episode, runs, value,
-/// lo, hi), the numbers as the file writes them.
-fn efficiency_rows(
+/// `sample_efficiency.csv`'s rows of `method` and `statistic`, as (episode or step, runs,
+/// value, lo, hi), the numbers as the file writes them.
+pub fn efficiency_rows(
     out: &Path,
     method: &str,
     statistic: &str,
@@ -438,6 +438,25 @@ fn efficiency_rows(
                 r[1].to_string(),
                 r[2].to_string(),
                 [r[4].to_string(), r[5].to_string(), r[6].to_string()],
+            )
+        })
+        .collect()
+}
+
+/// A curve's points of one statistic (`of`) as `sample_efficiency.csv` writes them: (at,
+/// runs, [value, lo, hi]).
+pub fn as_written(
+    points: &[sapnet::report::metric::CurvePoint],
+    of: fn(&sapnet::report::metric::CurvePoint) -> sapnet::stats::Estimate,
+) -> Vec<(String, String, [String; 3])> {
+    points
+        .iter()
+        .map(|p| {
+            let e = of(p);
+            (
+                p.at.to_string(),
+                p.runs.to_string(),
+                [e.point, e.lo, e.hi].map(|x| format!("{x:?}")),
             )
         })
         .collect()
@@ -458,10 +477,7 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
     workbench.workbench.curves.axis = Some(sapnet::report::metric::XAxis::Episode);
     let labels = ["dqn[16]", "dqn[8]"];
     for (index, label) in labels.iter().enumerate() {
-        let points = workbench
-            .workbench
-            .curves
-            .curve(&workbench.folder().state, index);
+        let points = workbench.workbench.curves.curve(workbench.folder(), index);
         for (statistic, of) in [
             (
                 "iqm",
@@ -472,18 +488,7 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
             let rows = efficiency_rows(&out, label, statistic);
             // Episodes 10 to 30 of MA10: 21 points.
             assert_eq!(rows.len(), 21, "{label} {statistic}");
-            let drawn: Vec<(String, String, [String; 3])> = points
-                .iter()
-                .map(|p| {
-                    let e = of(p);
-                    (
-                        p.at.to_string(),
-                        p.runs.to_string(),
-                        [e.point, e.lo, e.hi].map(|x| format!("{x:?}")),
-                    )
-                })
-                .collect();
-            assert_eq!(drawn, rows, "{label} {statistic}");
+            assert_eq!(as_written(&points, of), rows, "{label} {statistic}");
         }
     }
     let legend_value = |workbench: &Opened, label: &str| -> String {
@@ -518,7 +523,7 @@ fn the_curves_view_shows_the_points_of_sample_efficiency_csv() {
     // shown is episode 26's.
     workbench.on_key(key('m'));
     workbench.on_key(key('+'));
-    let (from, to) = workbench.workbench.curves.range(&workbench.folder().state);
+    let (from, to) = workbench.workbench.curves.range(workbench.folder());
     assert_eq!((from, to), (6.0, 26.0));
     let drawn = text(&screen(&workbench, (120, 40)));
     assert!(drawn.contains("ep 6–26 of 30"), "{drawn}");
@@ -545,10 +550,7 @@ fn the_curves_are_drawn_in_each_methods_colour_or_marker() {
     finished_folder(&out);
     let workbench = workbench(&out, "v");
     // The curves made first (in the background, a moment after the view opens).
-    workbench
-        .workbench
-        .curves
-        .made_now(&workbench.folder().state);
+    workbench.workbench.curves.made_now(workbench.folder());
     let kinds: Vec<_> = workbench
         .folder()
         .state

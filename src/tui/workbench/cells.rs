@@ -45,10 +45,9 @@ pub fn method_kinds(folder: &FolderState) -> Vec<crate::reuse::MethodKind> {
         .collect()
 }
 
-/// The style of each method of the protocol, in its order: its family's hue, members
-/// of a family in turn a shade apart ([`Theme::method`]).
-pub fn method_styles(folder: &FolderState, theme: Theme) -> Vec<Style> {
-    let kinds = method_kinds(folder);
+/// The style of each method of `kinds`, in its order: its family's hue, members of a
+/// family in turn a shade apart ([`Theme::method`]).
+pub fn method_styles(kinds: &[crate::reuse::MethodKind], theme: Theme) -> Vec<Style> {
     kinds
         .iter()
         .enumerate()

@@ -16,9 +16,11 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 
+use crate::config::Budget;
 use crate::report::Report;
 use crate::results::folder_changes;
-use crate::results::folder_state::{FolderReader, FolderState, RunStatus};
+use crate::results::folder_state::{FolderReader, FolderState, RunProgress, RunStatus};
+use crate::results::run_metrics::{self, RunFiles};
 use crate::results::Status;
 use crate::trainer::MethodId;
 use crate::tui::follow;
@@ -61,10 +63,84 @@ impl Folder {
         }
         self.read_error = None;
     }
+}
 
-    /// The protocol's methods, as many as the Comparison view lists.
-    pub fn methods(&self) -> usize {
-        self.state.config.protocol.methods.len()
+/// What the Comparison and Curves views read of the folder shown: its methods, its runs
+/// with their episodes, the report of the finished ones. A protocol's results folder
+/// ([`Folder`]) and a `sapnet compare` folder
+/// ([`super::compare_folder::CompareFolder`]) both are one; where they differ (a protocol
+/// plans its runs and their budget, compare chose how its runs were set side by side),
+/// each says its own.
+pub trait Compared {
+    /// The folder, which the views keep what they read of it by.
+    fn dir(&self) -> &Path;
+    /// Its methods, in its order.
+    fn methods(&self) -> Vec<MethodId>;
+    /// The runs method `index` is given (a protocol's plan) or has (compare's).
+    fn planned_runs(&self, index: usize) -> usize;
+    /// Every run, method by method, with its episodes so far.
+    fn runs(&self) -> &[RunProgress];
+    /// Where each run with episodes has its per-episode metrics.
+    fn run_files(&self) -> Vec<RunFiles>;
+    /// The library's sources, as the activation metrics name them.
+    fn sources(&self) -> Vec<String>;
+    /// The budget the runs are read against: `sample_efficiency.csv`'s axis and extent.
+    fn budget(&self) -> Budget;
+    /// The curves' moving average, in episodes.
+    fn window(&self) -> usize;
+    /// The report of the finished runs; `None` until there is one.
+    fn report(&self) -> Option<&Report>;
+    /// Whether a newer report is being made (the one shown is older, or none).
+    fn computing(&self) -> bool;
+
+    /// Runs finished to their end.
+    fn finished_runs(&self) -> usize {
+        self.runs()
+            .iter()
+            .filter(|r| r.status == RunStatus::Done)
+            .count()
+    }
+}
+
+impl Compared for Folder {
+    fn dir(&self) -> &Path {
+        &self.state.dir
+    }
+
+    fn methods(&self) -> Vec<MethodId> {
+        MethodId::all(&self.state.config.protocol.methods)
+    }
+
+    fn planned_runs(&self, _: usize) -> usize {
+        self.state.config.protocol.runs as usize
+    }
+
+    fn runs(&self) -> &[RunProgress] {
+        &self.state.runs
+    }
+
+    fn run_files(&self) -> Vec<RunFiles> {
+        run_metrics::run_files(&self.state)
+    }
+
+    fn sources(&self) -> Vec<String> {
+        self.state.library.iter().map(|e| e.name.clone()).collect()
+    }
+
+    fn budget(&self) -> Budget {
+        self.state.config.protocol.budget
+    }
+
+    fn window(&self) -> usize {
+        self.state.config.protocol.moving_average
+    }
+
+    fn report(&self) -> Option<&Report> {
+        self.report.as_ref()
+    }
+
+    fn computing(&self) -> bool {
+        self.computing
     }
 }
 

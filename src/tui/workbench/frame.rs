@@ -20,7 +20,10 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Clear, Paragraph};
 use ratatui::Frame;
 
-use super::folder::Folder;
+use std::path::Path;
+
+use super::compare_folder::CompareFolder;
+use super::folder::{Compared, Folder};
 use crate::results::folder_state::FolderState;
 use crate::results::Status;
 use crate::tui::keys::{HELP_BAR, QUIT_BAR};
@@ -147,10 +150,65 @@ pub fn folder_line(model: &Folder, theme: Theme, width: usize) -> Line<'static> 
         " · {}",
         super::cells::runs_finished(folder.finished_runs(), folder.runs.len())
     );
-    let mut dir = folder.dir.display().to_string();
-    let mut task = format!("· {} · ", folder.task());
+    let state_style = if folder.writer.is_some() {
+        theme.active()
+    } else {
+        Style::new()
+    };
+    let mut spans = heading(
+        (&folder.dir, &folder.task()),
+        ((state, state_style), progress),
+        theme,
+        width,
+    );
+    if let Some(error) = &model.read_error {
+        spans.push(Span::styled(
+            format!(" · re-reading failed, showing the last read: {error}"),
+            theme.stopped(),
+        ));
+    } else if let Some(error) = &folder.error {
+        spans.push(Span::styled(format!(" · {error}"), theme.stopped()));
+    }
+    Line::from(spans)
+}
+
+/// A compare folder, its task, how its runs were set side by side and how many there
+/// are, fitted as [`folder_line`] is.
+pub fn compare_line(compare: &CompareFolder, theme: Theme, width: usize) -> Line<'static> {
+    let methods = compare.methods().len();
+    let runs = compare.runs().len();
+    let progress = format!(
+        " · {} of {}",
+        super::cells::counted(runs, "run"),
+        super::cells::counted(methods, "method")
+    );
+    // The task is compare's `--task`, any text: shown as data.
+    let task = crate::shown_text::cut(&compare.scoring.task, 40);
+    Line::from(heading(
+        (&compare.dir, &task),
+        ((compare.alignment_text(), Style::new()), progress),
+        theme,
+        width,
+    ))
+}
+
+/// The header's spans: the folder, its task, where it stands, how far. On a narrow
+/// terminal the task goes first, then the folder's path is cut from its start, so that
+/// where it stands and how far always show.
+fn heading(
+    (dir, task): (&Path, &str),
+    ((state, state_style), progress): ((String, Style), String),
+    theme: Theme,
+    width: usize,
+) -> Vec<Span<'static>> {
+    let mut dir = dir.display().to_string();
+    let mut task = format!("· {task} · ");
     let used = |dir: &str, task: &str| {
-        dir.chars().count() + 2 + task.chars().count() + state.chars().count() + progress.len()
+        dir.chars().count()
+            + 2
+            + task.chars().count()
+            + state.chars().count()
+            + progress.chars().count()
     };
     if used(&dir, &task) > width {
         task = "· ".into();
@@ -161,28 +219,12 @@ pub fn folder_line(model: &Folder, theme: Theme, width: usize) -> Line<'static> 
         let tail: String = dir.chars().skip(dir.chars().count() - keep).collect();
         dir = format!("…{tail}");
     }
-    let mut spans = vec![
+    vec![
         Span::styled(format!(" {dir} "), theme.title()),
         Span::raw(task),
-        Span::styled(
-            state,
-            if folder.writer.is_some() {
-                theme.active()
-            } else {
-                Style::new()
-            },
-        ),
+        Span::styled(state, state_style),
         Span::raw(progress),
-    ];
-    if let Some(error) = &model.read_error {
-        spans.push(Span::styled(
-            format!(" · re-reading failed, showing the last read: {error}"),
-            theme.stopped(),
-        ));
-    } else if let Some(error) = &folder.error {
-        spans.push(Span::styled(format!(" · {error}"), theme.stopped()));
-    }
-    Line::from(spans)
+    ]
 }
 
 /// Below this width the bar names the shown tab only, the others by their keys, so

@@ -2,7 +2,8 @@
 //! Folders view lists what is under it ([`crate::results::found`]: found before the
 //! terminal is taken, never through a link), and Enter opens the one picked on the same
 //! terminal — a results folder in the workbench's views ([`super::opened`], `R` included),
-//! a sweep in the Sweep view ([`super::sweep`]); Esc there comes back to the list.
+//! a sweep in the Sweep view ([`super::sweep`]), a compare folder in its Comparison and
+//! Curves ([`super::compared`]); Esc there comes back to the list.
 
 use std::path::Path;
 
@@ -12,6 +13,7 @@ use ratatui::layout::Rect;
 use ratatui::text::{Line, Span};
 use ratatui::Frame;
 
+use super::compared::CompareScreen;
 use super::opened::{self, OpenScreen};
 use super::session::live::{Ended, Settings};
 use super::sweep;
@@ -55,6 +57,7 @@ pub const FOLDERS_KEYS: &[Binding<FoldersScreenCommand>] = &[
 enum Inside<'a> {
     Results(Box<OpenScreen<'a>>),
     Sweep(sweep::Running),
+    Compare(Box<CompareScreen>),
 }
 
 /// The list, or the folder opened from it.
@@ -100,15 +103,7 @@ impl<'a> FoldersScreen<'a> {
                 OpenScreen::start(&dir, self.settings).map(|s| Inside::Results(Box::new(s)))
             }
             Kind::Sweep => sweep::Running::start(&dir).map(Inside::Sweep),
-            Kind::Compare => {
-                self.notice = Some(format!(
-                    "{} is a `sapnet compare` folder: its views are not in the workbench \
-                     yet; its table is comparison.csv (as compare printed it), its plots the \
-                     .png files beside it",
-                    dir.display()
-                ));
-                return;
-            }
+            Kind::Compare => CompareScreen::start(&dir).map(|s| Inside::Compare(Box::new(s))),
         };
         match inside {
             Ok(inside) => self.inside = Some(inside),
@@ -129,6 +124,7 @@ impl<'a> FoldersScreen<'a> {
                     flow
                 }
                 Inside::Sweep(screen) => screen.on_key(key),
+                Inside::Compare(screen) => screen.on_key(key),
             };
             // Esc, where the folder's screen would quit, comes back to the list.
             if flow == Flow::Quit && esc {
@@ -169,6 +165,7 @@ impl<'a> FoldersScreen<'a> {
         match &self.inside {
             Some(Inside::Results(screen)) => return screen.draw(frame),
             Some(Inside::Sweep(screen)) => return screen.draw(frame),
+            Some(Inside::Compare(screen)) => return screen.draw(frame, theme),
             None => {}
         }
         let help = self.help.then(|| {
@@ -204,6 +201,7 @@ impl Screen for FoldersScreen<'_> {
         match &mut self.inside {
             Some(Inside::Results(screen)) => screen.drain(),
             Some(Inside::Sweep(screen)) => screen.drain(),
+            Some(Inside::Compare(screen)) => screen.drain(),
             None => (false, Flow::Continue),
         }
     }
@@ -220,6 +218,7 @@ impl Screen for FoldersScreen<'_> {
         match &mut self.inside {
             Some(Inside::Results(inside)) => inside.on_mouse(mouse, screen),
             Some(Inside::Sweep(inside)) => inside.on_mouse(mouse, screen),
+            Some(Inside::Compare(inside)) => inside.on_mouse(mouse, screen),
             None => {
                 if !self.help {
                     let body = frame::body_area(screen, false);

@@ -6,9 +6,11 @@
 //! - [`opened`]: `sapnet open DIR`;
 //! - [`session`]: `sapnet` (a protocol trained in the UI: stop, launch, resume);
 //! - [`sweep`]: `sapnet open SWEEP`;
+//! - [`compared`]: `sapnet open COMPARE`, a `sapnet compare` folder;
 //! - [`folders`]: `sapnet open PARENT`, the folders under it, each opened on one of the
 //!   screens above.
 
+pub mod compared;
 pub mod folders;
 pub mod opened;
 pub mod session;

@@ -37,10 +37,7 @@ pub const SWEEP_KEYS: &[Binding<SweepScreenCommand>] = &[
     },
     Binding {
         keys: &QUIT_KEYS,
-        help: (
-            keys::QUIT_KEYS_SAID,
-            "quit (the folder is only read: nothing in it changes)",
-        ),
+        help: keys::QUIT_READING,
         bar: Some(keys::QUIT_BAR),
     },
 ];

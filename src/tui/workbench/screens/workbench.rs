@@ -1,8 +1,10 @@
 //! The workbench of a results folder, which `sapnet open DIR` ([`super::opened`]) and a
 //! protocol run in the UI ([`super::session`]) both are: the folder's views and the Run
-//! view a tab apart, in one frame ([`crate::tui::workbench::frame`]). It routes keys and
-//! clicks — `?`'s overlay, then the view shown (its table), then the screen's table (the
-//! tabs, `?`, quitting, a protocol's controls) — and hands the screen what is its own.
+//! view a tab apart, in one frame ([`crate::tui::workbench::frame`]); and of a `sapnet
+//! compare` folder ([`super::compared`]), its Comparison and Curves only. It routes keys
+//! and clicks — `?`'s overlay, then the view shown (its table), then the screen's table
+//! (the tabs, `?`, quitting, a protocol's controls) — and hands the screen what is its
+//! own. The tabs are the screen's table's: a view it lists no key for is never shown.
 
 use std::convert::Infallible;
 
@@ -18,7 +20,8 @@ use crate::results::folder_state::{FolderState, RunStatus};
 use crate::tui::keys::{self, ch, Binding, OnHelp};
 use crate::tui::theme::Theme;
 use crate::tui::view::{Outcome, View};
-use crate::tui::workbench::folder::Folder;
+use crate::tui::workbench::compare_folder::CompareFolder;
+use crate::tui::workbench::folder::{Compared, Folder};
 use crate::tui::workbench::frame::{self, Chrome};
 use crate::tui::workbench::recorded;
 use crate::tui::workbench::views::comparison::ComparisonView;
@@ -117,6 +120,30 @@ pub const OPEN_KEYS: &[Binding<ScreenCommand>] = &[
     },
 ];
 
+/// A compare folder's keys: its Comparison and Curves, the runs being other tools' (no
+/// Runs view, no run's dashboard, nothing to resume).
+pub const COMPARE_KEYS: &[Binding<ScreenCommand>] = &[
+    Binding {
+        keys: &[
+            (ch('c'), S::Show(Tab::Comparison)),
+            (ch('v'), S::Show(Tab::Curves)),
+            (ch('1'), S::Show(Tab::Comparison)),
+            (ch('2'), S::Show(Tab::Curves)),
+        ],
+        help: (
+            "c v, 1 2",
+            "the Comparison and Curves views (runs from elsewhere have no dashboard)",
+        ),
+        bar: None,
+    },
+    HELP,
+    Binding {
+        keys: &QUIT_KEYS,
+        help: keys::QUIT_READING,
+        bar: Some(keys::QUIT_BAR),
+    },
+];
+
 /// A protocol's session's keys: its controls too.
 pub const SESSION_KEYS: &[Binding<ScreenCommand>] = &[
     TABS,
@@ -161,8 +188,10 @@ pub struct Host {
 /// A results folder's views and the Run view, with what is over them.
 pub struct Workbench {
     /// The folder as last read; `None` before a protocol started here wrote its
-    /// summary.json.
+    /// summary.json, and on a compare folder.
     pub folder: Option<Folder>,
+    /// The compare folder shown, in the Comparison and Curves views only.
+    pub compare: Option<CompareFolder>,
     /// Why the folder cannot be read yet.
     pub unread: Option<String>,
     pub tab: Tab,
@@ -180,6 +209,7 @@ impl Workbench {
     pub fn new(folder: Option<Folder>, run: RunView, tab: Tab) -> Self {
         Self {
             folder,
+            compare: None,
             unread: None,
             tab,
             runs: RunsView::default(),
@@ -189,6 +219,14 @@ impl Workbench {
             help: false,
             notice: None,
         }
+    }
+
+    /// The workbench on a compare folder, its Comparison shown.
+    pub fn of_compare(compare: CompareFolder) -> Self {
+        let run = RunView::new(&compare.scoring.task, None);
+        let mut workbench = Self::new(None, run, Tab::Comparison);
+        workbench.compare = Some(compare);
+        workbench
     }
 
     /// A new read of the folder, as [`Folder::refreshed`] takes it.
@@ -242,17 +280,13 @@ impl Workbench {
     }
 
     fn view_key(&mut self, key: &KeyEvent) -> Outcome<Intent> {
-        let Some(folder) = &self.folder else {
-            return match self.tab {
-                Tab::Run => lift(self.run.on_key(&(), key)),
-                _ => Outcome::Ignored,
-            };
-        };
-        match self.tab {
-            Tab::Runs => self.runs.on_key(folder, key),
-            Tab::Comparison => self.comparison.on_key(folder, key),
-            Tab::Curves => self.curves.on_key(folder, key),
-            Tab::Run => lift(self.run.on_key(&(), key)),
+        let compared = compared(&self.folder, &self.compare);
+        match (self.tab, &self.folder, compared) {
+            (Tab::Run, _, _) => lift(self.run.on_key(&(), key)),
+            (Tab::Runs, Some(folder), _) => self.runs.on_key(folder, key),
+            (Tab::Comparison, _, Some(shown)) => self.comparison.on_key(shown, key),
+            (Tab::Curves, _, Some(shown)) => self.curves.on_key(shown, key),
+            _ => Outcome::Ignored,
         }
     }
 
@@ -326,12 +360,13 @@ impl Workbench {
             return true;
         }
         let body = frame::body_area(screen, over_the_top);
-        let outcome = match (self.tab, &self.folder) {
-            (Tab::Run, _) => lift(self.run.on_mouse(&(), mouse, body)),
-            (_, None) => Outcome::Ignored,
-            (Tab::Runs, Some(folder)) => self.runs.on_mouse(folder, mouse, body),
-            (Tab::Comparison, Some(folder)) => self.comparison.on_mouse(folder, mouse, body),
-            (Tab::Curves, Some(folder)) => self.curves.on_mouse(folder, mouse, body),
+        let compared = compared(&self.folder, &self.compare);
+        let outcome = match (self.tab, &self.folder, compared) {
+            (Tab::Run, _, _) => lift(self.run.on_mouse(&(), mouse, body)),
+            (Tab::Runs, Some(folder), _) => self.runs.on_mouse(folder, mouse, body),
+            (Tab::Comparison, _, Some(shown)) => self.comparison.on_mouse(shown, mouse, body),
+            (Tab::Curves, _, Some(shown)) => self.curves.on_mouse(shown, mouse, body),
+            _ => Outcome::Ignored,
         };
         let changed = outcome != Outcome::Ignored;
         self.done(outcome);
@@ -352,15 +387,18 @@ impl Workbench {
         if let Some(lines) = self.run_in_mode() {
             return lines;
         }
-        let (own, legend) = match (self.tab, &self.folder) {
-            (Tab::Run, _) => (keys::help_lines(self.run.keys()), self.run.legend(&())),
-            (_, None) => (Vec::new(), Vec::new()),
-            (Tab::Runs, Some(f)) => (keys::help_lines(self.runs.keys()), self.runs.legend(f)),
-            (Tab::Comparison, Some(f)) => (
+        let compared = compared(&self.folder, &self.compare);
+        let (own, legend) = match (self.tab, &self.folder, compared) {
+            (Tab::Run, _, _) => (keys::help_lines(self.run.keys()), self.run.legend(&())),
+            (Tab::Runs, Some(f), _) => (keys::help_lines(self.runs.keys()), self.runs.legend(f)),
+            (Tab::Comparison, _, Some(f)) => (
                 keys::help_lines(self.comparison.keys()),
                 self.comparison.legend(f),
             ),
-            (Tab::Curves, Some(f)) => (keys::help_lines(self.curves.keys()), self.curves.legend(f)),
+            (Tab::Curves, _, Some(f)) => {
+                (keys::help_lines(self.curves.keys()), self.curves.legend(f))
+            }
+            _ => (Vec::new(), Vec::new()),
         };
         let mut lines = own;
         lines.extend(keys::help_lines(keys));
@@ -382,12 +420,13 @@ impl Workbench {
             .iter()
             .filter_map(|&c| keys::binding(host.keys, c)?.bar)
             .collect();
-        commands.extend(match (self.tab, &self.folder) {
-            (Tab::Run, _) => self.run.bar(&()),
-            (_, None) => Vec::new(),
-            (Tab::Runs, Some(folder)) => self.runs.bar(folder),
-            (Tab::Comparison, Some(folder)) => self.comparison.bar(folder),
-            (Tab::Curves, Some(folder)) => self.curves.bar(folder),
+        let compared = compared(&self.folder, &self.compare);
+        commands.extend(match (self.tab, &self.folder, compared) {
+            (Tab::Run, _, _) => self.run.bar(&()),
+            (Tab::Runs, Some(folder), _) => self.runs.bar(folder),
+            (Tab::Comparison, _, Some(shown)) => self.comparison.bar(shown),
+            (Tab::Curves, _, Some(shown)) => self.curves.bar(shown),
+            _ => Vec::new(),
         });
         commands
     }
@@ -405,10 +444,11 @@ impl Workbench {
         let free = self.run_in_mode().is_none();
         let width = usize::from(frame.area().width);
         let chrome = Chrome {
-            header: match (over_the_top, &self.folder) {
-                (true, _) => self.run_line(host, theme),
-                (false, Some(folder)) => frame::folder_line(folder, theme, width),
-                (false, None) => Line::from(vec![
+            header: match (over_the_top, &self.folder, &self.compare) {
+                (true, _, _) => self.run_line(host, theme),
+                (false, Some(folder), _) => frame::folder_line(folder, theme, width),
+                (false, None, Some(compare)) => frame::compare_line(compare, theme, width),
+                (false, None, None) => Line::from(vec![
                     Span::styled(format!(" {} ", host.dir), theme.title()),
                     Span::raw(format!("· {}", host.state)),
                 ]),
@@ -427,12 +467,13 @@ impl Workbench {
             help: self.help.then(|| self.help_lines(host.keys)),
             notice: self.notice.as_deref(),
         };
-        let body = |frame: &mut Frame, area: Rect| match (self.tab, &self.folder) {
-            (Tab::Run, _) => self.run.draw(&(), frame, area, theme),
-            (_, None) => self.draw_waiting(frame, area, host, theme),
-            (Tab::Runs, Some(folder)) => self.runs.draw(folder, frame, area, theme),
-            (Tab::Comparison, Some(folder)) => self.comparison.draw(folder, frame, area, theme),
-            (Tab::Curves, Some(folder)) => self.curves.draw(folder, frame, area, theme),
+        let compared = compared(&self.folder, &self.compare);
+        let body = |frame: &mut Frame, area: Rect| match (self.tab, &self.folder, compared) {
+            (Tab::Run, _, _) => self.run.draw(&(), frame, area, theme),
+            (Tab::Runs, Some(folder), _) => self.runs.draw(folder, frame, area, theme),
+            (Tab::Comparison, _, Some(shown)) => self.comparison.draw(shown, frame, area, theme),
+            (Tab::Curves, _, Some(shown)) => self.curves.draw(shown, frame, area, theme),
+            _ => self.draw_waiting(frame, area, host, theme),
         };
         frame::draw(frame, &chrome, theme, body, overlay);
     }
@@ -483,6 +524,19 @@ impl Workbench {
             lines.push(Line::from(Span::styled(error.clone(), theme.dim())));
         }
         frame.render_widget(Paragraph::new(lines).wrap(Wrap { trim: true }), area);
+    }
+}
+
+/// What the Comparison and Curves views show: the results folder, else the compare
+/// folder (fields apart, so that a view may be borrowed beside it).
+fn compared<'a>(
+    folder: &'a Option<Folder>,
+    compare: &'a Option<CompareFolder>,
+) -> Option<&'a (dyn Compared + 'static)> {
+    match (folder, compare) {
+        (Some(folder), _) => Some(folder),
+        (None, Some(compare)) => Some(compare),
+        (None, None) => None,
     }
 }
 

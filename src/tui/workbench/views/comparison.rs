@@ -25,7 +25,7 @@ use crate::tui::row_window::RowWindow;
 use crate::tui::theme::Theme;
 use crate::tui::view::{Outcome, View};
 use crate::tui::workbench::cells::{counted, fit, inner, method_styles, runs_finished};
-use crate::tui::workbench::folder::Folder;
+use crate::tui::workbench::folder::Compared;
 
 /// Which aggregate over runs the Comparison view shows, as `comparison.csv` names them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -202,20 +202,19 @@ impl Default for ComparisonView {
 
 impl ComparisonView {
     /// Keeps the cursor on a method of a folder read again.
-    pub fn refreshed(&mut self, folder: &Folder) {
-        self.cursor = self.cursor.min(folder.methods().saturating_sub(1));
+    pub fn refreshed(&mut self, folder: &dyn Compared) {
+        self.cursor = self.cursor.min(folder.methods().len().saturating_sub(1));
     }
 
     /// The methods, by their place in the protocol, in the order the table lists them:
     /// sorted by the view's column and direction, a method without a value last either
     /// way, ties in the protocol's order.
-    pub fn order(&self, model: &Folder) -> Vec<usize> {
+    pub fn order(&self, model: &dyn Compared) -> Vec<usize> {
         let labels = labels(model);
         let mut order: Vec<usize> = (0..labels.len()).collect();
         let row = |i: usize| {
             model
-                .report
-                .as_ref()
+                .report()
                 .and_then(|r| r.comparison.iter().find(|c| c.method == labels[i]))
         };
         let value = |i: usize| -> Option<f64> {
@@ -255,20 +254,17 @@ impl ComparisonView {
     }
 }
 
-/// The protocol's methods' labels, in its order.
-fn labels(model: &Folder) -> Vec<String> {
+/// The folder's methods' labels, in its order.
+fn labels(model: &dyn Compared) -> Vec<String> {
     model
-        .state
-        .config
-        .protocol
-        .methods
+        .methods()
         .iter()
-        .map(|m| m.label())
+        .map(|m| m.label().to_string())
         .collect()
 }
 
 impl View for ComparisonView {
-    type Model = Folder;
+    type Model = dyn Compared;
     type Command = ComparisonCommand;
     type Intent = Intent;
 
@@ -276,7 +272,7 @@ impl View for ComparisonView {
         KEYS
     }
 
-    fn apply(&mut self, folder: &Folder, command: ComparisonCommand) -> Outcome<Intent> {
+    fn apply(&mut self, folder: &dyn Compared, command: ComparisonCommand) -> Outcome<Intent> {
         match command {
             ComparisonCommand::Move(by) => {
                 // Along the table's order, not the protocol's.
@@ -302,18 +298,23 @@ impl View for ComparisonView {
         Outcome::Done
     }
 
-    fn draw(&self, folder: &Folder, frame: &mut Frame, area: Rect, theme: Theme) {
+    fn draw(&self, folder: &dyn Compared, frame: &mut Frame, area: Rect, theme: Theme) {
         draw(frame, area, self, folder, theme);
     }
 
-    fn legend(&self, _: &Folder) -> Vec<(&'static str, &'static str)> {
+    fn legend(&self, _: &dyn Compared) -> Vec<(&'static str, &'static str)> {
         vec![(
             "click",
             "a method's row picks it; a view's name below shows it",
         )]
     }
 
-    fn on_mouse(&mut self, folder: &Folder, mouse: MouseEvent, area: Rect) -> Outcome<Intent> {
+    fn on_mouse(
+        &mut self,
+        folder: &dyn Compared,
+        mouse: MouseEvent,
+        area: Rect,
+    ) -> Outcome<Intent> {
         if mouse.kind != MouseEventKind::Down(MouseButton::Left) {
             return Outcome::Ignored;
         }
@@ -333,14 +334,14 @@ const BOTH_SCORES_WIDTH: u16 = 100;
 /// The fewest lines the pairs' panel keeps (its borders and three pairs).
 const PAIRS_LINES: u16 = 5;
 
-fn draw(frame: &mut Frame, area: Rect, view: &ComparisonView, model: &Folder, theme: Theme) {
-    let Some(report) = &model.report else {
+fn draw(frame: &mut Frame, area: Rect, view: &ComparisonView, model: &dyn Compared, theme: Theme) {
+    let Some(report) = model.report() else {
         frame.render_widget(
             Paragraph::new(vec![
                 Line::from(coverage(model)),
                 Line::from(""),
                 Line::styled(
-                    if model.computing {
+                    if model.computing() {
                         "Making the comparison of the finished runs (the bootstrap takes a \
                          moment)…"
                     } else {
@@ -362,8 +363,8 @@ fn draw(frame: &mut Frame, area: Rect, view: &ComparisonView, model: &Folder, th
 }
 
 /// The line saying over how many runs, the table, the pairs.
-fn areas(area: Rect, model: &Folder) -> [Rect; 3] {
-    let methods = model.methods() as u16;
+fn areas(area: Rect, model: &dyn Compared) -> [Rect; 3] {
+    let methods = model.methods().len() as u16;
     let table_height = (methods + 5).min(area.height.saturating_sub(1 + PAIRS_LINES));
     Layout::vertical([
         Constraint::Length(1),
@@ -386,11 +387,11 @@ fn window(inside: Rect, order: &[usize], view: &ComparisonView) -> RowWindow {
 fn method_at(
     area: Rect,
     view: &ComparisonView,
-    model: &Folder,
+    model: &dyn Compared,
     column: u16,
     row: u16,
 ) -> Option<usize> {
-    model.report.as_ref()?;
+    model.report()?;
     let [_, table, _] = areas(area, model);
     let inside = inner(table);
     let first = inside.y + 1;
@@ -404,10 +405,9 @@ fn method_at(
 }
 
 /// Over how many runs: every planned one, or (partial) the finished ones so far.
-fn coverage(model: &Folder) -> String {
-    let folder = &model.state;
-    let (finished, planned) = (folder.finished_runs(), folder.runs.len());
-    if model.report.is_none() {
+fn coverage(model: &dyn Compared) -> String {
+    let (finished, planned) = (model.finished_runs(), model.runs().len());
+    if model.report().is_none() {
         format!(" {}", runs_finished(finished, planned))
     } else if finished == planned {
         let all = if planned == 1 {
@@ -550,7 +550,7 @@ fn score_columns(
 fn draw_table(
     frame: &mut Frame,
     area: Rect,
-    (view, model): (&ComparisonView, &Folder),
+    (view, model): (&ComparisonView, &dyn Compared),
     report: &Report,
     theme: Theme,
 ) {
@@ -564,7 +564,7 @@ fn draw_table(
     if inside.height < 3 {
         return;
     }
-    let folder = &model.state;
+    let methods = model.methods();
     let labels = labels(model);
     let rows: Vec<Option<&MethodComparison>> = labels
         .iter()
@@ -602,14 +602,15 @@ fn draw_table(
     let mut lines = vec![Line::from(header).style(theme.dim())];
     let order = view.order(model);
     let window = window(inside, &order, view);
-    let styles = method_styles(folder, theme);
+    let kinds: Vec<_> = methods.iter().map(|m| m.kind).collect();
+    let styles = method_styles(&kinds, theme);
     for i in window.rows().map(|at| order[at]) {
         let picked = i == view.cursor;
         let style = |s: Style| if picked { s.patch(theme.cursor()) } else { s };
         let runs = format!(
             "{}/{}",
             rows[i].map_or(0, |r| r.runs),
-            folder.config.protocol.runs
+            model.planned_runs(i)
         );
         let mut spans = vec![
             Span::styled(
@@ -708,18 +709,11 @@ fn draw_pairs(
     frame: &mut Frame,
     area: Rect,
     view: &ComparisonView,
-    model: &Folder,
+    model: &dyn Compared,
     report: &Report,
     theme: Theme,
 ) {
-    let folder = &model.state;
-    let Some(method) = folder
-        .config
-        .protocol
-        .methods
-        .get(view.cursor)
-        .map(|m| m.label())
-    else {
+    let Some(method) = labels(model).into_iter().nth(view.cursor) else {
         return;
     };
     let score = view.score;

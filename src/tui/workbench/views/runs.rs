@@ -17,7 +17,7 @@ use crate::tui::keys::{ch, code, Binding};
 use crate::tui::row_window::RowWindow;
 use crate::tui::theme::Theme;
 use crate::tui::view::{Outcome, View};
-use crate::tui::workbench::cells::{fit, inner, method_styles};
+use crate::tui::workbench::cells::{fit, inner, method_kinds, method_styles};
 use crate::tui::workbench::folder::Folder;
 
 /// The sparkline's levels, lowest first.
@@ -166,7 +166,7 @@ fn draw(frame: &mut Frame, area: Rect, folder: &FolderState, cursor: usize, them
     );
     let mut lines = vec![Line::styled(header, theme.dim())];
     let rows = run_window(inside, folder, cursor);
-    let styles = method_styles(folder, theme);
+    let styles = method_styles(&method_kinds(folder), theme);
     for i in rows.rows() {
         let run = &folder.runs[i];
         let first_of_method = i == 0 || folder.runs[i - 1].method != run.method;

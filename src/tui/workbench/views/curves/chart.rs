@@ -16,11 +16,11 @@ use ratatui::Frame;
 use super::{runs_of, CurvesView as Curves};
 use crate::report::metric::{CurvePoint, Metric, XAxis};
 use crate::report::plots::palette::method_colours;
-use crate::results::folder_state::FolderState;
 use crate::stats::Estimate;
 use crate::tui::row_window::RowWindow;
 use crate::tui::theme::Theme;
-use crate::tui::workbench::cells::{fit, inner, method_kinds};
+use crate::tui::workbench::cells::{fit, inner};
+use crate::tui::workbench::folder::Compared;
 
 /// Without colour, each method's line carries its own marker (the legend's too).
 pub const MARKERS: [&str; 10] = ["●", "▲", "■", "◆", "✚", "○", "△", "□", "◇", "×"];
@@ -46,7 +46,7 @@ pub(super) fn draw(
     frame: &mut Frame,
     area: Rect,
     curves: &Curves,
-    folder: &FolderState,
+    folder: &dyn Compared,
     theme: Theme,
 ) {
     let (made, making) = curves.curves(folder);
@@ -54,18 +54,17 @@ pub(super) fn draw(
         draw_waiting(frame, area, curves, folder, making, theme);
         return;
     };
-    let colours = method_colours(&method_kinds(folder));
-    let methods: Vec<Shown> = folder
-        .config
-        .protocol
-        .methods
+    let ids = folder.methods();
+    let kinds: Vec<_> = ids.iter().map(|m| m.kind).collect();
+    let colours = method_colours(&kinds);
+    let methods: Vec<Shown> = ids
         .iter()
         .enumerate()
         .map(|(index, method)| {
             let (r, g, b) = colours[index];
             Shown {
                 index,
-                label: method.label(),
+                label: method.label().to_string(),
                 colour: Color::Rgb(r, g, b),
                 points: made.methods.get(index).cloned().unwrap_or_default(),
             }
@@ -145,12 +144,12 @@ fn draw_waiting(
     frame: &mut Frame,
     area: Rect,
     curves: &Curves,
-    folder: &FolderState,
+    folder: &dyn Compared,
     making: Option<std::time::Instant>,
     theme: Theme,
 ) {
     let runs = folder
-        .runs
+        .runs()
         .iter()
         .filter(|r| !r.training.is_empty())
         .count();
@@ -185,9 +184,8 @@ fn draw_waiting(
 }
 
 /// The metric as the view names it.
-fn metric_name(curves: &Curves, folder: &FolderState) -> String {
-    let sources: Vec<String> = folder.library.iter().map(|e| e.name.clone()).collect();
-    curves.metric.name(&sources)
+fn metric_name(curves: &Curves, folder: &dyn Compared) -> String {
+    curves.metric.name(&folder.sources())
 }
 
 /// A value of `metric` with its decimals.
@@ -206,11 +204,9 @@ fn place(axis: XAxis, x: f64) -> String {
 }
 
 /// The labels' width in the legend.
-fn label_width(folder: &FolderState) -> usize {
+fn label_width(folder: &dyn Compared) -> usize {
     folder
-        .config
-        .protocol
-        .methods
+        .methods()
         .iter()
         .map(|m| m.label().chars().count())
         .max()
@@ -240,7 +236,7 @@ fn areas(inside: Rect, label_width: usize, runs: bool) -> [Rect; 2] {
 pub(super) fn legend_method_at(
     area: Rect,
     curves: &Curves,
-    folder: &FolderState,
+    folder: &dyn Compared,
     column: u16,
     row: u16,
 ) -> Option<usize> {
@@ -253,7 +249,7 @@ pub(super) fn legend_method_at(
     if !(legend.x..legend.x + legend.width).contains(&column) || row < first {
         return None;
     }
-    let methods = folder.config.protocol.methods.len();
+    let methods = folder.methods().len();
     legend_window(legend, methods, curves.cursor).row_at(usize::from(row - first))
 }
 
@@ -270,14 +266,14 @@ fn legend_window(area: Rect, methods: usize, cursor: usize) -> RowWindow {
 /// What the view shows, over how many runs, and where on the axis; a spinner while the
 /// curves are made again.
 fn title(
-    folder: &FolderState,
+    folder: &dyn Compared,
     curves: &Curves,
     ((from, to), making): ((f64, f64), Option<std::time::Instant>),
     theme: Theme,
 ) -> Line<'static> {
     let window = curves.window(folder);
     let axis = curves.axis(folder);
-    let (finished, planned_runs) = (folder.finished_runs(), folder.runs.len());
+    let (finished, planned_runs) = (folder.finished_runs(), folder.runs().len());
     let over = if finished == planned_runs && planned_runs == 1 {
         "its one run".to_string()
     } else if finished == planned_runs {
@@ -602,7 +598,7 @@ type ShownRuns<'a> = (&'a Shown, &'a [Vec<(f64, f64)>], (f64, f64));
 fn draw_runs_legend(
     frame: &mut Frame,
     area: Rect,
-    (folder, curves): (&FolderState, &Curves),
+    (folder, curves): (&dyn Compared, &Curves),
     (method, run_lines, (from, to)): ShownRuns<'_>,
     shown: usize,
     theme: Theme,

@@ -27,14 +27,14 @@ use crate::config::Budget;
 use crate::report::metric::{self, CurvePoint, Metric, RunMetric, XAxis};
 use crate::report::sample_efficiency;
 use crate::report::TrainingEpisodes;
-use crate::results::folder_state::{FolderState, RunProgress, RunStatus};
+use crate::results::folder_state::{RunProgress, RunStatus};
 use crate::results::run_metrics::{self, OnFile, RunFiles};
 use crate::stats::Estimate;
 use crate::tui::background;
 use crate::tui::keys::{ch, code, Binding};
 use crate::tui::theme::Theme;
 use crate::tui::view::{Outcome, View};
-use crate::tui::workbench::folder::Folder;
+use crate::tui::workbench::folder::Compared;
 
 pub use chart::MARKERS;
 
@@ -159,17 +159,17 @@ impl Default for CurvesView {
 
 /// The runs of method `index` that have episodes (finished, stopped or running): those
 /// `episodes.csv` holds when the protocol ends.
-pub fn runs_of(folder: &FolderState, index: usize) -> Vec<&RunProgress> {
+pub fn runs_of(folder: &dyn Compared, index: usize) -> Vec<&RunProgress> {
     folder
-        .runs
+        .runs()
         .iter()
         .filter(|r| r.method.index == index && !r.training.is_empty())
         .collect()
 }
 
 /// The episodes (or, under a step budget, the steps) a run of the protocol is given.
-pub fn planned(folder: &FolderState) -> f64 {
-    match folder.config.protocol.budget {
+pub fn planned(folder: &dyn Compared) -> f64 {
+    match folder.budget() {
         Budget::Episodes(n) => f64::from(n.max(1)),
         Budget::Steps(n) => n.max(1) as f64,
     }
@@ -285,33 +285,37 @@ fn run_line(run: &RunMetric, request: &Request, points: &[f64]) -> Vec<(f64, f64
 
 impl CurvesView {
     /// What the folder's files hold (looked at again when runs gain episodes or files).
-    pub fn on_file(&self, folder: &FolderState) -> OnFile {
+    pub fn on_file(&self, folder: &dyn Compared) -> OnFile {
         let runs = folder
-            .runs
+            .runs()
             .iter()
             .filter(|r| !r.training.is_empty())
             .count();
         let mut curves = self.curves.borrow_mut();
         if let Some((dir, count, on_file)) = &curves.on_file {
-            if *dir == folder.dir && *count == runs {
+            if dir == folder.dir() && *count == runs {
                 return on_file.clone();
             }
         }
-        let on_file = run_metrics::on_file(&run_metrics::run_files(folder), folder.library.len());
-        curves.on_file = Some((folder.dir.clone(), runs, on_file.clone()));
+        let on_file = run_metrics::on_file(&folder.run_files(), folder.sources().len());
+        curves.on_file = Some((folder.dir().to_path_buf(), runs, on_file.clone()));
         on_file
+    }
+
+    /// Whether every run with episodes has their steps (a run from elsewhere may not).
+    fn stepped(folder: &dyn Compared) -> bool {
+        folder
+            .runs()
+            .iter()
+            .filter(|r| !r.training.is_empty())
+            .all(|r| r.training.lengths.iter().any(|&l| l > 0))
     }
 
     /// The x axis drawn: the one picked, else the environment step where every run with
     /// episodes has steps, else the episode.
-    pub fn axis(&self, folder: &FolderState) -> XAxis {
+    pub fn axis(&self, folder: &dyn Compared) -> XAxis {
         self.axis.unwrap_or_else(|| {
-            let stepped = folder
-                .runs
-                .iter()
-                .filter(|r| !r.training.is_empty())
-                .all(|r| r.training.lengths.iter().any(|&l| l > 0));
-            if stepped {
+            if Self::stepped(folder) {
                 XAxis::Step
             } else {
                 XAxis::Episode
@@ -319,21 +323,19 @@ impl CurvesView {
         })
     }
 
-    /// The moving average's window: the one picked, else the protocol's.
-    pub fn window(&self, folder: &FolderState) -> usize {
-        self.window
-            .unwrap_or(folder.config.protocol.moving_average)
-            .max(1)
+    /// The moving average's window: the one picked, else the folder's.
+    pub fn window(&self, folder: &dyn Compared) -> usize {
+        self.window.unwrap_or(folder.window()).max(1)
     }
 
-    fn request(&self, folder: &FolderState) -> Request {
+    fn request(&self, folder: &dyn Compared) -> Request {
         let quantum = (planned(folder) as u64 / sample_efficiency::POINTS as u64).max(1);
         Request {
             metric: self.metric,
             axis: self.axis(folder),
             window: self.window(folder),
             runs: folder
-                .runs
+                .runs()
                 .iter()
                 .filter(|r| !r.training.is_empty())
                 .map(|r| {
@@ -349,7 +351,7 @@ impl CurvesView {
 
     /// The curves of the view's choice: made, or being made (then the last ones of the
     /// same choice if any, and since when). Starts making them when needed.
-    pub fn curves(&self, folder: &FolderState) -> (Option<Made>, Option<Instant>) {
+    pub fn curves(&self, folder: &dyn Compared) -> (Option<Made>, Option<Instant>) {
         let request = self.request(folder);
         let mut curves = self.curves.borrow_mut();
         if let Some((_, _, rx)) = &curves.making {
@@ -365,19 +367,14 @@ impl CurvesView {
         let started = match &curves.making {
             Some((r, since, _)) if *r == request => *since,
             _ => {
-                let runs = run_metrics::run_files(folder);
+                let runs = folder.run_files();
                 let labels: Vec<String> = folder
-                    .config
-                    .protocol
-                    .methods
+                    .methods()
                     .iter()
-                    .map(|m| m.label())
+                    .map(|m| m.label().to_string())
                     .collect();
-                let sources: Vec<String> = folder.library.iter().map(|e| e.name.clone()).collect();
-                let protocol = (
-                    folder.config.protocol.budget,
-                    folder.config.protocol.moving_average,
-                );
+                let sources = folder.sources();
+                let protocol = (folder.budget(), folder.window());
                 let job = request.clone();
                 let rx = background::spawn("workbench: making the curves", move || {
                     make(&job, &runs, &labels, &sources, protocol)
@@ -407,14 +404,14 @@ impl CurvesView {
     }
 
     /// The curves of the view's choice, made here and now.
-    pub fn made_now(&self, folder: &FolderState) -> Made {
+    pub fn made_now(&self, folder: &dyn Compared) -> Made {
         let _ = self.curves(folder);
         self.settle();
         self.curves(folder).0.unwrap_or_default()
     }
 
     /// Method `index`'s curve of the view's choice, made here and now.
-    pub fn curve(&self, folder: &FolderState, index: usize) -> Vec<CurvePoint> {
+    pub fn curve(&self, folder: &dyn Compared, index: usize) -> Vec<CurvePoint> {
         self.made_now(folder)
             .methods
             .get(index)
@@ -423,12 +420,12 @@ impl CurvesView {
     }
 
     /// The axis's extent: the budget's on its own axis, else the curves' last made.
-    pub fn extent(&self, folder: &FolderState) -> (f64, f64) {
+    pub fn extent(&self, folder: &dyn Compared) -> (f64, f64) {
         let axis = self.axis(folder);
-        if axis == budget_axis(folder.config.protocol.budget) {
+        if axis == budget_axis(folder.budget()) {
             return (1.0, planned(folder));
         }
-        let runs = folder.runs.iter().filter(|r| !r.training.is_empty());
+        let runs = folder.runs().iter().filter(|r| !r.training.is_empty());
         match axis {
             XAxis::Episode => (1.0, runs.map(|r| r.episodes()).max().unwrap_or(1) as f64),
             XAxis::Step => runs
@@ -455,7 +452,7 @@ impl CurvesView {
     }
 
     /// The range shown on the axis, first to last.
-    pub fn range(&self, folder: &FolderState) -> (f64, f64) {
+    pub fn range(&self, folder: &dyn Compared) -> (f64, f64) {
         let all = self.extent(folder);
         self.zoom.map_or(all, |zoom| clamp(zoom, all))
     }
@@ -468,7 +465,7 @@ impl CurvesView {
     }
 
     /// The next metric on file (`by` 1) or the previous (-1).
-    fn next_metric(&mut self, folder: &FolderState, by: isize) {
+    fn next_metric(&mut self, folder: &dyn Compared, by: isize) {
         let metrics = self.on_file(folder).metrics;
         let at = metrics.iter().position(|&m| m == self.metric).unwrap_or(0) as isize;
         let n = metrics.len().max(1) as isize;
@@ -478,20 +475,29 @@ impl CurvesView {
             .unwrap_or(Metric::Return);
     }
 
-    /// The next x axis on file: episode, step, wall time.
-    fn next_axis(&mut self, folder: &FolderState) {
+    /// The next x axis on file: episode, step, wall time; or, where not every run has
+    /// steps and no wall time is on file, why the episode is the only one.
+    fn next_axis(&mut self, folder: &dyn Compared) -> Outcome<super::Intent> {
         let wall = self.on_file(folder).wall;
+        if !wall && !Self::stepped(folder) {
+            return Outcome::Said(
+                "the episode is the only x axis here: not every run's file gives its \
+                 episodes' steps"
+                    .into(),
+            );
+        }
         self.axis = Some(match self.axis(folder) {
             XAxis::Episode => XAxis::Step,
             XAxis::Step if wall => XAxis::Wall,
             XAxis::Step | XAxis::Wall => XAxis::Episode,
         });
         self.zoom = None;
+        Outcome::Done
     }
 
-    /// The next smoothing window: the protocol's, none, then wider.
-    fn next_window(&mut self, folder: &FolderState) {
-        let own = folder.config.protocol.moving_average.max(1);
+    /// The next smoothing window: the folder's, none, then wider.
+    fn next_window(&mut self, folder: &dyn Compared) {
+        let own = folder.window().max(1);
         let mut windows = vec![own];
         windows.extend(WINDOWS.iter().copied().filter(|&w| w != own));
         let at = windows
@@ -562,7 +568,7 @@ const KEYS: &[Binding<CurvesCommand>] = &[
         keys: &[(ch('s'), C::Smoothing)],
         help: (
             "s",
-            "the smoothing: the protocol's moving average, none, 5, 25, 50, 100 episodes",
+            "the smoothing: the folder's moving average, none, 5, 25, 50, 100 episodes",
         ),
         bar: Some(("s", "smooth")),
     },
@@ -629,7 +635,7 @@ const KEYS: &[Binding<CurvesCommand>] = &[
 ];
 
 impl View for CurvesView {
-    type Model = Folder;
+    type Model = dyn Compared;
     type Command = CurvesCommand;
     type Intent = super::Intent;
 
@@ -637,9 +643,8 @@ impl View for CurvesView {
         KEYS
     }
 
-    fn apply(&mut self, folder: &Folder, command: CurvesCommand) -> Outcome<super::Intent> {
-        let folder = &folder.state;
-        let methods = folder.config.protocol.methods.len();
+    fn apply(&mut self, folder: &dyn Compared, command: CurvesCommand) -> Outcome<super::Intent> {
+        let methods = folder.methods().len();
         let all = self.extent(folder);
         let (from, to) = self.range(folder);
         let width = to - from;
@@ -649,7 +654,7 @@ impl View for CurvesView {
             C::Pick(_) if self.run.is_some() => return Outcome::Ignored,
             C::Back | C::Run(_) if self.run.is_none() => return Outcome::Ignored,
             C::Metric(by) => self.next_metric(folder, by),
-            C::Axis => self.next_axis(folder),
+            C::Axis => return self.next_axis(folder),
             C::Smoothing => self.next_window(folder),
             C::Pick(by) => {
                 let last = methods.saturating_sub(1) as isize;
@@ -692,13 +697,13 @@ impl View for CurvesView {
         Outcome::Done
     }
 
-    fn draw(&self, folder: &Folder, frame: &mut Frame, area: Rect, theme: Theme) {
-        chart::draw(frame, area, self, &folder.state, theme);
+    fn draw(&self, folder: &dyn Compared, frame: &mut Frame, area: Rect, theme: Theme) {
+        chart::draw(frame, area, self, folder, theme);
     }
 
     /// Reading one method's runs, the arrows pick nothing and `[ ]` move; else the
     /// reverse.
-    fn offers(&self, _: &Folder, command: CurvesCommand) -> bool {
+    fn offers(&self, _: &dyn Compared, command: CurvesCommand) -> bool {
         match command {
             C::Pick(_) => self.run.is_none(),
             C::Run(_) => self.run.is_some(),
@@ -706,11 +711,11 @@ impl View for CurvesView {
         }
     }
 
-    fn words(&self, _: &Folder, command: CurvesCommand) -> Option<&'static str> {
+    fn words(&self, _: &dyn Compared, command: CurvesCommand) -> Option<&'static str> {
         (command == C::Runs && self.run.is_some()).then_some("methods")
     }
 
-    fn legend(&self, _: &Folder) -> Vec<(&'static str, &'static str)> {
+    fn legend(&self, _: &dyn Compared) -> Vec<(&'static str, &'static str)> {
         vec![(
             "click",
             "a method in the legend picks it and shows or hides it; a view's name below \
@@ -720,14 +725,14 @@ impl View for CurvesView {
 
     fn on_mouse(
         &mut self,
-        folder: &Folder,
+        folder: &dyn Compared,
         mouse: MouseEvent,
         area: Rect,
     ) -> Outcome<super::Intent> {
         if mouse.kind != MouseEventKind::Down(MouseButton::Left) {
             return Outcome::Ignored;
         }
-        match chart::legend_method_at(area, self, &folder.state, mouse.column, mouse.row) {
+        match chart::legend_method_at(area, self, folder, mouse.column, mouse.row) {
             Some(method) => {
                 self.cursor = method;
                 self.toggle(method);
