@@ -181,7 +181,7 @@ pub fn unended_by<'a>(
     })
 }
 
-/// Whether `dir` holds the record [`write`] makes: compare folders written before it did
+/// Whether `dir` holds the record [`write()`] makes: compare folders written before it did
 /// hold only their report.
 pub fn is_recorded(dir: &Path) -> bool {
     std::fs::symlink_metadata(dir.join(SCORING)).is_ok()
