@@ -7,10 +7,16 @@
 //! `python3 shared/bench/torch_update_bench.py --batches 32`.
 //!
 //! Also times one greedy action, the forward pass an agent makes every step.
+//!
+//! `SAPNET_RUN_ONCE=<n>` takes `n` greedy actions and `n` highest Q-values (`2n` passes of
+//! one observation) of each acting network once, without criterion, and prints a digest of
+//! them: for counting instructions
+//! under `valgrind --tool=callgrind` (the difference between `n` and `0`), and for checking
+//! that two builds act alike.
 
 use std::time::Duration;
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use criterion::{criterion_group, BenchmarkId, Criterion};
 use rand::{rngs::StdRng, Rng, SeedableRng};
 use rand_distr::StandardNormal;
 use sapnet::dqn::DqnConfig;
@@ -81,10 +87,14 @@ fn update(c: &mut Criterion) {
     group.finish();
 }
 
+/// The networks whose greedy action is timed: the paper's smallest and deepest, and the
+/// widest of the shipped CartPole library's sources.
+const ACTING: [&[usize]; 3] = [&[100], &[100, 100, 100], &[64, 114, 149]];
+
 /// Acting costs a forward pass of one observation every environment step.
 fn greedy_action(c: &mut Criterion) {
     let mut group = c.benchmark_group("dqn_greedy_action");
-    for hidden in [&[100][..], &[100, 100, 100]] {
+    for hidden in ACTING {
         let architecture = Architecture::new(4, hidden, 2);
         let name = architecture.to_string();
         let net = QNet::new(architecture, &mut StdRng::seed_from_u64(0)).expect("network");
@@ -97,4 +107,29 @@ fn greedy_action(c: &mut Criterion) {
 }
 
 criterion_group!(benches, update, greedy_action);
-criterion_main!(benches);
+
+fn main() {
+    if let Some(n) = std::env::var("SAPNET_RUN_ONCE")
+        .ok()
+        .and_then(|n| n.parse::<usize>().ok())
+    {
+        let mut rng = StdRng::seed_from_u64(0);
+        let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut eat = |word: u64| {
+            hash ^= word;
+            hash = hash.wrapping_mul(0x100_0000_01b3);
+        };
+        for hidden in ACTING {
+            let net = QNet::new(Architecture::new(4, hidden, 2), &mut rng).expect("network");
+            for _ in 0..n {
+                let obs: [f32; 4] = std::array::from_fn(|_| rng.random_range(-2.0..2.0));
+                eat(net.greedy_action(&obs).expect("action") as u64);
+                eat(u64::from(net.max_q(&obs).expect("value").to_bits()));
+            }
+        }
+        println!("{n} greedy actions and highest values of each of {ACTING:?}: digest {hash:016x}");
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -36,4 +36,4 @@ pub use frozen::FrozenNet;
 pub use loss::{huber, td_huber_loss};
 pub use optim::Adam;
 pub use qnet::{Architecture, Init, QNet};
-pub use replay::{Batch, ReplayBuffer, Transition};
+pub use replay::{transition_bytes, Batch, ReplayBuffer, Transition};

@@ -1,8 +1,12 @@
 //! Experience replay: a ring buffer of transitions, sampled uniformly with replacement.
 //!
-//! Transitions live in flat columns (one `Vec` per field, observations `obs_size` floats
-//! apiece) that grow as transitions arrive, so a 1e6-transition buffer costs only what it
-//! holds. Once full, the oldest transition is overwritten.
+//! Each transition is one fixed-size record of `2·obs_size + 2` f32 words, interleaved in
+//! one array: the observation, the next observation, the reward, and a word holding the
+//! action and the two flags as bits ([`tag`]). A minibatch's draw then touches one or two
+//! cache lines per transition where six column arrays touched six, and the records of a
+//! batch are prefetched as soon as their slots are drawn (the draws are the same, in the
+//! same order: the same minibatches bit for bit). Records grow as transitions arrive, so a
+//! 1e6-transition buffer costs only what it holds; once full, the oldest is overwritten.
 
 use rand::Rng;
 
@@ -19,21 +23,58 @@ pub struct Transition<'a> {
     pub truncated: bool,
 }
 
+/// The record's last word: the action in the low bits, `terminated` in bit 31 and
+/// `truncated` in bit 30. Kept as an `f32` of those bits so that a record is one slice of
+/// `f32`; the bits are only ever moved, never computed with, and with the action below
+/// 2²² they are never a NaN's (whose exponent bits 23–30 are all set), so every move keeps
+/// them.
+mod tag {
+    /// Actions up to this many are stored.
+    pub const ACTIONS: usize = 1 << 22;
+    const TERMINATED: u32 = 1 << 31;
+    const TRUNCATED: u32 = 1 << 30;
+
+    pub fn pack(action: usize, terminated: bool, truncated: bool) -> f32 {
+        assert!(action < ACTIONS, "action index {action} fits in a replay record");
+        let flags = if terminated { TERMINATED } else { 0 } | if truncated { TRUNCATED } else { 0 };
+        f32::from_bits(action as u32 | flags)
+    }
+
+    pub fn action(word: f32) -> u32 {
+        word.to_bits() & !(TERMINATED | TRUNCATED)
+    }
+
+    pub fn terminated(word: f32) -> bool {
+        word.to_bits() & TERMINATED != 0
+    }
+
+    pub fn truncated(word: f32) -> bool {
+        word.to_bits() & TRUNCATED != 0
+    }
+}
+
+/// Bytes one stored transition takes: a record of `2·obs_size + 2` f32 words (two
+/// observations, the reward, the action and flags). The protocol's memory check counts
+/// replay memory with it.
+pub fn transition_bytes(obs_size: usize) -> usize {
+    (2 * obs_size + 2) * std::mem::size_of::<f32>()
+}
+
 /// A fixed-capacity ring buffer of transitions.
 #[derive(Debug, Clone)]
 pub struct ReplayBuffer {
     capacity: usize,
     obs_size: usize,
+    /// f32 words per record: `2·obs_size + 2`.
+    stride: usize,
+    /// Records held.
+    len: usize,
     /// Slot the next transition is written to once the buffer is full.
     next: usize,
     /// Transitions pushed since the buffer was made.
     pushes: u64,
-    obs: Vec<f32>,
-    next_obs: Vec<f32>,
-    actions: Vec<u32>,
-    rewards: Vec<f32>,
-    terminated: Vec<bool>,
-    truncated: Vec<bool>,
+    /// `len` records of `stride` words: obs, next obs, reward, [`tag`].
+    records: Vec<f32>,
 }
 
 impl ReplayBuffer {
@@ -45,23 +86,20 @@ impl ReplayBuffer {
         Self {
             capacity,
             obs_size,
+            stride: 2 * obs_size + 2,
+            len: 0,
             next: 0,
             pushes: 0,
-            obs: Vec::new(),
-            next_obs: Vec::new(),
-            actions: Vec::new(),
-            rewards: Vec::new(),
-            terminated: Vec::new(),
-            truncated: Vec::new(),
+            records: Vec::new(),
         }
     }
 
     pub fn len(&self) -> usize {
-        self.actions.len()
+        self.len
     }
 
     pub fn is_empty(&self) -> bool {
-        self.actions.is_empty()
+        self.len == 0
     }
 
     pub fn capacity(&self) -> usize {
@@ -72,30 +110,39 @@ impl ReplayBuffer {
         self.obs_size
     }
 
+    /// The record of slot `i`.
+    #[inline]
+    fn record(&self, i: usize) -> &[f32] {
+        &self.records[i * self.stride..(i + 1) * self.stride]
+    }
+
     /// Stores a transition, overwriting the oldest one when full.
     ///
     /// # Panics
-    /// If an observation is not `obs_size` long or the action exceeds `u32` (caller bugs).
+    /// If an observation is not `obs_size` long or the action is 2²² or more (caller bugs).
     pub fn push(&mut self, t: Transition<'_>) {
-        assert_eq!(t.obs.len(), self.obs_size, "observation size");
-        assert_eq!(t.next_obs.len(), self.obs_size, "next observation size");
-        let action = u32::try_from(t.action).expect("action index fits in u32");
-        if self.len() < self.capacity {
-            self.obs.extend_from_slice(t.obs);
-            self.next_obs.extend_from_slice(t.next_obs);
-            self.actions.push(action);
-            self.rewards.push(t.reward as f32);
-            self.terminated.push(t.terminated);
-            self.truncated.push(t.truncated);
+        let n = self.obs_size;
+        assert_eq!(t.obs.len(), n, "observation size");
+        assert_eq!(t.next_obs.len(), n, "next observation size");
+        let tag = tag::pack(t.action, t.terminated, t.truncated);
+        if self.len < self.capacity {
+            if self.records.len() == self.records.capacity() {
+                // Doubling as a `Vec` does, but never past the capacity's records.
+                let room = self.records.capacity().max(64 * self.stride);
+                let most = self.capacity * self.stride - self.records.len();
+                self.records.reserve_exact(room.min(most));
+            }
+            self.records.extend_from_slice(t.obs);
+            self.records.extend_from_slice(t.next_obs);
+            self.records.extend([t.reward as f32, tag]);
+            self.len += 1;
         } else {
-            let i = self.next;
-            let span = i * self.obs_size..(i + 1) * self.obs_size;
-            self.obs[span.clone()].copy_from_slice(t.obs);
-            self.next_obs[span].copy_from_slice(t.next_obs);
-            self.actions[i] = action;
-            self.rewards[i] = t.reward as f32;
-            self.terminated[i] = t.terminated;
-            self.truncated[i] = t.truncated;
+            let at = self.next * self.stride;
+            let record = &mut self.records[at..at + self.stride];
+            record[..n].copy_from_slice(t.obs);
+            record[n..2 * n].copy_from_slice(t.next_obs);
+            record[2 * n] = t.reward as f32;
+            record[2 * n + 1] = tag;
         }
         self.next = (self.next + 1) % self.capacity;
         self.pushes += 1;
@@ -111,22 +158,36 @@ impl ReplayBuffer {
         (self.next + self.capacity - 1) % self.capacity
     }
 
-    /// The observations and next observations of the slots `slots`, row-major.
-    pub fn observations(&self, slots: std::ops::Range<usize>) -> (&[f32], &[f32]) {
-        let span = slots.start * self.obs_size..slots.end * self.obs_size;
-        (&self.obs[span.clone()], &self.next_obs[span])
+    /// The observations and next observations of the slots `slots`, row-major, into `obs`
+    /// and `next` (emptied first).
+    pub fn observations_into(
+        &self,
+        slots: std::ops::Range<usize>,
+        obs: &mut Vec<f32>,
+        next: &mut Vec<f32>,
+    ) {
+        obs.clear();
+        next.clear();
+        let n = self.obs_size;
+        for slot in slots {
+            let record = self.record(slot);
+            obs.extend_from_slice(&record[..n]);
+            next.extend_from_slice(&record[n..2 * n]);
+        }
     }
 
     /// The `i`-th stored transition in slot order (not age order).
     pub fn get(&self, i: usize) -> Transition<'_> {
-        let span = i * self.obs_size..(i + 1) * self.obs_size;
+        let n = self.obs_size;
+        let record = self.record(i);
+        let tag = record[2 * n + 1];
         Transition {
-            obs: &self.obs[span.clone()],
-            action: self.actions[i] as usize,
-            reward: f64::from(self.rewards[i]),
-            next_obs: &self.next_obs[span],
-            terminated: self.terminated[i],
-            truncated: self.truncated[i],
+            obs: &record[..n],
+            action: tag::action(tag) as usize,
+            reward: f64::from(record[2 * n]),
+            next_obs: &record[n..2 * n],
+            terminated: tag::terminated(tag),
+            truncated: tag::truncated(tag),
         }
     }
 
@@ -138,6 +199,10 @@ impl ReplayBuffer {
     /// Fills `batch` with `size` transitions drawn uniformly with replacement, reusing its
     /// memory; the batch keeps their slots.
     ///
+    /// Every slot is drawn first (the same draws, in the same order, as drawing each before
+    /// copying it) and its record prefetched, so that the records' loads overlap; then the
+    /// records are copied into the batch's columns.
+    ///
     /// # Panics
     /// If the buffer is empty.
     pub fn sample_into(&self, size: usize, batch: &mut Batch, rng: &mut impl Rng) {
@@ -148,9 +213,71 @@ impl ReplayBuffer {
         batch.clear(self.obs_size);
         for _ in 0..size {
             let slot = rng.random_range(0..self.len());
-            batch.push(self.get(slot));
+            self.prefetch(slot);
             batch.slots.push(slot);
         }
+        // The tasks' widths get a copy of constant length (moves in registers, where a
+        // length known only at run time calls `memcpy` twice per transition).
+        match self.obs_size {
+            1 => self.gather::<1>(batch),
+            2 => self.gather::<2>(batch),
+            3 => self.gather::<3>(batch),
+            4 => self.gather::<4>(batch),
+            6 => self.gather::<6>(batch),
+            8 => self.gather::<8>(batch),
+            _ => self.gather::<0>(batch),
+        }
+    }
+
+    /// Copies the records of `batch`'s slots into its columns; `N` is the observation size,
+    /// or 0 for "`obs_size`, whatever it is".
+    #[inline(always)]
+    fn gather<const N: usize>(&self, batch: &mut Batch) {
+        let n = if N == 0 { self.obs_size } else { N };
+        debug_assert_eq!(n, self.obs_size);
+        let Batch {
+            obs,
+            next_obs,
+            actions,
+            rewards,
+            terminated,
+            truncated,
+            slots,
+            ..
+        } = batch;
+        for &slot in slots.iter() {
+            let record = self.record(slot);
+            let tag = record[2 * n + 1];
+            obs.extend_from_slice(&record[..n]);
+            next_obs.extend_from_slice(&record[n..2 * n]);
+            rewards.push(record[2 * n]);
+            actions.push(tag::action(tag));
+            terminated.push(tag::terminated(tag));
+            truncated.push(tag::truncated(tag));
+        }
+    }
+
+    /// Asks the CPU to bring slot `slot`'s record into the caches (every cache line it
+    /// spans); a hint that changes no value, and nothing where there is no such hint.
+    #[inline]
+    fn prefetch(&self, slot: usize) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let bytes = self.stride * std::mem::size_of::<f32>();
+            let start = self.record(slot).as_ptr().cast::<i8>();
+            // SAFETY (each prefetch): a prefetch is a hint: it reads nothing the program
+            // sees and cannot fault; every address is within the record.
+            let mut offset = 0;
+            while offset < bytes {
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset)) };
+                offset += 64;
+            }
+            // The line of the last byte, where the record straddles two.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(bytes - 1)) };
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = slot;
     }
 }
 
@@ -291,7 +418,7 @@ mod tests {
         assert_eq!(buffer.get(1).next_obs, &[4.0, -4.0]);
         assert!(buffer.get(0).terminated && !buffer.get(0).truncated);
         assert!(!buffer.get(1).terminated);
-        assert!(buffer.obs.len() == 6 && buffer.obs.capacity() < 1000);
+        assert!(buffer.records.len() == 3 * 6 && buffer.records.capacity() <= 3 * 6);
     }
 
     #[test]
@@ -334,6 +461,92 @@ mod tests {
             counts.iter().all(|&c| (900..1100).contains(&c)),
             "{counts:?}"
         );
+    }
+
+    /// The records hand back what was pushed, to the bit: every flag pair, the largest
+    /// action, rewards rounded to f32 as stored, observations of any bits (NaN payloads,
+    /// negative zero, subnormals).
+    #[test]
+    fn a_record_keeps_every_field_to_the_bit() {
+        let odd = [
+            f32::from_bits(0x7fc0_1234),
+            -0.0,
+            f32::from_bits(1),
+            f32::MAX,
+            f32::NEG_INFINITY,
+        ];
+        let mut buffer = ReplayBuffer::new(8, odd.len());
+        let next: Vec<f32> = odd.iter().rev().copied().collect();
+        let actions = [0, 1, 2, tag::ACTIONS - 1];
+        for (i, (terminated, truncated)) in [(false, false), (true, false), (false, true), (true, true)]
+            .into_iter()
+            .enumerate()
+        {
+            buffer.push(Transition {
+                obs: &odd,
+                action: actions[i],
+                reward: 0.1 * i as f64 - 1e40,
+                next_obs: &next,
+                terminated,
+                truncated,
+            });
+            let t = buffer.get(i);
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(t.obs), bits(&odd));
+            assert_eq!(bits(t.next_obs), bits(&next));
+            assert_eq!(t.action, actions[i]);
+            assert_eq!(t.reward, f64::from((0.1 * i as f64 - 1e40) as f32));
+            assert_eq!((t.terminated, t.truncated), (terminated, truncated));
+        }
+        assert_eq!(transition_bytes(odd.len()), 48);
+        assert_eq!(buffer.records.len() * 4, 4 * transition_bytes(odd.len()));
+    }
+
+    #[test]
+    #[should_panic(expected = "fits in a replay record")]
+    fn an_action_beyond_the_tag_is_refused() {
+        let mut buffer = ReplayBuffer::new(2, 1);
+        buffer.push(Transition {
+            action: tag::ACTIONS,
+            ..transition(&[0.0], 0)
+        });
+    }
+
+    /// A sample is the batch of drawing each slot in turn and pushing its transition (the
+    /// column buffer's way): the same slots from the same draws, the same values, wrapped
+    /// or not.
+    #[test]
+    fn a_sample_is_each_drawn_transition_in_turn() {
+        // Widths with a copy of their own (1–4, 6, 8) and without (5, 11).
+        let cases = [1, 2, 3, 4, 5, 6, 8, 11].into_iter().flat_map(|w| {
+            [(50, 30), (50, 137)]
+                .into_iter()
+                .map(move |(capacity, pushes)| (w, capacity, pushes))
+        });
+        for (width, capacity, pushes) in cases {
+            let mut buffer = ReplayBuffer::new(capacity, width);
+            for i in 0..pushes {
+                let obs: Vec<f32> = (0..width).map(|k| (i * 16 + k) as f32).collect();
+                let next: Vec<f32> = obs.iter().map(|x| -x - 0.5).collect();
+                buffer.push(Transition {
+                    next_obs: &next,
+                    ..transition(&obs, i)
+                });
+            }
+            for seed in 0..5 {
+                let mut sampled = Batch::new();
+                buffer.sample_into(64, &mut sampled, &mut StdRng::seed_from_u64(seed));
+                let mut rng = StdRng::seed_from_u64(seed);
+                let mut expected = Batch::new();
+                expected.clear(width);
+                for _ in 0..64 {
+                    let slot = rng.random_range(0..buffer.len());
+                    expected.push(buffer.get(slot));
+                    expected.slots.push(slot);
+                }
+                assert_eq!(sampled, expected);
+            }
+        }
     }
 
     #[test]

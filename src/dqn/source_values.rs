@@ -29,6 +29,8 @@ pub(crate) struct SourceValues {
     /// next, unless the episode ended.
     latest_next: Vec<f32>,
     latest_slot: usize,
+    /// The observations and next observations of the rows being filled.
+    rows: (Vec<f32>, Vec<f32>),
     work: Workspace,
 }
 
@@ -104,8 +106,7 @@ impl SourceValues {
         let slot = replay.latest_slot();
         let previous = (slot + replay.capacity() - 1) % replay.capacity();
         let continues = replay.pushes() > 1 && replay.capacity() > 1 && {
-            let (obs, _) = replay.observations(slot..slot + 1);
-            let (_, before) = replay.observations(previous..previous + 1);
+            let (obs, before) = (replay.get(slot).obs, replay.get(previous).next_obs);
             obs.iter()
                 .zip(before)
                 .all(|(a, b)| a.to_bits() == b.to_bits())
@@ -120,8 +121,7 @@ impl SourceValues {
         }
         let kept = previous * width..(previous + 1) * width;
         self.at_obs[slot * width..(slot + 1) * width].copy_from_slice(&self.at_next[kept]);
-        let (_, next) = replay.observations(slot..slot + 1);
-        self.compute(isa, next, slot, 1, sources, true)
+        self.compute(isa, replay.get(slot).next_obs, slot, 1, sources, true)
     }
 
     /// Computes the slots `start..start + rows` from `replay`, growing the cache to them.
@@ -138,9 +138,13 @@ impl SourceValues {
             self.at_obs.resize(end, 0.0);
             self.at_next.resize(end, 0.0);
         }
-        let (obs, next) = replay.observations(start..start + rows);
-        self.compute(isa, obs, start, rows, sources, false)?;
-        self.compute(isa, next, start, rows, sources, true)
+        let (mut obs, mut next) = std::mem::take(&mut self.rows);
+        replay.observations_into(start..start + rows, &mut obs, &mut next);
+        let computed = self
+            .compute(isa, &obs, start, rows, sources, false)
+            .and_then(|()| self.compute(isa, &next, start, rows, sources, true));
+        self.rows = (obs, next);
+        computed
     }
 
     /// Each source's values of `observations` (`rows` of them) into the slots from `start`,

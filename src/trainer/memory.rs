@@ -13,10 +13,10 @@ use crate::trainer::RunSpec;
 /// learner here, an upper bound).
 const LEARNER_COPIES: f64 = 5.0;
 
-/// Bytes one stored transition takes: two observations of `obs` f32s, the action (u32),
-/// the reward (f32), two flags.
+/// Bytes one stored transition takes: its record in the replay buffer
+/// ([`crate::dqn::transition_bytes`]).
 fn transition_bytes(obs: usize) -> f64 {
-    8.0 * obs as f64 + 10.0
+    crate::dqn::transition_bytes(obs) as f64
 }
 
 fn parameter_bytes(architecture: &Architecture) -> f64 {
@@ -128,16 +128,16 @@ mod tests {
     #[test]
     fn a_dqn_run_needs_its_network_five_times_and_its_steps_in_replay() {
         // CartPole: 4 inputs, 2 actions; [10]: 10·5 + 2·11 = 72 parameters, 288 bytes.
-        // 100 episodes of at most 500 steps under a capacity of 1,000: 1,000 transitions of
-        // 8·4 + 10 = 42 bytes.
+        // 100 episodes of at most 500 steps under a capacity of 1,000: 1,000 records of
+        // (2·4 + 2)·4 = 40 bytes.
         assert_eq!(
             run_bytes(&dqn_spec(vec![10], 1_000)).unwrap(),
-            5.0 * 288.0 + 42_000.0
+            5.0 * 288.0 + 40_000.0
         );
         // A capacity above the run's steps holds only the steps: 100·500.
         assert_eq!(
             run_bytes(&dqn_spec(vec![10], 1_000_000)).unwrap(),
-            5.0 * 288.0 + 50_000.0 * 42.0
+            5.0 * 288.0 + 50_000.0 * 40.0
         );
     }
 
