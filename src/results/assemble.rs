@@ -128,25 +128,33 @@ fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// Each run's training episodes, from its own `episodes.csv`.
+/// Each run's training episodes, from its own `episodes.csv`, its rows numbered in order
+/// ([`plot_data::in_order`]).
 pub fn training_episodes(folders: &[RunFolder]) -> Result<TrainingRuns> {
     #[derive(Deserialize)]
     struct Row {
+        episode: u32,
         reward: f64,
         steps: u32,
     }
     let mut runs = BTreeMap::new();
     for folder in folders {
         let path = folder.dir.join("episodes.csv");
+        let record = &folder.summary.record;
         let mut reader = crate::safe_io::csv_reader(&path)
             .with_context(|| format!("reading {}", path.display()))?;
         let mut episodes = TrainingEpisodes::default();
+        let run = (record.method.label(), record.run);
+        let mut last = None;
         for (i, row) in reader.deserialize::<Row>().enumerate() {
             let row = row.with_context(|| format!("{}: row {}", path.display(), i + 2))?;
+            if let Some(last) = last {
+                plot_data::in_order(&path, i + 2, "episode", run, last, row.episode)?;
+            }
+            last = Some(row.episode);
             let reward = plot_data::a_kept_return(&path, i, row.reward)?;
             episodes.push(reward, row.steps);
         }
-        let record = &folder.summary.record;
         plot_data::some_returns(&path, record, episodes.len())?;
         runs.insert((record.method.clone(), record.run), Arc::new(episodes));
     }

@@ -36,7 +36,7 @@ pub fn read(dir: &Path) -> Result<PlotData> {
     let config = read_header(dir)?.config;
     let mut episodes = training_episodes(&dir.join("episodes.csv"))?;
     let path = dir.join("tests.csv");
-    let mut tests = ByRunReader::new(&path, "return");
+    let mut tests = ByRunReader::new(&path, "return", "test");
     each_row(&path, |record, headers, at| {
         let row: TestRow = parse(record, headers, &path, at)?;
         tests.push(row.method, row.run, row.test, row.test_return, at)
@@ -116,9 +116,9 @@ fn take_method<T>(map: &mut BTreeMap<(String, u32), T>, label: &str) -> Vec<T> {
 /// `episodes.csv`, in episode order; a return that is not finite, or more values than
 /// [`MAX_VALUES_KEPT`], refused naming the file and the row.
 pub(super) fn training_episodes(path: &Path) -> Result<BTreeMap<(String, u32), TrainingEpisodes>> {
-    let mut returns = ByRunReader::new(path, "reward");
+    let mut returns = ByRunReader::new(path, "reward", "episode");
     // Kept as they are read (a u32 each), not as a return is: 12 bytes an episode.
-    let mut lengths = ByRunReader::<u32>::new(path, "steps");
+    let mut lengths = ByRunReader::<u32>::new(path, "steps", "episode");
     each_row(path, |record, headers, at| {
         let row: EpisodeRow = parse(record, headers, path, at)?;
         returns.push(row.method, row.run, row.episode, row.reward, at)?;
@@ -181,14 +181,38 @@ pub(super) fn some_returns(
     Ok(())
 }
 
-/// Groups `(method, run, index, value)` rows by run as they are read, each run's values in
-/// order of their index (episode or test): runs side by side interleave their rows. A run's
-/// rows come numbered 1, 2, 3… (as sapnet writes them): then only the values are kept, and
-/// the indices only from a run whose rows come in another order.
+/// Refuses row `at` of `path` unless its index (`what`: episode or test) comes after the
+/// `last` one of its run: a run's rows are numbered in order, as sapnet writes them, so a
+/// reader keeps their values in the order read, never an index to sort them by.
+pub(super) fn in_order(
+    path: &Path,
+    at: usize,
+    what: &str,
+    (method, run): (&str, u32),
+    last: u32,
+    index: u32,
+) -> Result<()> {
+    if index <= last {
+        bail!(
+            "{}: row {at}: {what} {index} of {method:?} run {run} comes after its {what} \
+             {last}: a run's rows are read in the order of their {what}, each once, as sapnet \
+             writes them",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// Groups `(method, run, index, value)` rows by run as they are read: runs side by side
+/// interleave their rows. Within a run a row that repeats or goes back is refused where it
+/// is read ([`in_order`]): it kept every index to sort by, which a file of 2^25 rows all
+/// numbered 1 made cost 128 MiB more per column (issue 52's xz bomb, 785 MB in all).
 struct ByRunReader<'p, T = f64> {
     path: &'p Path,
     /// What the value is, for messages (`reward`).
     column: &'static str,
+    /// What the index counts, for messages (`episode`).
+    index: &'static str,
     runs: BTreeMap<String, BTreeMap<u32, Series<T>>>,
     kept: usize,
 }
@@ -212,27 +236,25 @@ impl Kept for u32 {
 
 struct Series<T> {
     values: Chunked<T>,
-    /// The first row's index: the rows in order are `first`, `first + 1`, ….
-    first: u32,
-    /// Every row's index, once one broke the order.
-    indices: Option<Chunked<u32>>,
+    /// The last row's index: the next one's is greater.
+    last: u32,
 }
 
 impl<T> Default for Series<T> {
     fn default() -> Self {
         Self {
             values: Chunked::default(),
-            first: 0,
-            indices: None,
+            last: 0,
         }
     }
 }
 
 impl<'p, T: Kept> ByRunReader<'p, T> {
-    fn new(path: &'p Path, column: &'static str) -> Self {
+    fn new(path: &'p Path, column: &'static str, index: &'static str) -> Self {
         Self {
             path,
             column,
+            index,
             runs: BTreeMap::new(),
             kept: 0,
         }
@@ -253,21 +275,10 @@ impl<'p, T: Kept> ByRunReader<'p, T> {
             None => self.runs.entry(method.to_string()).or_default(),
         };
         let series = runs.entry(run).or_default();
-        if series.values.is_empty() {
-            series.first = index;
+        if !series.values.is_empty() {
+            in_order(self.path, at, self.index, (method, run), series.last, index)?;
         }
-        let next = u64::from(series.first) + series.values.len() as u64;
-        if series.indices.is_none() && u64::from(index) != next {
-            let first = series.first;
-            let mut indices = Chunked::default();
-            for i in 0..series.values.len() as u32 {
-                indices.push(first + i);
-            }
-            series.indices = Some(indices);
-        }
-        if let Some(indices) = &mut series.indices {
-            indices.push(index);
-        }
+        series.last = index;
         series.values.push(value);
         Ok(())
     }
@@ -276,17 +287,7 @@ impl<'p, T: Kept> ByRunReader<'p, T> {
         let mut by_run = BTreeMap::new();
         for (method, runs) in self.runs {
             for (run, series) in runs {
-                let values = series.values.into_vec();
-                let values = match series.indices {
-                    None => values,
-                    Some(indices) => {
-                        let mut pairs: Vec<(u32, T)> =
-                            indices.into_vec().into_iter().zip(values).collect();
-                        pairs.sort_by_key(|&(index, _)| index);
-                        pairs.into_iter().map(|(_, v)| v).collect()
-                    }
-                };
-                by_run.insert((method.clone(), run), values);
+                by_run.insert((method.clone(), run), series.values.into_vec());
             }
         }
         by_run
@@ -325,10 +326,6 @@ impl<T: Copy> Chunked<T> {
             }
         }
         self.len += 1;
-    }
-
-    fn len(&self) -> usize {
-        self.len
     }
 
     fn is_empty(&self) -> bool {
