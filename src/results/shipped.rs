@@ -39,6 +39,17 @@ pub fn can_replot(dir: &Path) -> bool {
 /// what its report is made of (`episodes.csv` or, as `docs/` ships it, `episodes.csv.xz`).
 /// Refused for a protocol that did not finish.
 pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
+    runs_reading(dir, header, episodes)
+}
+
+/// [`runs`], the training episodes read by `read` ([`episodes`]: the folder's
+/// `episodes.csv`, the config's methods): a reader that holds them from a read before
+/// hands them over instead of reading them again.
+pub fn runs_reading(
+    dir: &Path,
+    header: &SummaryHeader,
+    read: impl FnOnce(&Path, &[MethodId]) -> Result<TrainingRuns>,
+) -> Result<ShippedRuns> {
     if !matches!(header.status, None | Some(Status::Complete)) {
         bail!(
             "{}: a protocol that did not finish (summary.json: status {:?}) and has no run \
@@ -75,7 +86,7 @@ pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
         };
         runs.push(run.with_method(method.clone()));
     }
-    let episodes = episodes(&dir.join("episodes.csv"), &methods)?;
+    let episodes = read(&dir.join("episodes.csv"), &methods)?;
     for run in &runs {
         let key = (run.record.method.clone(), run.record.run);
         let count = episodes.get(&key).map_or(0, |e| e.len());
@@ -121,7 +132,7 @@ pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
 }
 
 /// Each run's training episodes from the folder's `episodes.csv`, keyed by its method.
-fn episodes(path: &Path, methods: &[MethodId]) -> Result<TrainingRuns> {
+pub fn episodes(path: &Path, methods: &[MethodId]) -> Result<TrainingRuns> {
     plot_data::training_episodes(path)?
         .into_iter()
         .map(|((label, run), episodes)| {
