@@ -89,7 +89,9 @@ pub fn assemble(
     if !summary.runs.is_empty() {
         report.write(out)?;
         crate::failpoint::point("report-written");
-        let data = plot_data::read(out)?;
+        // The plots read the returns again, from the top-level file: not beside these.
+        drop(episodes);
+        let data = plot_data::read_expecting(out, &plot_data::EpisodeCounts::of(&summary.runs))?;
         plots::write_all(out, &data)
             .with_context(|| format!("drawing the plots in {}", out.display()))?;
         crate::failpoint::point("plots-drawn");
@@ -129,7 +131,9 @@ fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<
 }
 
 /// Each run's training episodes, from its own `episodes.csv`, its rows numbered in order
-/// ([`plot_data::in_order`]).
+/// ([`plot_data::in_order`]): kept in one block of the episodes its record counts (a
+/// vector grown as rows come would hold one and a half times a large run's values while
+/// it moves them), more rows than that in chunks.
 pub fn training_episodes(folders: &[RunFolder]) -> Result<TrainingRuns> {
     #[derive(Deserialize)]
     struct Row {
@@ -143,7 +147,9 @@ pub fn training_episodes(folders: &[RunFolder]) -> Result<TrainingRuns> {
         let record = &folder.summary.record;
         let mut reader = crate::safe_io::csv_reader(&path)
             .with_context(|| format!("reading {}", path.display()))?;
-        let mut episodes = TrainingEpisodes::default();
+        let expected = (record.episodes as usize).min(crate::limits::MAX_VALUES_KEPT);
+        let mut returns = plot_data::Chunked::with_capacity(expected);
+        let mut lengths = plot_data::Chunked::with_capacity(expected);
         let run = (record.method.label(), record.run);
         let mut last = None;
         for (i, row) in reader.deserialize::<Row>().enumerate() {
@@ -152,9 +158,13 @@ pub fn training_episodes(folders: &[RunFolder]) -> Result<TrainingRuns> {
                 plot_data::in_order(&path, i + 2, "episode", run, last, row.episode)?;
             }
             last = Some(row.episode);
-            let reward = plot_data::a_kept_return(&path, i, row.reward)?;
-            episodes.push(reward, row.steps);
+            returns.push(plot_data::a_kept_return(&path, i, row.reward)?);
+            lengths.push(row.steps);
         }
+        let episodes = TrainingEpisodes {
+            returns: returns.into_vec(),
+            lengths: lengths.into_vec(),
+        };
         plot_data::some_returns(&path, record, episodes.len())?;
         runs.insert((record.method.clone(), record.run), Arc::new(episodes));
     }

@@ -301,13 +301,13 @@ impl FolderReader {
         // Seen before the read: a change during it is a change at the next.
         let seen = folder_changes::files(dir, &SHIPPED_FILES);
         let cache = &mut self.shipped;
-        let shipped = super::shipped::runs_reading(dir, &header, |path, methods| {
+        let shipped = super::shipped::runs_reading(dir, &header, |path, methods, runs| {
             if let Some((_, episodes)) = cache.as_ref().filter(|(before, _)| *before == seen) {
                 return Ok(episodes.clone());
             }
             // What this reader held goes before the read, not after it.
             *cache = None;
-            let episodes = super::shipped::episodes(path, methods)?;
+            let episodes = super::shipped::episodes(path, methods, runs)?;
             *cache = Some((seen, episodes.clone()));
             Ok(episodes)
         })?;
