@@ -103,15 +103,29 @@ pub fn assemble(
 
 /// Writes `path` as a header (`create` makes an empty file with it) followed by the rows of
 /// every part, in order, each part's own header skipped; through a temporary file renamed
-/// into place.
+/// into place, removed if a part is refused (a part's xz bomb left a gigabyte there).
 fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<()>) -> Result<()> {
     let tmp = crate::safe_io::sibling(path, "tmp");
-    create(&tmp)?;
+    let written = write_parts(path, &tmp, parts, create);
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
+}
+
+/// [`concatenate`]'s writing, into `tmp`.
+fn write_parts(
+    path: &Path,
+    tmp: &Path,
+    parts: &[PathBuf],
+    create: impl Fn(&Path) -> Result<()>,
+) -> Result<()> {
+    create(tmp)?;
     // Opened again for appending, never through a link (create made a regular file).
     let mut file = OpenOptions::new()
         .append(true)
         .custom_flags(libc::O_NOFOLLOW)
-        .open(&tmp)
+        .open(tmp)
         .with_context(|| format!("writing {}", tmp.display()))?;
     for part in parts {
         let text = crate::safe_io::open_csv(part)
@@ -126,7 +140,7 @@ fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<
     }
     file.flush()
         .and_then(|()| file.sync_all())
-        .and_then(|()| std::fs::rename(&tmp, path))
+        .and_then(|()| std::fs::rename(tmp, path))
         .with_context(|| format!("writing {}", path.display()))
 }
 

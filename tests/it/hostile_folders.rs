@@ -1608,6 +1608,31 @@ fn plot_keeps_a_run_kept_only_compressed() {
     assert_eq!(after.lines().count(), before.lines().count());
 }
 
+/// `plot` refusing a run's xz twin leaves no part of the episodes.csv it was putting
+/// together (a bomb's left a gigabyte in the folder, refused at the bound on what it
+/// decompresses to).
+#[test]
+fn plot_refusing_a_runs_twin_leaves_nothing_half_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("results");
+    ok(dqn(&out, &[]).output().unwrap());
+    let part = out.join("runs/dqn-16-run1/episodes.csv");
+    let mut xz = Vec::new();
+    lzma_rs::xz_compress(&mut &std::fs::read(&part).unwrap()[..], &mut xz).unwrap();
+    std::fs::write(part.with_extension("csv.xz"), &xz[..xz.len() / 2]).unwrap();
+    std::fs::remove_file(&part).unwrap();
+    refused(
+        sapnet().arg("plot").arg(&out).output().unwrap(),
+        "episodes.csv.xz: truncated",
+    );
+    let left: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.contains(".tmp"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
 /// Item 9: SIGTERM to `sapnet open` leaves the alternate screen and raw mode, exit 143.
 #[test]
 fn sigterm_restores_the_terminal_of_sapnet_open() {
