@@ -1177,8 +1177,9 @@ fn untextual_paths_and_number_mistakes_are_said_before_anything_runs() {
 }
 
 // Issue 52: bounded everywhere. Each test is built from the issue's reproducer; memory is
-// checked only where a bound refuses before allocating (the peaks are measured by hand:
-// see docs/dev/reliability.md).
+// checked where a bound refuses before allocating, and as the peak of the sapnet process
+// (wait4, or VmHWM in tmux) on a case a test can make in seconds; the full-size peaks are
+// measured by hand (docs/dev/reliability.md, scripts/hostile/).
 
 /// A copy of `docs/cartpole/`'s data files (`summary.json`, `episodes.csv.xz`): a shipped
 /// folder, read by `plot` and `open` from its top-level files.
