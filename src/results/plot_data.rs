@@ -237,7 +237,7 @@ impl<'a> EpisodeCounts<'a> {
 /// Groups `(method, run, index, value)` rows by run as they are read: runs side by side
 /// interleave their rows. Within a run a row that repeats or goes back is refused where it
 /// is read ([`in_order`]): it kept every index to sort by, which a file of 2^25 rows all
-/// numbered 1 made cost 128 MiB more per column (issue 52's xz bomb, 785 MB in all).
+/// numbered 1 made cost 128 MiB more per column (issue 52's xz bomb, 804 MB in all).
 struct ByRunReader<'p, T = f64> {
     path: &'p Path,
     /// What the value is, for messages (`reward`).
@@ -292,7 +292,7 @@ impl<'p, T: Kept> ByRunReader<'p, T> {
     /// Each run's values kept in one block made for its expected rows, as many as the
     /// reader keeps at most: read into chunks, a folder's runs would be copied into their
     /// blocks at the end, and the chunks left to the allocator would cost as much again
-    /// (a folder of 24 M episodes peaked at 530 MB for 288 MB of values).
+    /// (a folder of 24 M episodes peaked at 557 MB for 288 MB of values).
     fn expecting(mut self, counts: &'p EpisodeCounts<'p>) -> Self {
         self.counts = Some(counts);
         self

@@ -1402,7 +1402,7 @@ fn xz_tool(args: &[&str], input: &[u8]) -> Option<Vec<u8>> {
 /// Issue 52's done-when: a 229 KB xz bomb of 1.5 GiB is refused by `plot` and `open`
 /// within 600 MB of peak memory. Its rows all say episode 1 of run 0: read to the bound
 /// on values kept (2^25 rows), with an index kept per column to sort them by, it peaked
-/// at 785 MB; a row that repeats its run's episode is now refused where it is read. Made
+/// at 804 MB; a row that repeats its run's episode is now refused where it is read. Made
 /// as `scripts/hostile/xz_bomb.py` makes it, of `xz -9` streams one after another (16 MiB
 /// of rows each, its 64 MiB dictionary declared) instead of one, to be made in a second.
 #[test]
@@ -1520,7 +1520,7 @@ fn open_and_enter_peak_kib(tmp: &Path, dir: &Path) -> u64 {
 /// down to 3 M rows: `open` and Enter cost at most half as much again as the 36 MB of
 /// values beyond what the same folder costs with 3,000 rows. (It cost 2.4 times them: the
 /// first read's values copied out of their chunks, and a second read of the whole folder
-/// for the comparison while the first was shown; the whole folder peaked at 775-832 MB.)
+/// for the comparison while the first was shown; the whole folder peaked at 793-852 MB.)
 #[test]
 fn a_folder_of_millions_of_rows_opens_and_enter_costs_about_its_values() {
     if !crate::common::tmux::available() {
