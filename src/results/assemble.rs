@@ -89,7 +89,9 @@ pub fn assemble(
     if !summary.runs.is_empty() {
         report.write(out)?;
         crate::failpoint::point("report-written");
-        let data = plot_data::read(out)?;
+        // The plots read the returns again, from the top-level file: not beside these.
+        drop(episodes);
+        let data = plot_data::read_expecting(out, &plot_data::EpisodeCounts::of(&summary.runs))?;
         plots::write_all(out, &data)
             .with_context(|| format!("drawing the plots in {}", out.display()))?;
         crate::failpoint::point("plots-drawn");
@@ -101,15 +103,29 @@ pub fn assemble(
 
 /// Writes `path` as a header (`create` makes an empty file with it) followed by the rows of
 /// every part, in order, each part's own header skipped; through a temporary file renamed
-/// into place.
+/// into place, removed if a part is refused (a part's xz bomb left a gigabyte there).
 fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<()>) -> Result<()> {
     let tmp = crate::safe_io::sibling(path, "tmp");
-    create(&tmp)?;
+    let written = write_parts(path, &tmp, parts, create);
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
+}
+
+/// [`concatenate`]'s writing, into `tmp`.
+fn write_parts(
+    path: &Path,
+    tmp: &Path,
+    parts: &[PathBuf],
+    create: impl Fn(&Path) -> Result<()>,
+) -> Result<()> {
+    create(tmp)?;
     // Opened again for appending, never through a link (create made a regular file).
     let mut file = OpenOptions::new()
         .append(true)
         .custom_flags(libc::O_NOFOLLOW)
-        .open(&tmp)
+        .open(tmp)
         .with_context(|| format!("writing {}", tmp.display()))?;
     for part in parts {
         let text = crate::safe_io::open_csv(part)
@@ -124,29 +140,45 @@ fn concatenate(path: &Path, parts: &[PathBuf], create: impl Fn(&Path) -> Result<
     }
     file.flush()
         .and_then(|()| file.sync_all())
-        .and_then(|()| std::fs::rename(&tmp, path))
+        .and_then(|()| std::fs::rename(tmp, path))
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// Each run's training episodes, from its own `episodes.csv`.
+/// Each run's training episodes, from its own `episodes.csv`, its rows numbered in order
+/// ([`plot_data::in_order`]): kept in one block of the episodes its record counts (a
+/// vector grown as rows come would hold one and a half times a large run's values while
+/// it moves them), more rows than that in chunks.
 pub fn training_episodes(folders: &[RunFolder]) -> Result<TrainingRuns> {
     #[derive(Deserialize)]
     struct Row {
+        episode: u32,
         reward: f64,
         steps: u32,
     }
     let mut runs = BTreeMap::new();
     for folder in folders {
         let path = folder.dir.join("episodes.csv");
+        let record = &folder.summary.record;
         let mut reader = crate::safe_io::csv_reader(&path)
             .with_context(|| format!("reading {}", path.display()))?;
-        let mut episodes = TrainingEpisodes::default();
+        let expected = (record.episodes as usize).min(crate::limits::MAX_VALUES_KEPT);
+        let mut returns = plot_data::Chunked::with_capacity(expected);
+        let mut lengths = plot_data::Chunked::with_capacity(expected);
+        let run = (record.method.label(), record.run);
+        let mut last = None;
         for (i, row) in reader.deserialize::<Row>().enumerate() {
             let row = row.with_context(|| format!("{}: row {}", path.display(), i + 2))?;
-            let reward = plot_data::a_kept_return(&path, i, row.reward)?;
-            episodes.push(reward, row.steps);
+            if let Some(last) = last {
+                plot_data::in_order(&path, i + 2, "episode", run, last, row.episode)?;
+            }
+            last = Some(row.episode);
+            returns.push(plot_data::a_kept_return(&path, i, row.reward)?);
+            lengths.push(row.steps);
         }
-        let record = &folder.summary.record;
+        let episodes = TrainingEpisodes {
+            returns: returns.into_vec(),
+            lengths: lengths.into_vec(),
+        };
         plot_data::some_returns(&path, record, episodes.len())?;
         runs.insert((record.method.clone(), record.run), Arc::new(episodes));
     }

@@ -22,12 +22,17 @@ pub struct Look {
 
 /// A file's identity, size and times.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-struct Stat {
+pub(super) struct Stat {
     dev: u64,
     ino: u64,
     len: u64,
     mtime: (i64, i64),
     ctime: (i64, i64),
+}
+
+/// What is seen of the files `names` of `dir`: equal when none was written between.
+pub(super) fn files(dir: &Path, names: &[&str]) -> Vec<Option<Stat>> {
+    names.iter().map(|name| stat(&dir.join(name))).collect()
 }
 
 fn stat(path: &Path) -> Option<Stat> {
@@ -48,17 +53,17 @@ pub fn look(dir: &Path) -> Look {
         .flatten()
         .map(|h| h.pid);
     let runs = dir.join(RUNS);
-    let mut files: Vec<Option<Stat>> = [
-        "summary.json",
-        "episodes.csv",
-        "episodes.csv.xz",
-        "activations.csv",
-        "activations.csv.xz",
-    ]
-    .iter()
-    .map(|name| stat(&dir.join(name)))
-    .chain([stat(&runs)])
-    .collect();
+    let mut files = files(
+        dir,
+        &[
+            "summary.json",
+            "episodes.csv",
+            "episodes.csv.xz",
+            "activations.csv",
+            "activations.csv.xz",
+        ],
+    );
+    files.push(stat(&runs));
     // A run in training grows its partial record without renaming anything; only a
     // writer does that, so only then are they looked at.
     if writer.is_some() {

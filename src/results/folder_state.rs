@@ -17,6 +17,7 @@ use std::sync::Arc;
 use anyhow::{Context, Result};
 use serde::Deserialize;
 
+use super::folder_changes::{self, Stat};
 use super::records::{self, run_name, RunFolder};
 use super::summary::{read_header, Status};
 use crate::config::{Budget, Config};
@@ -186,17 +187,27 @@ impl FolderState {
 }
 
 /// Reads a folder again and again (`sapnet open` refreshes), reading each finished run's
-/// returns once: a record in `runs/` never changes while its folder is there.
+/// returns once: a record in `runs/` never changes while its folder is there. A shipped
+/// folder's returns are read again only when its files changed: its first read again (the
+/// one that makes the report, right after the screen opens) would otherwise hold a second
+/// copy of every return beside the one shown, twice the data of a large folder.
 pub struct FolderReader {
     dir: PathBuf,
     finished_returns: BTreeMap<(String, u32), Arc<TrainingEpisodes>>,
+    /// A shipped folder's returns, with what was seen of its files before they were read.
+    shipped: Option<(Vec<Option<Stat>>, TrainingRuns)>,
 }
+
+/// The files a shipped folder's returns are read from ([`super::shipped::runs`]): its
+/// config and methods, and its episodes.
+const SHIPPED_FILES: [&str; 3] = ["summary.json", "episodes.csv", "episodes.csv.xz"];
 
 impl FolderReader {
     pub fn new(dir: &Path) -> Self {
         Self {
             dir: dir.to_path_buf(),
             finished_returns: BTreeMap::new(),
+            shipped: None,
         }
     }
 
@@ -210,7 +221,7 @@ impl FolderReader {
         let dir = &self.dir.clone();
         let header = read_header(dir)?;
         if !header.listed_runs.is_empty() && !records::any(dir)? {
-            return shipped(dir, header);
+            return self.shipped(dir, header);
         }
         let writer = folder_lock::holder(dir)?;
         let config = header.config;
@@ -281,13 +292,36 @@ impl FolderReader {
         self.finished_returns.insert(key, returns.clone());
         Ok(returns)
     }
+
+    /// A folder shipped with its top-level files only (`docs/`'s: no run records), read
+    /// from `summary.json` and `episodes.csv` as `sapnet plot` reads it
+    /// ([`super::shipped::runs`]), its returns those of the last read while its files are
+    /// unchanged.
+    fn shipped(&mut self, dir: &Path, header: super::SummaryHeader) -> Result<FolderState> {
+        // Seen before the read: a change during it is a change at the next.
+        let seen = folder_changes::files(dir, &SHIPPED_FILES);
+        let cache = &mut self.shipped;
+        let shipped = super::shipped::runs_reading(dir, &header, |path, methods, runs| {
+            if let Some((_, episodes)) = cache.as_ref().filter(|(before, _)| *before == seen) {
+                return Ok(episodes.clone());
+            }
+            // What this reader held goes before the read, not after it.
+            *cache = None;
+            let episodes = super::shipped::episodes(path, methods, runs)?;
+            *cache = Some((seen, episodes.clone()));
+            Ok(episodes)
+        })?;
+        shipped_state(dir, header, shipped)
+    }
 }
 
-/// A folder shipped with its top-level files only (`docs/`'s: no run records), read from
-/// `summary.json` and `episodes.csv` as `sapnet plot` reads it ([`super::shipped::runs`]):
-/// a finished protocol, every run it lists done (or stopped), the others not run.
-fn shipped(dir: &Path, header: super::SummaryHeader) -> Result<FolderState> {
-    let shipped = super::shipped::runs(dir, &header)?;
+/// A shipped folder's state: a finished protocol, every run it lists done (or stopped),
+/// the others not run.
+fn shipped_state(
+    dir: &Path,
+    header: super::SummaryHeader,
+    shipped: super::shipped::ShippedRuns,
+) -> Result<FolderState> {
     let writer = folder_lock::holder(dir)?;
     let config = header.config;
     let library = header.library.unwrap_or_default();

@@ -11,7 +11,7 @@ use serde::Deserialize;
 use super::summary::read_header;
 use crate::limits::MAX_VALUES_KEPT;
 use crate::report::plots::{Curve, PlotData, SelectionHistory};
-use crate::report::TrainingEpisodes;
+use crate::report::{RunSummary, TrainingEpisodes};
 
 #[derive(Deserialize)]
 struct EpisodeRow<'a> {
@@ -33,10 +33,15 @@ struct TestRow<'a> {
 
 /// The plots' data, from the files of a results directory.
 pub fn read(dir: &Path) -> Result<PlotData> {
+    read_expecting(dir, &EpisodeCounts::default())
+}
+
+/// [`read`], each run's returns kept in a block of the episodes `counts` gives it.
+pub(super) fn read_expecting(dir: &Path, counts: &EpisodeCounts) -> Result<PlotData> {
     let config = read_header(dir)?.config;
-    let mut episodes = training_episodes(&dir.join("episodes.csv"))?;
+    let mut episodes = training_episodes(&dir.join("episodes.csv"), counts)?;
     let path = dir.join("tests.csv");
-    let mut tests = ByRunReader::new(&path, "return");
+    let mut tests = ByRunReader::new(&path, "return", "test");
     each_row(&path, |record, headers, at| {
         let row: TestRow = parse(record, headers, &path, at)?;
         tests.push(row.method, row.run, row.test, row.test_return, at)
@@ -114,11 +119,15 @@ fn take_method<T>(map: &mut BTreeMap<(String, u32), T>, label: &str) -> Vec<T> {
 
 /// Each run's training episodes (return and length) from a results folder's
 /// `episodes.csv`, in episode order; a return that is not finite, or more values than
-/// [`MAX_VALUES_KEPT`], refused naming the file and the row.
-pub(super) fn training_episodes(path: &Path) -> Result<BTreeMap<(String, u32), TrainingEpisodes>> {
-    let mut returns = ByRunReader::new(path, "reward");
+/// [`MAX_VALUES_KEPT`], refused naming the file and the row. Each run's are kept in a
+/// block of the episodes `counts` gives it.
+pub(super) fn training_episodes(
+    path: &Path,
+    counts: &EpisodeCounts,
+) -> Result<BTreeMap<(String, u32), TrainingEpisodes>> {
+    let mut returns = ByRunReader::new(path, "reward", "episode").expecting(counts);
     // Kept as they are read (a u32 each), not as a return is: 12 bytes an episode.
-    let mut lengths = ByRunReader::<u32>::new(path, "steps");
+    let mut lengths = ByRunReader::<u32>::new(path, "steps", "episode").expecting(counts);
     each_row(path, |record, headers, at| {
         let row: EpisodeRow = parse(record, headers, path, at)?;
         returns.push(row.method, row.run, row.episode, row.reward, at)?;
@@ -181,16 +190,67 @@ pub(super) fn some_returns(
     Ok(())
 }
 
-/// Groups `(method, run, index, value)` rows by run as they are read, each run's values in
-/// order of their index (episode or test): runs side by side interleave their rows. A run's
-/// rows come numbered 1, 2, 3… (as sapnet writes them): then only the values are kept, and
-/// the indices only from a run whose rows come in another order.
+/// Refuses row `at` of `path` unless its index (`what`: episode or test) comes after the
+/// `last` one of its run: a run's rows are numbered in order, as sapnet writes them, so a
+/// reader keeps their values in the order read, never an index to sort them by.
+pub(super) fn in_order(
+    path: &Path,
+    at: usize,
+    what: &str,
+    (method, run): (&str, u32),
+    last: u32,
+    index: u32,
+) -> Result<()> {
+    if index <= last {
+        bail!(
+            "{}: row {at}: {what} {index} of {method:?} run {run} comes after its {what} \
+             {last}: a run's rows are read in the order of their {what}, each once, as sapnet \
+             writes them",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// How many episodes each run has, as its record says (none when not given): the room a
+/// reader makes for its values, so that they are read where they will stay.
+#[derive(Default)]
+pub(super) struct EpisodeCounts<'a>(BTreeMap<(&'a str, u32), usize>);
+
+impl<'a> EpisodeCounts<'a> {
+    pub(super) fn of(runs: &'a [RunSummary]) -> Self {
+        let count = |r: &'a RunSummary| {
+            let record = &r.record;
+            (
+                (record.method.label(), record.run),
+                record.episodes as usize,
+            )
+        };
+        Self(runs.iter().map(count).collect())
+    }
+
+    fn of_run(&self, method: &str, run: u32) -> usize {
+        self.0.get(&(method, run)).copied().unwrap_or(0)
+    }
+}
+
+/// Groups `(method, run, index, value)` rows by run as they are read: runs side by side
+/// interleave their rows. Within a run a row that repeats or goes back is refused where it
+/// is read ([`in_order`]): it kept every index to sort by, which a file of 2^25 rows all
+/// numbered 1 made cost 128 MiB more per column (issue 52's xz bomb, 804 MB in all).
 struct ByRunReader<'p, T = f64> {
     path: &'p Path,
     /// What the value is, for messages (`reward`).
     column: &'static str,
+    /// What the index counts, for messages (`episode`).
+    index: &'static str,
     runs: BTreeMap<String, BTreeMap<u32, Series<T>>>,
     kept: usize,
+    /// The rows each run is expected to have.
+    counts: Option<&'p EpisodeCounts<'p>>,
+    /// Room made for expected rows so far: at most [`MAX_VALUES_KEPT`], whatever the
+    /// counts say.
+    reserved: usize,
 }
 
 /// A value a [`ByRunReader`] keeps: a return (refused unless finite) or a length.
@@ -212,30 +272,30 @@ impl Kept for u32 {
 
 struct Series<T> {
     values: Chunked<T>,
-    /// The first row's index: the rows in order are `first`, `first + 1`, ….
-    first: u32,
-    /// Every row's index, once one broke the order.
-    indices: Option<Chunked<u32>>,
-}
-
-impl<T> Default for Series<T> {
-    fn default() -> Self {
-        Self {
-            values: Chunked::default(),
-            first: 0,
-            indices: None,
-        }
-    }
+    /// The last row's index: the next one's is greater.
+    last: u32,
 }
 
 impl<'p, T: Kept> ByRunReader<'p, T> {
-    fn new(path: &'p Path, column: &'static str) -> Self {
+    fn new(path: &'p Path, column: &'static str, index: &'static str) -> Self {
         Self {
             path,
             column,
+            index,
             runs: BTreeMap::new(),
             kept: 0,
+            counts: None,
+            reserved: 0,
         }
+    }
+
+    /// Each run's values kept in one block made for its expected rows, as many as the
+    /// reader keeps at most: read into chunks, a folder's runs would be copied into their
+    /// blocks at the end, and the chunks left to the allocator would cost as much again
+    /// (a folder of 24 M episodes peaked at 557 MB for 288 MB of values).
+    fn expecting(mut self, counts: &'p EpisodeCounts<'p>) -> Self {
+        self.counts = Some(counts);
+        self
     }
 
     fn push(&mut self, method: &str, run: u32, index: u32, value: T, at: usize) -> Result<()> {
@@ -252,22 +312,19 @@ impl<'p, T: Kept> ByRunReader<'p, T> {
             Some(runs) => runs,
             None => self.runs.entry(method.to_string()).or_default(),
         };
-        let series = runs.entry(run).or_default();
-        if series.values.is_empty() {
-            series.first = index;
-        }
-        let next = u64::from(series.first) + series.values.len() as u64;
-        if series.indices.is_none() && u64::from(index) != next {
-            let first = series.first;
-            let mut indices = Chunked::default();
-            for i in 0..series.values.len() as u32 {
-                indices.push(first + i);
+        let series = runs.entry(run).or_insert_with(|| {
+            let expected = self.counts.map_or(0, |counts| counts.of_run(method, run));
+            let room = expected.min(MAX_VALUES_KEPT - self.reserved);
+            self.reserved += room;
+            Series {
+                values: Chunked::with_capacity(room),
+                last: 0,
             }
-            series.indices = Some(indices);
+        });
+        if !series.values.is_empty() {
+            in_order(self.path, at, self.index, (method, run), series.last, index)?;
         }
-        if let Some(indices) = &mut series.indices {
-            indices.push(index);
-        }
+        series.last = index;
         series.values.push(value);
         Ok(())
     }
@@ -276,35 +333,35 @@ impl<'p, T: Kept> ByRunReader<'p, T> {
         let mut by_run = BTreeMap::new();
         for (method, runs) in self.runs {
             for (run, series) in runs {
-                let values = series.values.into_vec();
-                let values = match series.indices {
-                    None => values,
-                    Some(indices) => {
-                        let mut pairs: Vec<(u32, T)> =
-                            indices.into_vec().into_iter().zip(values).collect();
-                        pairs.sort_by_key(|&(index, _)| index);
-                        pairs.into_iter().map(|(_, v)| v).collect()
-                    }
-                };
-                by_run.insert((method.clone(), run), values);
+                by_run.insert((method.clone(), run), series.values.into_vec());
             }
         }
         by_run
     }
 }
 
-/// Values kept in chunks of about a mebibyte: grown a chunk at a time, never copied into
-/// a larger block as a `Vec` grows (which would hold the old block and the new, twice the
-/// data, and leave the old ones to the allocator), so what a file's rows cost is the
-/// values themselves.
-struct Chunked<T> {
+/// Values kept in the block made for those expected, then in chunks of about a mebibyte:
+/// grown a chunk at a time, never copied into a larger block as a `Vec` grows (which
+/// would hold the old block and the new, twice the data, and leave the old ones to the
+/// allocator), so what a file's rows cost is the values themselves.
+pub(super) struct Chunked<T> {
+    /// The values expected, in the block they are handed over in.
+    block: Vec<T>,
+    /// The values past the block's room.
     chunks: Vec<Vec<T>>,
     len: usize,
 }
 
 impl<T> Default for Chunked<T> {
     fn default() -> Self {
+        Self::with_capacity(0)
+    }
+}
+
+impl<T> Chunked<T> {
+    pub(super) fn with_capacity(expected: usize) -> Self {
         Self {
+            block: Vec::with_capacity(expected),
             chunks: Vec::new(),
             len: 0,
         }
@@ -315,7 +372,12 @@ impl<T: Copy> Chunked<T> {
     /// A chunk's values: a mebibyte, less room for the allocator's own bookkeeping.
     const CHUNK: usize = ((1 << 20) - 512) / std::mem::size_of::<T>();
 
-    fn push(&mut self, value: T) {
+    pub(super) fn push(&mut self, value: T) {
+        self.len += 1;
+        if self.block.len() < self.block.capacity() {
+            self.block.push(value);
+            return;
+        }
         match self.chunks.last_mut() {
             Some(chunk) if chunk.len() < Self::CHUNK => chunk.push(value),
             _ => {
@@ -324,20 +386,21 @@ impl<T: Copy> Chunked<T> {
                 self.chunks.push(chunk);
             }
         }
-        self.len += 1;
-    }
-
-    fn len(&self) -> usize {
-        self.len
     }
 
     fn is_empty(&self) -> bool {
         self.len == 0
     }
 
-    /// The values in one block.
-    fn into_vec(self) -> Vec<T> {
-        let mut values = Vec::with_capacity(self.len);
+    /// The values in one block: the block made for them when they were as many as
+    /// expected; room expected and not used is given back.
+    pub(super) fn into_vec(self) -> Vec<T> {
+        let mut values = self.block;
+        if self.chunks.is_empty() {
+            values.shrink_to_fit();
+            return values;
+        }
+        values.reserve_exact(self.len - values.len());
         for chunk in self.chunks {
             values.extend_from_slice(&chunk);
         }

@@ -39,6 +39,17 @@ pub fn can_replot(dir: &Path) -> bool {
 /// what its report is made of (`episodes.csv` or, as `docs/` ships it, `episodes.csv.xz`).
 /// Refused for a protocol that did not finish.
 pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
+    runs_reading(dir, header, episodes)
+}
+
+/// [`runs`], the training episodes read by `read` ([`episodes`]: the folder's
+/// `episodes.csv`, the config's methods, the runs listed): a reader that holds them from a
+/// read before hands them over instead of reading them again.
+pub fn runs_reading(
+    dir: &Path,
+    header: &SummaryHeader,
+    read: impl FnOnce(&Path, &[MethodId], &[RunSummary]) -> Result<TrainingRuns>,
+) -> Result<ShippedRuns> {
     if !matches!(header.status, None | Some(Status::Complete)) {
         bail!(
             "{}: a protocol that did not finish (summary.json: status {:?}) and has no run \
@@ -75,7 +86,7 @@ pub fn runs(dir: &Path, header: &SummaryHeader) -> Result<ShippedRuns> {
         };
         runs.push(run.with_method(method.clone()));
     }
-    let episodes = episodes(&dir.join("episodes.csv"), &methods)?;
+    let episodes = read(&dir.join("episodes.csv"), &methods, &runs)?;
     for run in &runs {
         let key = (run.record.method.clone(), run.record.run);
         let count = episodes.get(&key).map_or(0, |e| e.len());
@@ -105,7 +116,9 @@ pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
         episodes: &episodes,
     }]);
     report.write(dir)?;
-    let data = plot_data::read(dir)?;
+    // The plots read the returns again, as they read any folder's: not beside these.
+    drop(episodes);
+    let data = plot_data::read_expecting(dir, &plot_data::EpisodeCounts::of(&runs))?;
     plots::write_all(dir, &data)
         .with_context(|| format!("drawing the plots in {}", dir.display()))?;
     let mut summary = Summary::new(&config, header.trace);
@@ -120,9 +133,10 @@ pub fn replot(dir: &Path, header: SummaryHeader) -> Result<Summary> {
     Ok(summary)
 }
 
-/// Each run's training episodes from the folder's `episodes.csv`, keyed by its method.
-fn episodes(path: &Path, methods: &[MethodId]) -> Result<TrainingRuns> {
-    plot_data::training_episodes(path)?
+/// Each run's training episodes from the folder's `episodes.csv`, keyed by its method,
+/// each kept in a block of the episodes `runs` says it has.
+pub fn episodes(path: &Path, methods: &[MethodId], runs: &[RunSummary]) -> Result<TrainingRuns> {
+    plot_data::training_episodes(path, &plot_data::EpisodeCounts::of(runs))?
         .into_iter()
         .map(|((label, run), episodes)| {
             let Some(method) = methods.iter().find(|m| m.label() == label) else {
