@@ -30,8 +30,10 @@ fn filled(stored: usize) -> ReplayBuffer {
     let mut obs = [0f32; OBS];
     let mut next = [0f32; OBS];
     for i in 0..stored {
-        obs.iter_mut().for_each(|x| *x = rng.random_range(-2.0..2.0));
-        next.iter_mut().for_each(|x| *x = rng.random_range(-2.0..2.0));
+        obs.iter_mut()
+            .for_each(|x| *x = rng.random_range(-2.0..2.0));
+        next.iter_mut()
+            .for_each(|x| *x = rng.random_range(-2.0..2.0));
         replay.push(Transition {
             obs: &obs,
             action: i % 2,

@@ -35,7 +35,10 @@ mod tag {
     const TRUNCATED: u32 = 1 << 30;
 
     pub fn pack(action: usize, terminated: bool, truncated: bool) -> f32 {
-        assert!(action < ACTIONS, "action index {action} fits in a replay record");
+        assert!(
+            action < ACTIONS,
+            "action index {action} fits in a replay record"
+        );
         let flags = if terminated { TERMINATED } else { 0 } | if truncated { TRUNCATED } else { 0 };
         f32::from_bits(action as u32 | flags)
     }
@@ -478,9 +481,10 @@ mod tests {
         let mut buffer = ReplayBuffer::new(8, odd.len());
         let next: Vec<f32> = odd.iter().rev().copied().collect();
         let actions = [0, 1, 2, tag::ACTIONS - 1];
-        for (i, (terminated, truncated)) in [(false, false), (true, false), (false, true), (true, true)]
-            .into_iter()
-            .enumerate()
+        for (i, (terminated, truncated)) in
+            [(false, false), (true, false), (false, true), (true, true)]
+                .into_iter()
+                .enumerate()
         {
             buffer.push(Transition {
                 obs: &odd,
