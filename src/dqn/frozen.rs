@@ -1,11 +1,13 @@
 //! A network that never learns again (a library's source as recorded), laid out for acting
 //! on one observation.
 //!
-//! The training path's pass ([`QNet::q_values`]) runs a batch across a vector's 16 lanes,
-//! so one observation is padded to 16 and 15 lanes compute nothing. Here each layer's
-//! weights are kept transposed, `Wᵀ[k][r]`, with the units padded to 16, and one
-//! observation's pass runs the lanes across the layer's units: a sixteenth of the work.
-//! Only for weights that do not change: the layout is made once.
+//! The training path's pass runs a batch across a vector's 16 lanes, so one observation
+//! padded to 16 would leave 15 lanes computing nothing. Here each layer's weights are kept
+//! transposed, `Wᵀ[k][r]`, with the units padded to 16, and one observation's pass runs the
+//! lanes across the layer's units: a sixteenth of the work. Only for weights that do not
+//! change: the layout is made once. A network that learns acts through
+//! [`QNet::q_values`], which transposes its weights in registers at every call
+//! (`kernels::MatVec`): the same bits, dearer than this pass (transposing is most of it).
 //!
 //! **The same bits** as [`QNet::q_values`]: every unit's value is the same chain of fused
 //! multiply-adds, from its bias over `k = 0, 1, …` in order (an FMA's product is exact, so

@@ -21,12 +21,14 @@ mod avx2;
 mod avx512;
 mod buffer;
 mod elementwise;
+mod matvec;
 mod portable;
 
 use std::sync::OnceLock;
 
 pub(crate) use buffer::Buffer;
 pub(crate) use elementwise::{adam_rows, sum_of_squares, AdamStep, Rows};
+pub(crate) use matvec::MatVec;
 
 /// Lanes the column count of a product is padded to: one AVX-512 vector, two of AVX2.
 pub(crate) const LANES: usize = 16;
