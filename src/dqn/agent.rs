@@ -9,6 +9,7 @@ use super::backprop::Workspace;
 use super::kernels::Isa;
 use super::round::{round, Interrupt};
 use super::scratch::{with_scratch, UpdateWork};
+use super::target_values::TargetValues;
 use super::{
     distillation_loss, td_huber_loss, Adam, Batch, DqnError, EpsilonGreedy, QNet, ReplayBuffer,
     Transition,
@@ -71,10 +72,17 @@ pub struct DqnAgent {
     /// The policy whose value the learner estimates, if not its own greedy one: its
     /// network's greedy action at `s′` is the bootstrap's (GPI's evaluation of a source).
     evaluated_policy: Option<QNet>,
+    /// `max_a Q_target(s′, a)` of the replay's transitions under the current target network.
+    target_values: TargetValues,
     /// Reused between updates.
     batch: Batch,
     targets: Vec<f32>,
     next_actions: Vec<usize>,
+    /// The bootstrap value of each transition of the minibatch (unused where terminal).
+    next_values: Vec<f32>,
+    /// The minibatch's transitions whose target values are not kept, and their `s′`.
+    misses: Vec<usize>,
+    miss_obs: Vec<f32>,
 }
 
 /// A teacher network distilled into the learner: `L = L_TD + weight · L_distil` at
@@ -103,9 +111,13 @@ impl DqnAgent {
             interrupt: Interrupt::default(),
             teacher: None,
             evaluated_policy: None,
+            target_values: TargetValues::new(),
             batch: Batch::new(),
             targets: Vec::new(),
             next_actions: Vec::new(),
+            next_values: Vec::new(),
+            misses: Vec::new(),
+            miss_obs: Vec::new(),
         })
     }
 
@@ -317,7 +329,7 @@ impl DqnAgent {
     ) -> Result<f64, DqnError> {
         let mut batch = std::mem::take(&mut self.batch);
         replay.sample_into(self.config.batch_size, &mut batch, rng);
-        let result = self.update_joined(&batch, joined);
+        let result = self.update_joined(&batch, joined, Some(replay));
         self.batch = batch;
         result
     }
@@ -328,14 +340,21 @@ impl DqnAgent {
     /// # Panics
     /// If `batch` is empty.
     pub fn update(&mut self, batch: &Batch) -> Result<f64, DqnError> {
-        self.update_joined(batch, &[])
+        self.update_joined(batch, &[], None)
     }
 
-    fn update_joined(&mut self, batch: &Batch, joined: &[&QNet]) -> Result<f64, DqnError> {
+    /// An update on `batch`, drawn from `replay` if given (whose slots' target values are
+    /// then kept between updates).
+    fn update_joined(
+        &mut self,
+        batch: &Batch,
+        joined: &[&QNet],
+        replay: Option<&ReplayBuffer>,
+    ) -> Result<f64, DqnError> {
         assert!(!batch.is_empty(), "cannot learn from an empty batch");
         with_scratch(|scratch| {
             let work = scratch.for_shape(self.online.architecture(), batch.len());
-            self.update_with(batch, work, joined)
+            self.update_with(batch, work, joined, replay)
         })
     }
 
@@ -345,8 +364,9 @@ impl DqnAgent {
         batch: &Batch,
         work: &mut UpdateWork,
         joined: &[&QNet],
+        replay: Option<&ReplayBuffer>,
     ) -> Result<f64, DqnError> {
-        self.compute_td_targets(batch, &mut work.target, joined)?;
+        self.compute_td_targets(batch, &mut work.target, joined, replay)?;
         let isa = Isa::current();
         // The targets are copied out: the target's buffers can take the teacher's pass.
         let target_work = &mut work.target;
@@ -394,7 +414,46 @@ impl DqnAgent {
     /// `y = r + γ·max_a' Q_target(s', a')` for every transition of `batch` (or, for a
     /// learner that evaluates another policy, `γ·Q_target(s′, π(s′))`), without the
     /// bootstrap after a terminal state (or a truncation, if `truncation_as_terminal`).
+    /// The values of `max_a' Q_target` of a minibatch drawn from `replay` are kept.
     fn compute_td_targets(
+        &mut self,
+        batch: &Batch,
+        work: &mut Workspace,
+        joined: &[&QNet],
+        replay: Option<&ReplayBuffer>,
+    ) -> Result<(), DqnError> {
+        self.next_values.clear();
+        self.next_values.resize(batch.len(), 0.0);
+        let own_greedy = joined.is_empty() && self.evaluated_policy.is_none();
+        match (own_greedy, replay, batch.slots()) {
+            (true, Some(replay), Some(slots)) => {
+                self.kept_next_values(batch, slots, replay, work)?
+            }
+            _ => self.computed_next_values(batch, work, joined)?,
+        }
+        let gamma = self.config.gamma as f32;
+        self.targets.clear();
+        for (b, &next_value) in self.next_values.iter().enumerate() {
+            let bootstrap = if self.terminal(batch, b) {
+                0.0
+            } else {
+                gamma * next_value
+            };
+            self.targets.push(batch.rewards()[b] + bootstrap);
+        }
+        Ok(())
+    }
+
+    /// Whether transition `b` of `batch` ends the bootstrap: terminated, or truncated
+    /// under `truncation_as_terminal`.
+    fn terminal(&self, batch: &Batch, b: usize) -> bool {
+        batch.terminated()[b] || (self.config.truncation_as_terminal && batch.truncated()[b])
+    }
+
+    /// The bootstrap values of every transition of `batch` from one target pass over them
+    /// all: `max_a' Q_target(s′, a′)`, or `Q_target(s′, a′)` at the action of the policy
+    /// the learner evaluates (its own, or with `joined`, the GPI action).
+    fn computed_next_values(
         &mut self,
         batch: &Batch,
         work: &mut Workspace,
@@ -413,22 +472,56 @@ impl DqnAgent {
         let next_q =
             self.target
                 .forward_with(Isa::current(), batch.next_obs(), batch.len(), work)?;
-        let gamma = self.config.gamma as f32;
-        let truncation_is_terminal = self.config.truncation_as_terminal;
         let evaluated = self.evaluated_policy.is_some() || !joined.is_empty();
-        self.targets.clear();
         let rows = next_q.chunks_exact(next_q.len() / batch.len());
-        for (b, row) in rows.enumerate() {
-            let terminal =
-                batch.terminated()[b] || (truncation_is_terminal && batch.truncated()[b]);
-            let bootstrap = if terminal {
-                0.0
-            } else if evaluated {
-                gamma * row[self.next_actions[b]]
+        for ((b, row), value) in rows.enumerate().zip(&mut self.next_values) {
+            *value = if evaluated {
+                row[self.next_actions[b]]
             } else {
-                gamma * row.iter().copied().fold(f32::MIN, f32::max)
+                greatest(row)
             };
-            self.targets.push(batch.rewards()[b] + bootstrap);
+        }
+        Ok(())
+    }
+
+    /// `max_a' Q_target(s′, a′)` of the non-terminal transitions of `batch`, drawn from
+    /// `replay`'s `slots`: kept values where the current target network gave them before,
+    /// one target pass over the others (`target_values.rs`: the same bits either way).
+    fn kept_next_values(
+        &mut self,
+        batch: &Batch,
+        slots: &[usize],
+        replay: &ReplayBuffer,
+        work: &mut Workspace,
+    ) -> Result<(), DqnError> {
+        self.target_values.follow(replay);
+        self.misses.clear();
+        self.miss_obs.clear();
+        let width = batch.obs_size();
+        for (b, &slot) in slots.iter().enumerate() {
+            if self.terminal(batch, b) {
+                continue;
+            }
+            match self.target_values.get(slot) {
+                Some(value) => self.next_values[b] = value,
+                None => {
+                    self.misses.push(b);
+                    self.miss_obs
+                        .extend_from_slice(&batch.next_obs()[b * width..(b + 1) * width]);
+                }
+            }
+        }
+        if self.misses.is_empty() {
+            return Ok(());
+        }
+        let next_q =
+            self.target
+                .forward_with(Isa::current(), &self.miss_obs, self.misses.len(), work)?;
+        let rows = next_q.chunks_exact(next_q.len() / self.misses.len());
+        for (&b, row) in self.misses.iter().zip(rows) {
+            let value = greatest(row);
+            self.next_values[b] = value;
+            self.target_values.set(slots[b], value);
         }
         Ok(())
     }
@@ -458,6 +551,7 @@ impl DqnAgent {
 
     /// Copies the online network into the target network.
     pub fn sync_target(&mut self) -> Result<(), DqnError> {
+        self.target_values.forget();
         self.target.copy_from(&self.online)
     }
 
@@ -488,6 +582,8 @@ impl DqnAgent {
         &self.online
     }
 
+    /// The target network, to read: only [`sync_target`](Self::sync_target) may change it
+    /// (the learner keeps values it computed, `target_values.rs`).
     pub fn target(&self) -> &QNet {
         &self.target
     }
@@ -496,4 +592,9 @@ impl DqnAgent {
     pub fn into_online(self) -> QNet {
         self.online
     }
+}
+
+/// The largest of `q`, folded from `f32::MIN` in order (a NaN is passed over).
+fn greatest(q: &[f32]) -> f32 {
+    q.iter().copied().fold(f32::MIN, f32::max)
 }

@@ -24,6 +24,7 @@ mod replay;
 mod round;
 mod scratch;
 mod source_values;
+mod target_values;
 
 pub use agent::{DqnAgent, TdError, UpdateReport};
 pub use attention::AttentionLearner;
@@ -37,3 +38,4 @@ pub use loss::{huber, td_huber_loss};
 pub use optim::Adam;
 pub use qnet::{Architecture, Init, QNet};
 pub use replay::{transition_bytes, Batch, ReplayBuffer, Transition};
+pub use target_values::BYTES_PER_TRANSITION as TARGET_VALUE_BYTES;

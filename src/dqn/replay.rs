@@ -10,6 +10,8 @@
 
 use rand::Rng;
 
+use super::target_values::next_replay_id;
+
 /// One environment step, as stored.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Transition<'a> {
@@ -64,8 +66,10 @@ pub fn transition_bytes(obs_size: usize) -> usize {
 }
 
 /// A fixed-capacity ring buffer of transitions.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct ReplayBuffer {
+    /// This buffer's own number ([`ReplayBuffer::id`]).
+    id: u64,
     capacity: usize,
     obs_size: usize,
     /// f32 words per record: `2·obs_size + 2`.
@@ -87,6 +91,7 @@ impl ReplayBuffer {
         assert!(capacity > 0, "replay capacity must be at least 1");
         assert!(obs_size > 0, "observation size must be at least 1");
         Self {
+            id: next_replay_id(),
             capacity,
             obs_size,
             stride: 2 * obs_size + 2,
@@ -95,6 +100,12 @@ impl ReplayBuffer {
             pushes: 0,
             records: Vec::new(),
         }
+    }
+
+    /// A number no other buffer of this process has, a clone's included: what a learner
+    /// keeps about a buffer's slots (`target_values.rs`) is for one buffer only.
+    pub fn id(&self) -> u64 {
+        self.id
     }
 
     pub fn len(&self) -> usize {
@@ -281,6 +292,22 @@ impl ReplayBuffer {
         }
         #[cfg(not(target_arch = "x86_64"))]
         let _ = slot;
+    }
+}
+
+impl Clone for ReplayBuffer {
+    /// A copy with an id of its own: the two may be pushed to differently from now on.
+    fn clone(&self) -> Self {
+        Self {
+            id: next_replay_id(),
+            capacity: self.capacity,
+            obs_size: self.obs_size,
+            stride: self.stride,
+            len: self.len,
+            next: self.next,
+            pushes: self.pushes,
+            records: self.records.clone(),
+        }
     }
 }
 

@@ -58,7 +58,11 @@ pub fn run_bytes(spec: &RunSpec) -> Result<f64, crate::env::EnvError> {
             .map_or(f64::INFINITY, |t| f64::from(n) * f64::from(t)),
     };
     let replay = (learners * spec.dqn.replay_capacity as f64).min(steps) * transition_bytes(obs);
-    Ok(networks + replay)
+    // Each learner keeps its target network's value of every stored transition.
+    let target_values = learners
+        * (spec.dqn.replay_capacity as f64).min(steps)
+        * crate::dqn::TARGET_VALUE_BYTES as f64;
+    Ok(networks + replay + target_values)
 }
 
 /// Refuses `specs` run `jobs` at a time if the largest of them could not fit in this
@@ -129,15 +133,15 @@ mod tests {
     fn a_dqn_run_needs_its_network_five_times_and_its_steps_in_replay() {
         // CartPole: 4 inputs, 2 actions; [10]: 10·5 + 2·11 = 72 parameters, 288 bytes.
         // 100 episodes of at most 500 steps under a capacity of 1,000: 1,000 records of
-        // (2·4 + 2)·4 = 40 bytes.
+        // (2·4 + 2)·4 = 40 bytes, and the learner's 8-byte target value of each.
         assert_eq!(
             run_bytes(&dqn_spec(vec![10], 1_000)).unwrap(),
-            5.0 * 288.0 + 40_000.0
+            5.0 * 288.0 + 40_000.0 + 8_000.0
         );
         // A capacity above the run's steps holds only the steps: 100·500.
         assert_eq!(
             run_bytes(&dqn_spec(vec![10], 1_000_000)).unwrap(),
-            5.0 * 288.0 + 50_000.0 * 40.0
+            5.0 * 288.0 + 50_000.0 * (40.0 + 8.0)
         );
     }
 

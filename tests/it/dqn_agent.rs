@@ -452,3 +452,58 @@ fn the_td_error_of_the_latest_transition_is_measured_before_and_after_the_round(
     let (report, _) = observe(true, true);
     assert!((report.td.unwrap().before + 0.5).abs() < 1e-6);
 }
+
+/// The learner keeps `max_a Q_target(s′, a)` of the replay's transitions while its target
+/// network lasts (`dqn/target_values.rs`). Kept or computed afresh, every target must be the
+/// same bits: a learner drawing from a small ring buffer (so slots are overwritten), its
+/// target copied every 7 updates, against a twin given the very same minibatches through
+/// `update`, which passes the target network over every transition each time.
+#[test]
+fn kept_target_values_give_the_bits_of_a_full_target_pass() {
+    let config = DqnConfig {
+        replay_start_size: 1,
+        ..DqnConfig::default()
+    };
+    let (mut kept, mut fresh) = (agent(&[24, 16], 3, &config), agent(&[24, 16], 3, &config));
+    let mut rng = StdRng::seed_from_u64(9);
+    let mut replay = ReplayBuffer::new(40, 2);
+    let (mut kept_rng, mut fresh_rng) = (StdRng::seed_from_u64(1), StdRng::seed_from_u64(1));
+    let mut batch = Batch::new();
+    for step in 0..300u64 {
+        let obs = [rng.random::<f32>(), rng.random::<f32>()];
+        let next_obs = [rng.random::<f32>(), rng.random::<f32>()];
+        replay.push(Transition {
+            obs: &obs,
+            action: rng.random_range(0..3),
+            reward: rng.random_range(-1.0..1.0),
+            next_obs: &next_obs,
+            terminated: rng.random::<f64>() < 0.1,
+            truncated: rng.random::<f64>() < 0.1,
+        });
+        let kept_loss = kept.learn_once(&replay, 7, &mut kept_rng).unwrap().unwrap();
+        replay.sample_into(config.batch_size, &mut batch, &mut fresh_rng);
+        let mut unslotted = Batch::new();
+        for b in 0..batch.len() {
+            let width = batch.obs_size();
+            unslotted.push(Transition {
+                obs: &batch.obs()[b * width..(b + 1) * width],
+                action: batch.actions()[b] as usize,
+                reward: f64::from(batch.rewards()[b]),
+                next_obs: &batch.next_obs()[b * width..(b + 1) * width],
+                terminated: batch.terminated()[b],
+                truncated: batch.truncated()[b],
+            });
+        }
+        let fresh_loss = fresh.update(&unslotted).unwrap();
+        if (step + 1).is_multiple_of(7) {
+            fresh.sync_target().unwrap();
+        }
+        assert_eq!(
+            kept_loss.to_bits(),
+            fresh_loss.to_bits(),
+            "loss at step {step}"
+        );
+    }
+    let bits = |net: &QNet| flat(net).iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(kept.online()), bits(fresh.online()));
+}
