@@ -8,9 +8,15 @@
 //! same order: the same minibatches bit for bit). Records grow as transitions arrive, so a
 //! 1e6-transition buffer costs only what it holds; once full, the oldest is overwritten.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use rand::Rng;
 
-use super::target_values::next_replay_id;
+/// A number no other replay buffer made by this process has.
+fn next_replay_id() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
+}
 
 /// One environment step, as stored.
 #[derive(Debug, Clone, Copy, PartialEq)]

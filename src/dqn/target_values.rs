@@ -15,8 +15,6 @@
 //! A value is valid for one target network (an *epoch*, counted up at each copy) and one
 //! record: a slot the ring buffer overwrites is forgotten ([`TargetValues::follow`]).
 
-use std::sync::atomic::{AtomicU64, Ordering};
-
 use super::ReplayBuffer;
 
 /// Bytes a learner keeps a stored transition's value in (the protocol's memory check).
@@ -108,12 +106,6 @@ impl TargetValues {
     fn bytes(&self) -> usize {
         self.slots.len() * BYTES_PER_TRANSITION
     }
-}
-
-/// A number no other replay buffer made by this process has.
-pub(crate) fn next_replay_id() -> u64 {
-    static NEXT: AtomicU64 = AtomicU64::new(1);
-    NEXT.fetch_add(1, Ordering::Relaxed)
 }
 
 #[cfg(test)]
