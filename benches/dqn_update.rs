@@ -1,7 +1,9 @@
 //! One DQN gradient update, as `shared/bench/torch_update_bench.py` times PyTorch's: online
 //! forward and gather, target forward, TD target, Huber loss, backward, Adam step, for
-//! 4-100-2, 4-100-100-2 and 4-100-100-100-2 at batch 32. Sampling is not timed: the batches
-//! are drawn before the clock starts.
+//! 4-100-2, 4-100-100-2 and 4-100-100-100-2 at batch 32 (and the shipped CartPole library's
+//! largest source, 4-64-114-149-2). Sampling is not timed: the batches are drawn before the
+//! clock starts, and a batch not drawn from a buffer runs the target network in full (no
+//! kept target values, `dqn/target_values.rs`).
 //!
 //! `cargo bench --bench dqn_update`; the PyTorch peer, in the same session:
 //! `python3 shared/bench/torch_update_bench.py --batches 32`.
@@ -57,12 +59,14 @@ fn update(c: &mut Criterion) {
     }
     let mut group = c.benchmark_group("dqn_update");
     group.measurement_time(Duration::from_secs(5));
-    // The paper's three shapes at ChainerRL's batch, and the zoo's CartPole network at
-    // its batch of 64 (about 34 MFLOP per update: the GFLOP/s figure of BENCHMARKS.md).
-    let cases: [(&[usize], usize); 4] = [
+    // The paper's three shapes and the shipped library's largest source at ChainerRL's
+    // batch, and the zoo's CartPole network at its batch of 64 (about 34 MFLOP per update:
+    // the GFLOP/s figure of BENCHMARKS.md).
+    let cases: [(&[usize], usize); 5] = [
         (&[100], 32),
         (&[100, 100], 32),
         (&[100, 100, 100], 32),
+        (&[64, 114, 149], 32),
         (&[256, 256], 64),
     ];
     for (hidden, size) in cases {
