@@ -28,7 +28,7 @@ struct Kept {
 }
 
 /// The kept values of one learner's target network.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub(crate) struct TargetValues {
     /// The buffer the slots are of ([`ReplayBuffer::id`]); 0 before the first.
     replay: u64,
@@ -44,8 +44,10 @@ pub(crate) struct TargetValues {
 impl TargetValues {
     pub(crate) fn new() -> Self {
         Self {
+            replay: 0,
+            pushes: 0,
             epoch: 1,
-            ..Self::default()
+            slots: Vec::new(),
         }
     }
 
