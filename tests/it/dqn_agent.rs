@@ -32,18 +32,24 @@ fn flat(net: &QNet) -> Vec<f32> {
 fn random_replay(n: usize, rng: &mut StdRng) -> ReplayBuffer {
     let mut replay = ReplayBuffer::new(1000, 2);
     for _ in 0..n {
-        let obs = [rng.random::<f32>(), rng.random::<f32>()];
-        let next_obs = [rng.random::<f32>(), rng.random::<f32>()];
-        replay.push(Transition {
-            obs: &obs,
-            action: rng.random_range(0..3),
-            reward: rng.random_range(-1.0..1.0),
-            next_obs: &next_obs,
-            terminated: rng.random::<f64>() < 0.1,
-            truncated: false,
-        });
+        push_random(&mut replay, rng, false);
     }
     replay
+}
+
+/// Pushes a random transition (2 observation values, 3 actions), terminated one time in
+/// ten, and truncated one time in ten if `truncations` (drawn only then).
+fn push_random(replay: &mut ReplayBuffer, rng: &mut StdRng, truncations: bool) {
+    let obs = [rng.random::<f32>(), rng.random::<f32>()];
+    let next_obs = [rng.random::<f32>(), rng.random::<f32>()];
+    replay.push(Transition {
+        obs: &obs,
+        action: rng.random_range(0..3),
+        reward: rng.random_range(-1.0..1.0),
+        next_obs: &next_obs,
+        terminated: rng.random::<f64>() < 0.1,
+        truncated: truncations && rng.random::<f64>() < 0.1,
+    });
 }
 
 fn fixed_batch() -> Batch {
@@ -470,16 +476,7 @@ fn kept_target_values_give_the_bits_of_a_full_target_pass() {
     let (mut kept_rng, mut fresh_rng) = (StdRng::seed_from_u64(1), StdRng::seed_from_u64(1));
     let mut batch = Batch::new();
     for step in 0..300u64 {
-        let obs = [rng.random::<f32>(), rng.random::<f32>()];
-        let next_obs = [rng.random::<f32>(), rng.random::<f32>()];
-        replay.push(Transition {
-            obs: &obs,
-            action: rng.random_range(0..3),
-            reward: rng.random_range(-1.0..1.0),
-            next_obs: &next_obs,
-            terminated: rng.random::<f64>() < 0.1,
-            truncated: rng.random::<f64>() < 0.1,
-        });
+        push_random(&mut replay, &mut rng, true);
         let kept_loss = kept.learn_once(&replay, 7, &mut kept_rng).unwrap().unwrap();
         replay.sample_into(config.batch_size, &mut batch, &mut fresh_rng);
         let mut unslotted = Batch::new();
