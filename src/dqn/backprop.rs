@@ -21,8 +21,9 @@ use candle_core::{bail, Result, Storage, Tensor};
 
 use super::kernels::{
     largest_magnitude_bits, padded, sum_of_squares, Buffer, Finish, Isa, Product, Rows, Start,
-    Strided, Transpose,
+    Strided, Transpose, SLACK,
 };
+use super::live_units::{all_finite, pack_columns, pack_rows, unpack_rows, LiveUnits};
 use super::{Architecture, QNet};
 
 /// Scratch memory of the passes, for one architecture and batch size at a time; kept between
@@ -38,12 +39,28 @@ pub(crate) struct Workspace {
     activations: Vec<Buffer>,
     /// The Q-values `[batch, actions]`.
     q: Vec<f32>,
+    /// The live units of each layer's input, for the hidden layers (`live_units.rs`).
+    live: Vec<LiveUnits>,
+    /// The live units' activations of each hidden layer with dead units, packed.
+    packed_activations: Vec<Buffer>,
+    /// Layer `l`'s weights at its input's live units, packed, where its forward sums left
+    /// the dead ones out.
+    packed_weights: Vec<Buffer>,
+    /// Whether every layer's input was finite in the last forward pass: if not, the
+    /// backward pass leaves no dead unit out (`live_units.rs`).
+    finite: bool,
+    /// Whether dead units are kept in the passes (for tests that compare both ways).
+    keep_dead: bool,
     /// A layer's input and a column of ones `[batch, padded(units + 1)]`, for its weights'
     /// and bias's gradients.
     inputs: Buffer,
     /// ∂z of the layer being differentiated and ∂a of its input, `[units, columns]`.
     grad_out: Buffer,
     grad_in: Buffer,
+    /// A layer's weights at its live outputs (and live inputs), packed for ∂a; its weights'
+    /// gradient at its live outputs, before it is spread over the layer's rows.
+    packed_left: Buffer,
+    packed_gradient: Buffer,
     gradients: Gradients,
 }
 
@@ -63,6 +80,18 @@ impl Workspace {
             buffer.resize(units * columns);
         }
         self.q.resize(batch * architecture.action_count, 0.0);
+        self.live.resize_with(sizes.len(), LiveUnits::default);
+        self.live[0].all();
+        self.packed_activations
+            .resize_with(sizes.len(), Buffer::default);
+        for (buffer, &units) in self.packed_activations.iter_mut().zip(&sizes) {
+            buffer.resize(units * columns);
+        }
+        self.packed_weights
+            .resize_with(sizes.len() - 1, Buffer::default);
+        for (buffer, w) in self.packed_weights.iter_mut().zip(sizes.windows(2)) {
+            buffer.resize(w[0] * w[1] + SLACK);
+        }
         (self.sizes, self.batch, self.columns) = (sizes, batch, columns);
     }
 
@@ -91,6 +120,11 @@ impl Workspace {
         self.inputs.resize(self.batch * padded(widest + 1));
         self.grad_out.resize(widest * self.columns);
         self.grad_in.resize(widest * self.columns);
+        let most = |size: fn(&[usize]) -> usize| self.sizes.windows(2).map(size).max();
+        self.packed_left
+            .resize(most(|w| w[0] * w[1]).unwrap_or(0) + SLACK);
+        self.packed_gradient
+            .resize(most(|w| w[1] * padded(w[0] + 1)).unwrap_or(0));
         let shapes = self.sizes.windows(2).flat_map(|w| {
             let (inputs, outputs) = (w[0], w[1]);
             [(outputs, inputs, padded(inputs + 1)), (1, outputs, outputs)]
@@ -250,23 +284,44 @@ impl QNet {
         }
         .run(isa, &mut work.activations[0], columns);
         let layers = sizes.len() - 1;
+        work.finite = all_finite(&work.activations[0], sizes[0], columns, batch);
         for l in 0..layers {
             let (inputs, outputs) = (sizes[l], sizes[l + 1]);
+            let hidden_output = l + 1 < layers;
             let (done, next) = work.activations.split_at_mut(l + 1);
+            // A hidden layer's sums leave its input's dead units out; the output layer's
+            // keep every term (`live_units.rs`).
+            let live_inputs = work.live[l].subset().filter(|_| hidden_output);
+            let packed_weights = &mut work.packed_weights[l];
             self.with_layer(l, |weight, bias| {
+                let (left, depth, right) = match live_inputs {
+                    Some(live) => {
+                        pack_columns(isa, weight, inputs, outputs, &work.live[l], packed_weights);
+                        let left = Strided {
+                            data: packed_weights,
+                            row_stride: live.len(),
+                            column_stride: 1,
+                        };
+                        (left, live.len(), &work.packed_activations[l][..])
+                    }
+                    None => {
+                        let left = Strided {
+                            data: weight,
+                            row_stride: inputs,
+                            column_stride: 1,
+                        };
+                        (left, inputs, &done[l][..])
+                    }
+                };
                 Product {
                     rows: outputs,
-                    depth: inputs,
+                    depth,
                     columns,
-                    left: Strided {
-                        data: weight,
-                        row_stride: inputs,
-                        column_stride: 1,
-                    },
-                    right: &done[l],
+                    left,
+                    right,
                     right_stride: columns,
                     start: Start::Bias(bias),
-                    finish: if l + 1 < layers {
+                    finish: if hidden_output {
                         Finish::Relu
                     } else {
                         Finish::Keep
@@ -274,6 +329,19 @@ impl QNet {
                 }
                 .run(isa, &mut next[0], columns)
             })?;
+            if hidden_output {
+                let live = &mut work.live[l + 1];
+                if work.keep_dead {
+                    live.all();
+                    work.finite &= all_finite(&next[0], outputs, columns, batch);
+                } else {
+                    work.finite &= live.scan(isa, &next[0], outputs, columns, batch);
+                }
+                if let Some(units) = live.subset() {
+                    let packed = &mut work.packed_activations[l + 1];
+                    pack_rows(&next[0], columns, columns, units, packed);
+                }
+            }
         }
         let actions = sizes[layers];
         Transpose {
@@ -308,9 +376,15 @@ impl QNet {
             columns: sizes[layers],
         }
         .run(isa, &mut work.grad_out, columns);
+        // Dead units are left out only where every input was finite (`live_units.rs`); δ
+        // (`grad_out`) then holds the live units' rows only.
+        let live = |h: usize| work.live[h].subset().filter(|_| work.finite);
         for l in (0..layers).rev() {
             let (inputs, outputs) = (sizes[l], sizes[l + 1]);
             let stride = padded(inputs + 1);
+            let live_outputs = live(l + 1).filter(|_| l + 1 < layers);
+            let live_inputs = live(l).filter(|_| l > 0);
+            let computed_rows = live_outputs.map_or(outputs, <[u32]>::len);
             let input = &work.activations[l];
             Transpose {
                 src: input,
@@ -326,8 +400,8 @@ impl QNet {
                 [weight, bias, ..] => (weight, bias),
                 _ => unreachable!("two gradients per layer"),
             };
-            Product {
-                rows: outputs,
+            let gradient = Product {
+                rows: computed_rows,
                 depth: batch,
                 columns: stride,
                 left: Strided {
@@ -339,26 +413,57 @@ impl QNet {
                 right_stride: stride,
                 start: Start::Zero,
                 finish: Finish::Keep,
+            };
+            match live_outputs {
+                Some(live) => {
+                    gradient.run(isa, &mut work.packed_gradient, stride);
+                    let packed = &work.packed_gradient;
+                    unpack_rows(packed, stride, live, outputs, &mut weight.values);
+                }
+                None => gradient.run(isa, &mut weight.values, stride),
             }
-            .run(isa, &mut weight.values, stride);
             for (o, db) in bias.values.iter_mut().enumerate() {
                 *db = weight.values[o * stride + inputs];
             }
             if l > 0 {
+                let (packed_left, packed_weights) = (&mut work.packed_left, &work.packed_weights);
                 self.with_layer(l, |weight, _| {
+                    // left[i][o] = Wₗ[o][i], over the live outputs and inputs.
+                    let (data, column_stride): (&[f32], usize) = match (live_outputs, live_inputs) {
+                        (None, None) => (weight, inputs),
+                        (Some(outs), None) => {
+                            pack_rows(weight, inputs, inputs, outs, packed_left);
+                            (packed_left, inputs)
+                        }
+                        // The forward pass packed a hidden layer's live inputs' columns.
+                        (None, Some(ins)) if l + 1 < layers => (&packed_weights[l], ins.len()),
+                        (None, Some(ins)) => {
+                            pack_columns(isa, weight, inputs, outputs, &work.live[l], packed_left);
+                            (packed_left, ins.len())
+                        }
+                        (Some(outs), Some(ins)) => {
+                            let width = ins.len();
+                            pack_rows(&packed_weights[l], width, width, outs, packed_left);
+                            (packed_left, width)
+                        }
+                    };
+                    let mask = match live_inputs {
+                        Some(_) => &work.packed_activations[l][..],
+                        None => &input[..],
+                    };
                     Product {
-                        rows: inputs,
-                        depth: outputs,
+                        rows: live_inputs.map_or(inputs, <[u32]>::len),
+                        depth: computed_rows,
                         columns,
                         left: Strided {
-                            data: weight,
+                            data,
                             row_stride: 1,
-                            column_stride: inputs,
+                            column_stride,
                         },
                         right: &work.grad_out,
                         right_stride: columns,
                         start: Start::Zero,
-                        finish: Finish::MaskBy(input),
+                        finish: Finish::MaskBy(mask),
                     }
                     .run(isa, &mut work.grad_in, columns)
                 })?;
@@ -385,7 +490,7 @@ mod tests {
     use super::*;
     use crate::dqn::Architecture;
     use candle_core::{Device, Var};
-    use rand::{rngs::StdRng, SeedableRng};
+    use rand::{rngs::StdRng, Rng, SeedableRng};
 
     /// The same network through candle's autograd.
     fn autograd_forward(net: &QNet, obs: &Tensor) -> Tensor {
@@ -470,6 +575,162 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A network whose biases leave units dead for some minibatches in every hidden layer.
+    fn sparse_net(seed: u64) -> QNet {
+        let mut rng = StdRng::seed_from_u64(seed);
+        let net = QNet::new(Architecture::new(4, &[40, 37, 50], 3), &mut rng).unwrap();
+        for var in net.parameters().iter().skip(1).step_by(2) {
+            var.set(&Tensor::randn(-0.4f32, 0.6, var.shape(), &Device::Cpu).unwrap())
+                .unwrap();
+        }
+        net
+    }
+
+    fn random_values(n: usize, scale: f32, rng: &mut StdRng) -> Vec<f32> {
+        (0..n).map(|_| rng.random_range(-scale..scale)).collect()
+    }
+
+    fn bits(values: impl IntoIterator<Item = f32>) -> Vec<u32> {
+        values.into_iter().map(f32::to_bits).collect()
+    }
+
+    /// The gradient values, with a zero of either sign read as `+0` (as Adam reads it).
+    fn unsigned_zero_bits(work: &Workspace) -> Vec<u32> {
+        let rows = work.gradients().rows().collect::<Vec<_>>();
+        let values = rows.iter().flat_map(|r| {
+            r.values
+                .chunks(r.stride)
+                .flat_map(|row| &row[..r.columns])
+                .map(|&x| if x == 0.0 { 0.0 } else { x })
+        });
+        bits(values)
+    }
+
+    /// `live_units.rs`'s claim: leaving dead units out changes no Q-value, and no gradient
+    /// but for the sign of a zero, on every path, for minibatches with a padded tail.
+    #[test]
+    fn leaving_dead_units_out_changes_no_q_value_and_no_gradient_but_a_zeros_sign() {
+        let net = sparse_net(3);
+        let mut rng = StdRng::seed_from_u64(4);
+        let mut some_dead = 0;
+        for batch in [1, 9, 32, 40] {
+            let obs = random_values(batch * 4, 2.0, &mut rng);
+            let grad_q = random_values(batch * 3, 1.0, &mut rng);
+            for isa in Isa::ALL.into_iter().filter(|i| i.supported()) {
+                let mut kept = Workspace {
+                    keep_dead: true,
+                    ..Workspace::default()
+                };
+                let mut left_out = Workspace::default();
+                let q_kept = bits(
+                    net.forward_with(isa, &obs, batch, &mut kept)
+                        .unwrap()
+                        .to_vec(),
+                );
+                let q = bits(
+                    net.forward_with(isa, &obs, batch, &mut left_out)
+                        .unwrap()
+                        .to_vec(),
+                );
+                assert_eq!(q, q_kept, "{isa:?}, batch {batch}");
+                some_dead += left_out
+                    .live
+                    .iter()
+                    .filter(|l| l.subset().is_some())
+                    .count();
+                net.backward_with(isa, &mut kept, &grad_q).unwrap();
+                net.backward_with(isa, &mut left_out, &grad_q).unwrap();
+                assert_eq!(
+                    unsigned_zero_bits(&left_out),
+                    unsigned_zero_bits(&kept),
+                    "{isa:?}, batch {batch}"
+                );
+            }
+        }
+        assert!(
+            some_dead > 8,
+            "the minibatches left units dead ({some_dead} layers)"
+        );
+    }
+
+    /// Adam on the gradients of passes that leave dead units out gives the weights of Adam on
+    /// passes that do not, to the bit, update after update.
+    #[test]
+    fn leaving_dead_units_out_gives_the_same_weights_after_every_update() {
+        let config = crate::dqn::DqnConfig::default();
+        let net = sparse_net(5);
+        let twin = net.deep_copy().unwrap();
+        let (mut adam, mut twin_adam) = (
+            crate::dqn::Adam::new(net.parameters(), &config),
+            crate::dqn::Adam::new(twin.parameters(), &config),
+        );
+        let mut kept = Workspace {
+            keep_dead: true,
+            ..Workspace::default()
+        };
+        let mut left_out = Workspace::default();
+        let mut rng = StdRng::seed_from_u64(6);
+        let isa = Isa::current();
+        for update in 0..60 {
+            let batch = [32, 7][update % 2];
+            let obs = random_values(batch * 4, 2.0, &mut rng);
+            let grad_q = random_values(batch * 3, 1.0, &mut rng);
+            net.forward_with(isa, &obs, batch, &mut left_out).unwrap();
+            net.backward_with(isa, &mut left_out, &grad_q).unwrap();
+            adam.step(net.parameters(), left_out.gradients()).unwrap();
+            twin.forward_with(isa, &obs, batch, &mut kept).unwrap();
+            twin.backward_with(isa, &mut kept, &grad_q).unwrap();
+            twin_adam.step(twin.parameters(), kept.gradients()).unwrap();
+        }
+        let weights = |net: &QNet| -> Vec<u32> {
+            let values = net
+                .parameters()
+                .iter()
+                .flat_map(|p| p.flatten_all().unwrap().to_vec1::<f32>().unwrap());
+            bits(values)
+        };
+        let (a, b) = (weights(&net), weights(&twin));
+        let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+        assert_eq!(differ, 0, "weights that differ, of {}", a.len());
+    }
+
+    /// With an infinite activation, the backward pass leaves out nothing (a dead unit's
+    /// weight gradient is then `0·∞`, NaN, in the full pass): the same bits, NaNs included.
+    #[test]
+    fn a_non_finite_activation_makes_the_backward_pass_leave_nothing_out() {
+        let net = sparse_net(7);
+        let mut rng = StdRng::seed_from_u64(8);
+        let batch = 9;
+        let mut obs = random_values(batch * 4, 2.0, &mut rng);
+        obs[4..8].fill(f32::MAX); // the hidden layers' sums overflow
+        let grad_q = random_values(batch * 3, 1.0, &mut rng);
+        let isa = Isa::current();
+        let mut kept = Workspace {
+            keep_dead: true,
+            ..Workspace::default()
+        };
+        let mut left_out = Workspace::default();
+        net.forward_with(isa, &obs, batch, &mut kept).unwrap();
+        net.forward_with(isa, &obs, batch, &mut left_out).unwrap();
+        assert!(!left_out.finite, "an activation overflows");
+        net.backward_with(isa, &mut kept, &grad_q).unwrap();
+        net.backward_with(isa, &mut left_out, &grad_q).unwrap();
+        let all = |work: &Workspace| -> Vec<u32> {
+            let rows = work.gradients().rows().collect::<Vec<_>>();
+            let values = rows.iter().flat_map(|r| {
+                r.values
+                    .chunks(r.stride)
+                    .flat_map(|row| row[..r.columns].to_vec())
+            });
+            bits(values.collect::<Vec<_>>())
+        };
+        let (a, b) = (all(&left_out), all(&kept));
+        let nan = a.iter().filter(|&&x| f32::from_bits(x).is_nan()).count();
+        assert!(nan > 0, "the full pass's gradient holds NaNs");
+        let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+        assert_eq!(differ, 0, "gradient values that differ, of {}", a.len());
     }
 
     #[test]

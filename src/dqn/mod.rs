@@ -16,6 +16,7 @@ mod error;
 mod exploration;
 mod frozen;
 pub mod kernels;
+mod live_units;
 mod loss;
 mod optim;
 mod q_values;
