@@ -2,11 +2,11 @@
 //!
 //! A ReLU unit whose output is `+0` for every transition of a minibatch is *dead* for it. In
 //! the 300-episode reuse comparison on the shipped CartPole library, 40% of the hidden units
-//! were dead for the minibatch that passed through them, and the products over live units
-//! only were 27% of the whole products' arithmetic (counted by instrumenting `backprop.rs`,
-//! BENCHMARKS.md). What a dead unit contributes, with finite weights (a library refuses a
-//! policy with a non-finite weight, an update with a non-finite gradient is refused, and
-//! Adam's steps are then finite):
+//! were dead for the minibatch that passed through them, and 27% of the weights joined two
+//! units live for it (counted over the learners' backward passes, observations and
+//! Q-values counted live; BENCHMARKS.md). What a dead unit contributes, with finite weights
+//! (a library refuses a policy with a non-finite weight, an update with a non-finite
+//! gradient is refused, and Adam's steps are then finite):
 //!
 //! - **Its terms in the next layer's forward sums**, `w·(+0)`, are signed zeros: added to a
 //!   sum they change it only where it is zero, and then only its sign, which the next
