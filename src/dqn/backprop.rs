@@ -23,7 +23,7 @@ use super::kernels::{
     largest_magnitude_bits, padded, sum_of_squares, Buffer, Finish, Isa, Product, Rows, Start,
     Strided, Transpose, SLACK,
 };
-use super::live_units::{all_finite, pack_columns, pack_rows, unpack_rows, LiveUnits};
+use super::live_units::{all_finite, pack_columns, pack_rows, spread_gradient, LiveUnits};
 use super::{Architecture, QNet};
 
 /// Scratch memory of the passes, for one architecture and batch size at a time; kept between
@@ -386,15 +386,22 @@ impl QNet {
             let live_inputs = live(l).filter(|_| l > 0);
             let computed_rows = live_outputs.map_or(outputs, <[u32]>::len);
             let input = &work.activations[l];
+            // ∂W's columns are the live inputs' only, then the bias's (its dead inputs'
+            // columns are zeros: `live_units.rs`).
+            let (live_input_rows, transposed) = match live_inputs {
+                Some(live) => (live.len(), &work.packed_activations[l][..]),
+                None => (inputs, &input[..]),
+            };
+            let packed_stride = padded(live_input_rows + 1);
             Transpose {
-                src: input,
+                src: transposed,
                 src_stride: columns,
-                rows: inputs,
+                rows: live_input_rows,
                 columns: batch,
             }
-            .run(isa, &mut work.inputs, stride);
-            for row in work.inputs.chunks_exact_mut(stride).take(batch) {
-                row[inputs] = 1.0;
+            .run(isa, &mut work.inputs, packed_stride);
+            for row in work.inputs.chunks_exact_mut(packed_stride).take(batch) {
+                row[live_input_rows] = 1.0;
             }
             let (weight, bias) = match &mut work.gradients.parameters[2 * l..] {
                 [weight, bias, ..] => (weight, bias),
@@ -403,24 +410,32 @@ impl QNet {
             let gradient = Product {
                 rows: computed_rows,
                 depth: batch,
-                columns: stride,
+                columns: packed_stride,
                 left: Strided {
                     data: &work.grad_out,
                     row_stride: columns,
                     column_stride: 1,
                 },
                 right: &work.inputs,
-                right_stride: stride,
+                right_stride: packed_stride,
                 start: Start::Zero,
                 finish: Finish::Keep,
             };
-            match live_outputs {
-                Some(live) => {
-                    gradient.run(isa, &mut work.packed_gradient, stride);
-                    let packed = &work.packed_gradient;
-                    unpack_rows(packed, stride, live, outputs, &mut weight.values);
-                }
-                None => gradient.run(isa, &mut weight.values, stride),
+            if live_outputs.is_none() && live_inputs.is_none() {
+                gradient.run(isa, &mut weight.values, stride);
+            } else {
+                gradient.run(isa, &mut work.packed_gradient, packed_stride);
+                let live_input_units = live_inputs.map(|_| &work.live[l]);
+                spread_gradient(
+                    isa,
+                    &work.packed_gradient,
+                    packed_stride,
+                    live_outputs,
+                    live_input_units,
+                    outputs,
+                    (inputs, stride),
+                    &mut weight.values,
+                );
             }
             for (o, db) in bias.values.iter_mut().enumerate() {
                 *db = weight.values[o * stride + inputs];

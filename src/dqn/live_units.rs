@@ -19,6 +19,9 @@
 //!   ([`LiveUnits::scan`] checks; a pass with a non-finite activation computes everything).
 //! - **Its terms in the gradient of the layer below**, `w·∂zₗ[o]`, are signed zeros too;
 //!   and **its own input gradient** is masked to `+0` whatever the sum: neither is computed.
+//! - **Its column of the next layer's weight gradient**, `Σ_b ∂zₗ₊₁[o][b]·(+0)`, is `+0`
+//!   for finite `∂z`: written as zeros. (A non-finite `∂zₗ₊₁[o][b]` makes the bias's
+//!   gradient `Σ_b ∂zₗ₊₁[o][b]` non-finite too, and the update is refused either way.)
 //!
 //! So the forward pass is the same to the bit, and a gradient can differ only in the sign of
 //! a zero (a sum left at `−0` by an underflowing product, where the full sum would add a
@@ -139,26 +142,45 @@ pub(crate) fn pack_columns(
     kernels::pack_columns(isa, src, stride, rows, live.columns(), dst);
 }
 
-/// The inverse of [`pack_rows`] for `rows` rows in all: row `listed[i]` of `dst` is row `i`
-/// of `packed` (`stride` values each, in both), every row not listed `+0`.
-pub(crate) fn unpack_rows(
+/// A weight gradient computed over the live units only, spread back over the layer's rows
+/// (`rows` of `dst`, `stride` apart, the bias's gradient in column `inputs`). `packed` holds
+/// a row per live output (per output, when `live_outputs` is `None`), `packed_stride`
+/// apart: the live inputs' columns side by side, then the bias's (when `live_inputs` is
+/// `None`, the whole row as `dst` lays it out). Every other value is `+0`: what the full
+/// product gives a dead unit's row and column.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn spread_gradient(
+    isa: Isa,
     packed: &[f32],
-    stride: usize,
-    listed: &[u32],
+    packed_stride: usize,
+    live_outputs: Option<&[u32]>,
+    live_inputs: Option<&LiveUnits>,
     rows: usize,
+    (inputs, stride): (usize, usize),
     dst: &mut [f32],
 ) {
-    let mut next = listed.iter().zip(packed.chunks(stride)).peekable();
+    let mut packed_rows = packed.chunks(packed_stride);
+    let mut listed = live_outputs.map(|l| l.iter().peekable());
     for (r, row) in dst.chunks_mut(stride).take(rows).enumerate() {
-        match next.next_if(|(&l, _)| l as usize == r) {
-            Some((_, from)) => copy(row, from),
-            None => {
-                let mut chunks = row.chunks_exact_mut(16);
-                for chunk in &mut chunks {
-                    chunk.copy_from_slice(&[0.0; 16]);
-                }
-                chunks.into_remainder().fill(0.0);
+        let computed = match &mut listed {
+            Some(listed) => listed.next_if(|&&l| l as usize == r).is_some(),
+            None => true,
+        };
+        let Some(from) = computed.then(|| packed_rows.next()).flatten() else {
+            let mut chunks = row.chunks_exact_mut(16);
+            for chunk in &mut chunks {
+                chunk.copy_from_slice(&[0.0; 16]);
             }
+            chunks.into_remainder().fill(0.0);
+            continue;
+        };
+        match live_inputs {
+            Some(live) => {
+                let width = live.units.len();
+                kernels::spread_columns(isa, &from[..width], live.columns(), row);
+                row[inputs] = from[width];
+            }
+            None => copy(row, &from[..stride]),
         }
     }
 }
@@ -200,7 +222,7 @@ mod tests {
     }
 
     #[test]
-    fn packing_keeps_the_listed_rows_and_columns_and_unpacking_puts_them_back() {
+    fn packing_keeps_the_listed_rows_and_columns_and_spreading_puts_them_back() {
         // 3 rows of 4 values, stride 5.
         let src: Vec<f32> = (0..15).map(|x| x as f32).collect();
         let mut packed = [-1.0f32; 9];
@@ -213,14 +235,23 @@ mod tests {
         pack_columns(Isa::current(), &src, 5, 3, &live, &mut packed);
         assert_eq!(packed[..6], [1.0, 3.0, 6.0, 8.0, 11.0, 13.0]);
 
+        // A gradient of 3 rows, 2 inputs and the bias (stride 4); rows 1 and 2 computed.
         let packed = [1.0, 2.0, 9.0, 3.0, 4.0, 9.0]; // 2 rows of 3
-        let mut dst = [7.0f32; 10];
-        unpack_rows(&packed, 3, &[1, 2], 3, &mut dst);
-        assert_eq!(dst, [0.0, 0.0, 0.0, 1.0, 2.0, 9.0, 3.0, 4.0, 9.0, 7.0]);
-        unpack_rows(&packed, 3, &[], 3, &mut dst);
+        let mut dst = [7.0f32; 13];
+        let isa = Isa::current();
+        spread_gradient(isa, &packed, 3, Some(&[1, 2]), None, 3, (2, 3), &mut dst);
         assert_eq!(
             dst,
-            [0.0; 9].into_iter().chain([7.0]).collect::<Vec<_>>()[..]
+            [0.0, 0.0, 0.0, 1.0, 2.0, 9.0, 3.0, 4.0, 9.0, 7.0, 7.0, 7.0, 7.0]
         );
+        // Inputs 1 and 3 of 4 live, all 2 rows computed: a row of 16 (4 inputs, the bias).
+        let mut live = LiveUnits::default();
+        assert!(live.scan(isa, &[0.0, 1.0, 0.0, 2.0], 4, 1, 1));
+        let packed = [1.0, 2.0, 5.0, 3.0, 4.0, 6.0];
+        let mut dst = [7.0f32; 33];
+        spread_gradient(isa, &packed, 3, None, Some(&live), 2, (4, 16), &mut dst);
+        assert_eq!(dst[..6], [0.0, 1.0, 0.0, 2.0, 5.0, 0.0]);
+        assert_eq!(dst[16..22], [0.0, 3.0, 0.0, 4.0, 6.0, 0.0]);
+        assert_eq!(dst[32], 7.0);
     }
 }

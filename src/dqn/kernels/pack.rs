@@ -191,6 +191,58 @@ unsafe fn compress(
     }
 }
 
+/// The inverse of [`pack_columns`] for one row: `dst[columns.list[i]] = packed[i]`, every
+/// other value of `dst`'s first `16 × masks.len()` set to `+0`.
+///
+/// # Panics
+/// If `packed` holds fewer values than the list, or `dst` fewer than the masks cover.
+pub(crate) fn spread_columns(isa: Isa, packed: &[f32], columns: Columns, dst: &mut [f32]) {
+    let covered = 16 * columns.masks.len();
+    assert!(packed.len() >= columns.list.len() && dst.len() >= covered);
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 && isa.supported() {
+        assert!(
+            columns
+                .masks
+                .iter()
+                .map(|m| m.count_ones() as usize)
+                .sum::<usize>()
+                == columns.list.len(),
+            "the masks hold the list"
+        );
+        // SAFETY: the CPU has AVX-512F; the asserts bound every read and write.
+        unsafe { expand(packed, columns.masks, dst) };
+        return;
+    }
+    let _ = isa;
+    dst[..covered].fill(0.0);
+    for (&value, &c) in packed.iter().zip(columns.list) {
+        dst[c as usize] = value;
+    }
+}
+
+/// Each 16-column chunk of `dst` from the next values of `packed`, as many as its mask has
+/// bits, loaded under a mask (no read past them) and expanded to the mask's lanes.
+///
+/// # Safety
+/// The CPU has AVX-512F; `packed` holds the masks' bits in values, `dst` 16 a mask.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,popcnt")]
+unsafe fn expand(packed: &[f32], masks: &[u16], dst: &mut [f32]) {
+    use std::arch::x86_64::*;
+    let mut from = packed.as_ptr();
+    for (c, &mask) in masks.iter().enumerate() {
+        let kept = mask.count_ones();
+        let front = (u32::MAX.checked_shr(32 - kept).unwrap_or(0)) as u16;
+        let values = _mm512_maskz_loadu_ps(front, from);
+        _mm512_storeu_ps(
+            dst.as_mut_ptr().add(16 * c),
+            _mm512_maskz_expand_ps(mask, values),
+        );
+        from = from.add(kept as usize);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -230,6 +282,35 @@ mod tests {
                     assert_eq!(set, live.contains(&(u as u32)), "{isa:?} unit {u}");
                 }
                 assert_eq!(flags & 0x8000_0000 != 0, nan, "{isa:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn every_path_spreads_packed_values_back_to_their_columns() {
+        for list in [
+            vec![0u32, 3, 15, 16, 17, 31, 36],
+            vec![36],
+            (0..37).collect(),
+            vec![],
+        ] {
+            let mut masks = vec![0u16; 3];
+            for &c in &list {
+                masks[c as usize / 16] |= 1 << (c % 16);
+            }
+            let columns = Columns {
+                list: &list,
+                masks: &masks,
+            };
+            let packed: Vec<f32> = (1..=list.len()).map(|x| x as f32).collect();
+            for isa in Isa::ALL.into_iter().filter(|i| i.supported()) {
+                let mut dst = vec![-1.0f32; 49];
+                spread_columns(isa, &packed, columns, &mut dst);
+                for (c, &value) in dst[..48].iter().enumerate() {
+                    let want = list.iter().position(|&l| l as usize == c);
+                    assert_eq!(value, want.map_or(0.0, |i| packed[i]), "{isa:?} column {c}");
+                }
+                assert_eq!(dst[48], -1.0, "{isa:?}: nothing past the masks");
             }
         }
     }
