@@ -51,14 +51,14 @@ pub(crate) struct Workspace {
     finite: bool,
     /// Whether dead units are kept in the passes (for tests that compare both ways).
     keep_dead: bool,
-    /// A layer's input and a column of ones `[batch, padded(units + 1)]`, for its weights'
-    /// and bias's gradients.
+    /// A layer's input (its live units', where some are dead) and a column of ones
+    /// `[batch, padded(units + 1)]`, for its weights' and bias's gradients.
     inputs: Buffer,
     /// ∂z of the layer being differentiated and ∂a of its input, `[units, columns]`.
     grad_out: Buffer,
     grad_in: Buffer,
     /// A layer's weights at its live outputs (and live inputs), packed for ∂a; its weights'
-    /// gradient at its live outputs, before it is spread over the layer's rows.
+    /// gradient at its live outputs and inputs, before it is spread back over the layer.
     packed_left: Buffer,
     packed_gradient: Buffer,
     gradients: Gradients,

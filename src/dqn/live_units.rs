@@ -31,8 +31,8 @@
 //! that leave dead units out against passes that do not.
 //!
 //! The passes compute on *packed* operands, the live units' rows and columns copied side by
-//! side, so that the products run on the same dense kernels: the copies are a few values per
-//! weight, the products they save 32 multiply-adds per weight.
+//! side, so that the products run on the same dense kernels: a copy moves each weight once,
+//! a product over a minibatch of 32 multiplies and adds it 32 times.
 
 use super::kernels::{self, non_finite_bit, Columns, Isa};
 

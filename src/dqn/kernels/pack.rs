@@ -286,18 +286,29 @@ mod tests {
         }
     }
 
-    #[test]
-    fn every_path_spreads_packed_values_back_to_their_columns() {
-        for list in [
+    /// Lists of columns out of 37 (chunk edges, one, all, none) with their masks.
+    fn column_lists() -> Vec<(Vec<u32>, Vec<u16>)> {
+        let lists = [
             vec![0u32, 3, 15, 16, 17, 31, 36],
             vec![36],
             (0..37).collect(),
             vec![],
-        ] {
-            let mut masks = vec![0u16; 3];
-            for &c in &list {
-                masks[c as usize / 16] |= 1 << (c % 16);
-            }
+        ];
+        lists
+            .into_iter()
+            .map(|list| {
+                let mut masks = vec![0u16; 3];
+                for &c in &list {
+                    masks[c as usize / 16] |= 1 << (c % 16);
+                }
+                (list, masks)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_path_spreads_packed_values_back_to_their_columns() {
+        for (list, masks) in column_lists() {
             let columns = Columns {
                 list: &list,
                 masks: &masks,
@@ -319,16 +330,7 @@ mod tests {
     fn every_path_packs_the_listed_columns() {
         let (rows, stride) = (5, 37);
         let src: Vec<f32> = (0..rows * stride).map(|x| x as f32).collect();
-        for list in [
-            vec![0u32, 3, 15, 16, 17, 31, 36],
-            vec![36],
-            (0..37).collect(),
-            vec![],
-        ] {
-            let mut masks = vec![0u16; 3];
-            for &c in &list {
-                masks[c as usize / 16] |= 1 << (c % 16);
-            }
+        for (list, masks) in column_lists() {
             let columns = Columns {
                 list: &list,
                 masks: &masks,
