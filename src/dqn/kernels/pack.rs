@@ -106,6 +106,14 @@ pub(crate) struct Columns<'a> {
     pub masks: &'a [u16],
 }
 
+impl Columns<'_> {
+    /// The masks have as many bits as the list has columns (the vector paths count on it).
+    fn check_masks(&self) {
+        let bits: usize = self.masks.iter().map(|m| m.count_ones() as usize).sum();
+        assert!(bits == self.list.len(), "the masks hold the list");
+    }
+}
+
 /// `dst[r·n + i] = src[r·stride + columns.list[i]]` for the first `rows` rows, `n` the
 /// columns kept. The [`SLACK`] values after them may be overwritten.
 ///
@@ -132,15 +140,7 @@ pub(crate) fn pack_columns(
     assert!(columns.masks.len() * 16 > last as usize);
     #[cfg(target_arch = "x86_64")]
     if isa == Isa::Avx512 && isa.supported() {
-        assert!(
-            columns
-                .masks
-                .iter()
-                .map(|m| m.count_ones() as usize)
-                .sum::<usize>()
-                == width,
-            "the masks hold the list"
-        );
+        columns.check_masks();
         // SAFETY: the CPU has AVX-512F; the asserts bound every lane a mask selects.
         unsafe { compress(src, stride, rows, columns.masks, width, dst) };
         return;
@@ -201,15 +201,7 @@ pub(crate) fn spread_columns(isa: Isa, packed: &[f32], columns: Columns, dst: &m
     assert!(packed.len() >= columns.list.len() && dst.len() >= covered);
     #[cfg(target_arch = "x86_64")]
     if isa == Isa::Avx512 && isa.supported() {
-        assert!(
-            columns
-                .masks
-                .iter()
-                .map(|m| m.count_ones() as usize)
-                .sum::<usize>()
-                == columns.list.len(),
-            "the masks hold the list"
-        );
+        columns.check_masks();
         // SAFETY: the CPU has AVX-512F; the asserts bound every read and write.
         unsafe { expand(packed, columns.masks, dst) };
         return;
