@@ -235,7 +235,7 @@ mod tests {
         pack_columns(Isa::current(), &src, 5, 3, &live, &mut packed);
         assert_eq!(packed[..6], [1.0, 3.0, 6.0, 8.0, 11.0, 13.0]);
 
-        // A gradient of 3 rows, 2 inputs and the bias (stride 4); rows 1 and 2 computed.
+        // A gradient of 3 rows, 2 inputs and the bias (stride 3); rows 1 and 2 computed.
         let packed = [1.0, 2.0, 9.0, 3.0, 4.0, 9.0]; // 2 rows of 3
         let mut dst = [7.0f32; 13];
         let isa = Isa::current();
