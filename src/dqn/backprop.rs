@@ -284,7 +284,7 @@ impl QNet {
         }
         .run(isa, &mut work.activations[0], columns);
         let layers = sizes.len() - 1;
-        work.finite = all_finite(&work.activations[0], sizes[0], columns, batch);
+        work.finite = all_finite(isa, &work.activations[0], sizes[0], columns, batch);
         for l in 0..layers {
             let (inputs, outputs) = (sizes[l], sizes[l + 1]);
             let hidden_output = l + 1 < layers;
@@ -333,7 +333,7 @@ impl QNet {
                 let live = &mut work.live[l + 1];
                 if work.keep_dead {
                     live.all();
-                    work.finite &= all_finite(&next[0], outputs, columns, batch);
+                    work.finite &= all_finite(isa, &next[0], outputs, columns, batch);
                 } else {
                     work.finite &= live.scan(isa, &next[0], outputs, columns, batch);
                 }

@@ -34,7 +34,7 @@
 //! side, so that the products run on the same dense kernels: a copy moves each weight once,
 //! a product over a minibatch of 32 multiplies and adds it 32 times.
 
-use super::kernels::{self, non_finite_bit, Columns, Isa};
+use super::kernels::{self, Columns, Isa, Rows};
 
 /// The units of one layer's activations that are not dead for the minibatch.
 #[derive(Debug, Default, Clone)]
@@ -89,14 +89,21 @@ impl LiveUnits {
     }
 }
 
-/// Whether the first `batch` values of each of `rows` rows (`columns` apart) are finite.
-pub(crate) fn all_finite(values: &[f32], rows: usize, columns: usize, batch: usize) -> bool {
-    let flags = values
-        .chunks(columns)
-        .take(rows)
-        .flat_map(|row| &row[..batch])
-        .fold(0u32, |flags, &x| flags | non_finite_bit(x));
-    flags & 0x8000_0000 == 0
+/// Whether the first `batch` values of each of `rows` rows (`columns` apart) are finite: the
+/// gradients' finiteness check (`kernels::largest_magnitude_bits`) on those values.
+pub(crate) fn all_finite(
+    isa: Isa,
+    values: &[f32],
+    rows: usize,
+    columns: usize,
+    batch: usize,
+) -> bool {
+    let rows = Rows {
+        values: &values[..rows * columns],
+        columns: batch,
+        stride: columns,
+    };
+    kernels::largest_magnitude_bits(isa, rows) < f32::INFINITY.to_bits()
 }
 
 /// `to ← from`, 16 values at a time where it can: a copy of a known length is a few vector
@@ -213,12 +220,19 @@ mod tests {
         assert!(!live.scan(Isa::current(), &[f32::NAN, 1.0], 1, 2, 2));
         assert!(live.scan(Isa::current(), &[1.0, f32::NAN], 1, 2, 1));
         assert!(all_finite(
+            Isa::current(),
             &[1.0, 2.0, f32::NAN, 3.0, 4.0, f32::INFINITY],
             2,
             3,
             2
         ));
-        assert!(!all_finite(&[1.0, -f32::INFINITY, 0.0], 1, 3, 2));
+        assert!(!all_finite(
+            Isa::current(),
+            &[1.0, -f32::INFINITY, 0.0],
+            1,
+            3,
+            2
+        ));
     }
 
     #[test]

@@ -30,7 +30,7 @@ use std::sync::OnceLock;
 pub(crate) use buffer::Buffer;
 pub(crate) use elementwise::{adam_rows, sum_of_squares, AdamStep, Rows};
 pub(crate) use matvec::MatVec;
-pub(crate) use pack::{live_rows, non_finite_bit, pack_columns, spread_columns, Columns, SLACK};
+pub(crate) use pack::{live_rows, pack_columns, spread_columns, Columns, SLACK};
 
 /// Lanes the column count of a product is padded to: one AVX-512 vector, two of AVX2.
 pub(crate) const LANES: usize = 16;

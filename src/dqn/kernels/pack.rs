@@ -7,7 +7,7 @@ use super::Isa;
 /// A value's bits with its exponent field's carry: bit 31 is set iff the exponent is all
 /// ones (an infinity or a NaN). Integer `and` and `add` only.
 #[inline(always)]
-pub(crate) fn non_finite_bit(x: f32) -> u32 {
+fn non_finite_bit(x: f32) -> u32 {
     (x.to_bits() & 0x7f80_0000).wrapping_add(0x0080_0000)
 }
 
